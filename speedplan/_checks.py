@@ -1,0 +1,115 @@
+"""Input checks shared by every layer.
+
+Each helper raises :class:`~speedplan.errors.InvalidInputError` whose message names the
+argument, shows the offending value and says what to do.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .errors import InvalidInputError
+
+FloatArray = NDArray[np.float64]
+
+#: Largest grid a single solve accepts; beyond it memory, not the solver, becomes the limit.
+MAX_GRID_POINTS = 5_000_000
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def as_array(
+    name: str,
+    value: Any,
+    *,
+    ndim: int | None = None,
+    length: int | None = None,
+    allow_inf: bool = False,
+) -> FloatArray:
+    """Return ``value`` as a float64 array after checking its shape and finiteness.
+
+    ``allow_inf`` admits ``+inf`` (an absent bound) but never ``-inf`` or NaN.
+    """
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(
+            f"`{name}` must be numeric (a number or an array of numbers); got {_short(value)}"
+        ) from exc
+    if ndim is not None and arr.ndim != ndim:
+        raise InvalidInputError(
+            f"`{name}` must be a {ndim}-D array; got shape {arr.shape}"
+        )
+    if length is not None and arr.shape[0] != length:
+        raise InvalidInputError(f"`{name}` must have length {length}; got {arr.shape[0]}")
+    if np.isnan(arr).any():
+        raise InvalidInputError(f"`{name}` contains NaN; pass finite numbers")
+    if allow_inf:
+        if np.isneginf(arr).any():
+            raise InvalidInputError(f"`{name}` contains -inf; pass finite numbers or +inf")
+    elif not np.isfinite(arr).all():
+        raise InvalidInputError(f"`{name}` contains inf; pass finite numbers")
+    return arr
+
+
+def as_scalar(
+    name: str,
+    value: Any,
+    *,
+    positive: bool = False,
+    nonnegative: bool = False,
+    allow_inf: bool = False,
+) -> float:
+    """Return ``value`` as a float after checking sign and finiteness."""
+    if isinstance(value, bool):
+        raise InvalidInputError(f"`{name}` must be a number; got {value!r}")
+    arr = as_array(name, value, ndim=0, allow_inf=allow_inf)
+    x = float(arr)
+    if positive and not x > 0:
+        raise InvalidInputError(f"`{name}` must be > 0; got {x!r}")
+    if nonnegative and not x >= 0:
+        raise InvalidInputError(f"`{name}` must be >= 0; got {x!r}")
+    return x
+
+
+def broadcast_positive(name: str, value: Any, length: int, *, allow_inf: bool = False) -> FloatArray:
+    """Return a positive scalar-or-vector bound as an array of ``length``."""
+    arr = as_array(name, value, allow_inf=allow_inf)
+    if arr.ndim == 0:
+        arr = np.full(length, float(arr))
+    elif arr.ndim != 1 or arr.shape[0] != length:
+        raise InvalidInputError(
+            f"`{name}` must be a scalar or a 1-D array of length {length}; got shape {arr.shape}"
+        )
+    if not (arr > 0).all():
+        bad = int(np.flatnonzero(~(arr > 0))[0])
+        raise InvalidInputError(
+            f"`{name}` must be > 0 everywhere; got {arr[bad]!r} at index {bad}"
+        )
+    return arr
+
+
+def choice(name: str, value: Any, options: Iterable[str]) -> str:
+    """Check that ``value`` is one of ``options`` (a closed set of strings)."""
+    opts = tuple(options)
+    if not isinstance(value, str) or value not in opts:
+        listed = ", ".join(repr(o) for o in opts)
+        raise InvalidInputError(f"`{name}` must be one of {listed}; got {_short(value)}")
+    return value
+
+
+def grid_size(name: str, n: int) -> int:
+    """Guard against grids too large to hold in memory."""
+    if n > MAX_GRID_POINTS:
+        raise InvalidInputError(
+            f"`{name}` asks for {n} grid points, more than the {MAX_GRID_POINTS} one solve "
+            "handles; use a coarser resolution or split the path"
+        )
+    return n

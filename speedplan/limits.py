@@ -1,0 +1,71 @@
+"""Vehicle limits in SI units and their mapping to the paper's constants."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ._checks import as_scalar
+
+__all__ = ["Limits"]
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Kinematic limits of a vehicle, SI units.
+
+    Parameters
+    ----------
+    v_max : float
+        Speed limit [m/s].
+    a_max : float
+        Tangential acceleration limit [m/s²].
+    a_lat_max : float
+        Lateral (centripetal) acceleration limit [m/s²]; ``inf`` for none.
+    j_max : float
+        Jerk limit, the time derivative of tangential acceleration [m/s³]; ``inf`` for none.
+    a_decel : float, optional
+        Braking limit [m/s²]; defaults to ``a_max``.
+
+    Notes
+    -----
+    With ``w = v²`` the paper's constants are ``A = 2 a_max`` (and ``2 a_decel`` when
+    braking), ``J = 2 j_max`` and ``A_N = a_lat_max``.
+
+    Examples
+    --------
+    >>> from speedplan import Limits
+    >>> lim = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    >>> lim.a_decel, lim.A, lim.J
+    (1.0, 2.0, 1.0)
+    """
+
+    v_max: float
+    a_max: float
+    a_lat_max: float
+    j_max: float
+    a_decel: float = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "v_max", as_scalar("v_max", self.v_max, positive=True))
+        set_(self, "a_max", as_scalar("a_max", self.a_max, positive=True))
+        set_(self, "a_lat_max", as_scalar("a_lat_max", self.a_lat_max, positive=True,
+                                          allow_inf=True))
+        set_(self, "j_max", as_scalar("j_max", self.j_max, positive=True, allow_inf=True))
+        decel = self.a_max if self.a_decel is None else self.a_decel
+        set_(self, "a_decel", as_scalar("a_decel", decel, positive=True))
+
+    @property
+    def A(self) -> float:  # noqa: N802 - the paper's symbol
+        """Paper's acceleration bound on ``w' = d(v²)/ds``: ``2 a_max`` [m/s²]."""
+        return 2.0 * self.a_max
+
+    @property
+    def A_decel(self) -> float:  # noqa: N802 - the paper's symbol
+        """Braking bound on ``-w'``: ``2 a_decel`` [m/s²]."""
+        return 2.0 * self.a_decel
+
+    @property
+    def J(self) -> float:  # noqa: N802 - the paper's symbol
+        """Paper's jerk bound on ``w'' sqrt(w)``: ``2 j_max`` [m/s³]."""
+        return 2.0 * self.j_max

@@ -1,0 +1,94 @@
+"""Exact O(n) solution of the problem without jerk rows: a forward and a backward pass.
+
+Without jerk rows the pointwise largest feasible ``w`` is optimal, because the objective
+decreases in every ``w_i``. Chaining ``w_{i+1} <= w_i + A_i h_i`` from every node ``j`` gives
+``w_i <= w_max_j + c_i - c_j`` with ``c`` the cumulative sum of ``A h``, so the forward pass is
+``c + minimum.accumulate(w_max - c)``; the backward pass is the same on the reversed grid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._checks import FloatArray
+from ..errors import InfeasibleError
+from .problem import DiscreteProblem
+
+__all__ = ["max_feasible_w", "check_reachable"]
+
+
+def _forward(bound: FloatArray, rate_h: FloatArray) -> FloatArray:
+    c = np.concatenate(([0.0], np.cumsum(rate_h)))
+    out: FloatArray = c + np.minimum.accumulate(bound - c)
+    return np.minimum(out, bound)
+
+
+def max_feasible_w(problem: DiscreteProblem, *, pin_ends: bool = True) -> FloatArray:
+    """Largest ``w`` meeting the bounds and the acceleration/braking rows.
+
+    With ``pin_ends`` the end values are capped at ``w_start`` and ``w_end``; the result then
+    equals them exactly when the boundary values are reachable (see :func:`check_reachable`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.solve.problem import DiscreteProblem
+    >>> p = DiscreteProblem(s=np.arange(5.0), w_max=np.full(5, 10.0), accel=np.ones(4),
+    ...                     decel=np.ones(4), jerk=np.full(3, np.inf))
+    >>> max_feasible_w(p).tolist()
+    [0.0, 1.0, 2.0, 1.0, 0.0]
+    """
+    bound = problem.w_max.copy()
+    if pin_ends:
+        bound[0] = min(bound[0], problem.w_start)
+        bound[-1] = min(bound[-1], problem.w_end)
+    w = _forward(bound, problem.accel * problem.h)
+    w = _forward(w[::-1], (problem.decel * problem.h)[::-1])[::-1]
+    return np.maximum(w, 0.0)
+
+
+def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
+    """Raise :class:`InfeasibleError` if ``w_start`` / ``w_end`` cannot be met.
+
+    The message names the bound that cannot be reached and where (grid position ``s``).
+    """
+    tol = 1e-9 * max(1.0, float(np.max(problem.w_max)))
+    s = problem.s
+    for name, value, bound in (
+        ("w_start", problem.w_start, problem.w_max[0]),
+        ("w_end", problem.w_end, problem.w_max[-1]),
+    ):
+        if value > bound + tol:
+            where = s[0] if name == "w_start" else s[-1]
+            raise InfeasibleError(
+                f"`{name}`={value:.6g} exceeds the bound w_max={bound:.6g} at s={where:.6g}{units}",
+                constraint=name,
+                s=float(where),
+            )
+    # Braking from w_start: the backward pass alone says how fast each node may be.
+    dec_h = problem.decel * problem.h
+    c = np.concatenate(([0.0], np.cumsum(dec_h)))
+    reach_back = problem.w_max.copy()
+    reach_back[-1] = min(reach_back[-1], problem.w_end)
+    limit_from = reach_back + c  # w_0 <= w_max_j + c_j - c_0
+    j = int(np.argmin(limit_from))
+    if problem.w_start > limit_from[j] + tol:
+        raise InfeasibleError(
+            f"cannot brake from w_start={problem.w_start:.6g} down to w_max={reach_back[j]:.6g} "
+            f"at s={s[j]:.6g}{units} under the braking bound",
+            constraint="decel",
+            s=float(s[j]),
+        )
+    acc_h = problem.accel * problem.h
+    c = np.concatenate(([0.0], np.cumsum(acc_h)))
+    reach_fwd = problem.w_max.copy()
+    reach_fwd[0] = min(reach_fwd[0], problem.w_start)
+    limit_to = reach_fwd + (c[-1] - c)  # w_end <= w_max_j + (c_end - c_j)
+    j = int(np.argmin(limit_to))
+    if problem.w_end > limit_to[j] + tol:
+        raise InfeasibleError(
+            f"cannot accelerate from w_max={reach_fwd[j]:.6g} at s={s[j]:.6g}{units} up to "
+            f"w_end={problem.w_end:.6g} under the acceleration bound",
+            constraint="accel",
+            s=float(s[j]),
+        )

@@ -1,0 +1,176 @@
+"""The discrete speed-planning problem on a (possibly non-uniform) grid.
+
+With ``w = v²`` sampled at nodes ``s_0 < … < s_{n-1}`` (steps ``h_i``), the problem is
+
+    minimise   Σ_interior τ_i / sqrt(w_i)                    (τ_i = (h_{i-1} + h_i) / 2)
+    subject to (w_{i+1} - w_i) / h_i <= A_i,   (w_i - w_{i+1}) / h_i <= D_i,
+               0 <= w_i <= w_max_i,   w_0 = w_start,   w_{n-1} = w_end,
+               |w''_i| sqrt(w_i) <= J_i      (w'' the three-point second difference).
+
+On a uniform grid it is the paper's problem verbatim (``Σ h/sqrt(w_i)`` and
+``|w_{i-1} - 2 w_i + w_{i+1}| sqrt(w_i) <= h² J``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+
+from .._checks import FloatArray
+
+__all__ = ["DiscreteProblem"]
+
+#: Paper's exactness test: a jerk row may be violated by at most this (h = 1 units).
+JERK_TOL = 1e-5
+
+
+@dataclass(frozen=True)
+class DiscreteProblem:
+    """Data of one discrete problem; arrays are validated by the callers' checks.
+
+    Attributes
+    ----------
+    s : ndarray, shape (n,)
+        Strictly increasing grid positions.
+    w_max : ndarray, shape (n,)
+        Upper bounds on ``w`` (finite, >= 0).
+    accel, decel : ndarray, shape (n-1,)
+        Bounds ``A_i``, ``D_i`` on ``±(w_{i+1} - w_i) / h_i`` (finite, > 0).
+    jerk : ndarray, shape (n-2,)
+        Bounds ``J_i`` on ``|w''_i| sqrt(w_i)``; ``inf`` drops the row.
+    w_start, w_end : float
+        Fixed boundary values of ``w``.
+    """
+
+    s: FloatArray
+    w_max: FloatArray
+    accel: FloatArray
+    decel: FloatArray
+    jerk: FloatArray
+    w_start: float = 0.0
+    w_end: float = 0.0
+
+    @property
+    def n(self) -> int:
+        """Number of grid nodes."""
+        return int(self.s.shape[0])
+
+    @cached_property
+    def h(self) -> FloatArray:
+        """Steps ``h_i = s_{i+1} - s_i``, shape (n-1,)."""
+        return np.diff(self.s)
+
+    @cached_property
+    def tau(self) -> FloatArray:
+        """Interior cell lengths ``(h_{i-1} + h_i) / 2``, shape (n-2,)."""
+        return 0.5 * (self.h[:-1] + self.h[1:])
+
+    @cached_property
+    def uniform(self) -> bool:
+        """Whether the grid is uniform (to rounding)."""
+        h = self.h
+        return bool(np.ptp(h) <= 1e-9 * h.mean())
+
+    @cached_property
+    def has_jerk(self) -> bool:
+        """Whether any jerk row is finite."""
+        return bool(np.isfinite(self.jerk).any())
+
+    @cached_property
+    def second_difference(self) -> sp.csr_matrix:
+        """Sparse (n-2, n) operator mapping ``w`` to ``w''`` at interior nodes."""
+        h0, h1 = self.h[:-1], self.h[1:]
+        m = self.n - 2
+        rows = np.repeat(np.arange(m), 3)
+        cols = (np.arange(m)[:, None] + np.arange(3)[None, :]).ravel()
+        vals = np.column_stack(
+            (2.0 / (h0 * (h0 + h1)), -2.0 / (h0 * h1), 2.0 / (h1 * (h0 + h1)))
+        ).ravel()
+        return sp.csr_matrix((vals, (rows, cols)), shape=(m, self.n))
+
+    def travel_time(self, w: FloatArray) -> float:
+        """The objective ``Σ τ_i / sqrt(w_i)`` over interior nodes (inf if some ``w_i <= 0``)."""
+        wi = w[1:-1]
+        if (wi <= 0).any():
+            return float("inf")
+        return float(np.sum(self.tau / np.sqrt(wi)))
+
+    def jerk_rows(self, w: FloatArray) -> FloatArray:
+        """Per interior node, ``τ² (|w''| - J / sqrt(w))``: the paper's violation measure.
+
+        On a uniform grid this is ``|w_{i-1} - 2 w_i + w_{i+1}| - h² J_i / sqrt(w_i)``, which is
+        invariant under the paper's scaling ``(h, A, J) -> (ρh, A/ρ, J/ρ²)``. Rows with
+        ``J = inf`` give ``-inf``.
+        """
+        wpp = self.second_difference @ w
+        wi = np.maximum(w[1:-1], 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cap = np.where(np.isfinite(self.jerk), self.jerk / np.sqrt(wi), np.inf)
+        cap = np.where(np.isnan(cap), np.inf, cap)
+        out = np.asarray(self.tau**2 * (np.abs(wpp) - cap), dtype=np.float64)
+        return out
+
+    def jerk_violation(self, w: FloatArray) -> float:
+        """Largest jerk-row violation (``<= 0`` means every jerk row holds)."""
+        if not self.has_jerk or self.n < 3:
+            return 0.0
+        return max(float(np.max(self.jerk_rows(w))), 0.0)
+
+    def linear_violation(self, w: FloatArray) -> float:
+        """Largest violation of the linear rows (acceleration, bounds, boundary), in ``w`` units."""
+        dw = np.diff(w)
+        parts = (
+            np.max(dw - self.accel * self.h, initial=0.0),
+            np.max(-dw - self.decel * self.h, initial=0.0),
+            np.max(w - self.w_max, initial=0.0),
+            np.max(-w, initial=0.0),
+            abs(w[0] - self.w_start),
+            abs(w[-1] - self.w_end),
+        )
+        return float(max(parts))
+
+    def satisfies_a_priori_exactness(self) -> bool:
+        """Corollary 1: constant bounds on a uniform grid and ``w_max`` meets every positive row.
+
+        When true the relaxation is exact whatever its solution (the paper proves it for
+        constant ``A`` and ``J``; we also require a uniform grid).
+        """
+        if not self.has_jerk or self.n < 3:
+            return True
+        constant = (
+            self.uniform
+            and np.ptp(self.accel) == 0
+            and np.ptp(self.decel) == 0
+            and np.all(np.isfinite(self.jerk))
+            and np.ptp(self.jerk) == 0
+        )
+        if not constant:
+            return False
+        wm = self.w_max.copy()
+        wm[0], wm[-1] = self.w_start, self.w_end
+        wpp = self.second_difference @ wm
+        wi = wm[1:-1]
+        with np.errstate(divide="ignore"):
+            positive_rows = self.tau**2 * (wpp - self.jerk / np.sqrt(wi))
+        return bool(np.all(positive_rows <= JERK_TOL))
+
+    def scaled(self, s_scale: float, w_scale: float) -> DiscreteProblem:
+        """The same problem in units ``s/s_scale`` and ``w/w_scale``.
+
+        ``w`` solves this one iff ``w * w_scale`` solves the original, and travel times differ
+        by the factor ``s_scale / sqrt(w_scale)``.
+        """
+        a_scale = w_scale / s_scale
+        j_scale = w_scale**1.5 / s_scale**2
+        return DiscreteProblem(
+            s=(self.s - self.s[0]) / s_scale,
+            w_max=self.w_max / w_scale,
+            accel=self.accel / a_scale,
+            decel=self.decel / a_scale,
+            jerk=self.jerk / j_scale,
+            w_start=self.w_start / w_scale,
+            w_end=self.w_end / w_scale,
+        )
