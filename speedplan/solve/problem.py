@@ -23,8 +23,11 @@ from .._checks import FloatArray
 
 __all__ = ["DiscreteProblem"]
 
-#: Paper's exactness test: a jerk row may be violated by at most this (h = 1 units).
+#: Paper's exactness test: a jerk row may be violated by at most 1e-5 (``h = 1``, ``w_max``
+#: up to 100). We apply it relative to the largest bound, which is the same number at the
+#: paper's scale and makes the test invariant when ``w`` is rescaled.
 JERK_TOL = 1e-5
+JERK_TOL_REL = JERK_TOL / 100.0
 
 
 @dataclass(frozen=True)
@@ -113,6 +116,11 @@ class DiscreteProblem:
         out = np.asarray(self.tau**2 * (np.abs(wpp) - cap), dtype=np.float64)
         return out
 
+    @cached_property
+    def jerk_tol(self) -> float:
+        """Exactness threshold on :meth:`jerk_violation`: ``1e-7 × max(w_max)``."""
+        return JERK_TOL_REL * max(float(np.max(self.w_max)), self.w_start, self.w_end)
+
     def jerk_violation(self, w: FloatArray) -> float:
         """Largest jerk-row violation (``<= 0`` means every jerk row holds)."""
         if not self.has_jerk or self.n < 3:
@@ -155,7 +163,7 @@ class DiscreteProblem:
         wi = wm[1:-1]
         with np.errstate(divide="ignore"):
             positive_rows = self.tau**2 * (wpp - self.jerk / np.sqrt(wi))
-        return bool(np.all(positive_rows <= JERK_TOL))
+        return bool(np.all(positive_rows <= self.jerk_tol))
 
     def scaled(self, s_scale: float, w_scale: float) -> DiscreteProblem:
         """The same problem in units ``s/s_scale`` and ``w/w_scale``.

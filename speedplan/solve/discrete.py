@@ -1,0 +1,251 @@
+"""Solve the discrete problem to certified optimality: pass, relaxation, refinement.
+
+The algorithm is the paper's (Section "Solution algorithm"):
+
+1. without jerk rows, the exact forward/backward pass (no solver);
+2. otherwise the SOCP relaxation, whose dual objective is a certified lower bound;
+3. if its ``w`` meets every jerk row (violation <= 1e-5) it is globally optimal
+   (Observation 1); otherwise IPOPT refines from it and the optimum lies in
+   ``[lower_bound, objective]``.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from .._checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
+from ..errors import InvalidInputError, SolverError
+from .clarabel_ import RelaxationResult, solve_relaxation
+from .ipopt_ import refine_ipopt
+from .nojerk import check_reachable, max_feasible_w
+from .problem import DiscreteProblem
+from .solution import DiscreteSolution
+
+__all__ = ["solve_discrete", "solve_problem", "RELAXATION_BACKENDS", "REFINE_MODES"]
+
+#: Relaxation backends by name; each maps a (normalised) problem to a RelaxationResult.
+RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = {
+    "clarabel": solve_relaxation,
+}
+REFINE_MODES = ("auto", "always", "never")
+
+
+def _linear_tol(problem: DiscreteProblem) -> float:
+    return 1e-7 * max(1.0, float(np.max(problem.w_max)))
+
+
+def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArray | None:
+    """Shrink ``w`` uniformly until every jerk row holds (only when both ends are at rest).
+
+    ``c w`` keeps every linear row and scales ``w'' sqrt(w)`` by ``c^1.5``.
+    """
+    if problem.w_start != 0.0 or problem.w_end != 0.0:
+        return None
+    wpp = np.abs(problem.second_difference @ w)
+    load = wpp * np.sqrt(np.maximum(w[1:-1], 0.0))
+    finite = np.isfinite(problem.jerk) & (load > 0)
+    if not finite.any():
+        return w
+    c = float(min(1.0, np.min(problem.jerk[finite] / load[finite]) ** (2.0 / 3.0)))
+    return w * (c * (1.0 - 1e-12))
+
+
+def solve_problem(
+    problem: DiscreteProblem, *, refine: str = "auto", backend: str = "clarabel"
+) -> DiscreteSolution:
+    """Solve a validated :class:`DiscreteProblem` (any grid) and certify the result.
+
+    Raises
+    ------
+    InfeasibleError
+        If the boundary values cannot be met.
+    SolverError
+        If a backend fails and no feasible point can be produced.
+    """
+    t_start = time.perf_counter()
+    refine = choice("refine", refine, REFINE_MODES)
+    backend = choice("backend", backend, RELAXATION_BACKENDS)
+    check_reachable(problem)
+    if not problem.has_jerk or problem.n < 3:
+        w = max_feasible_w(problem)
+        obj = problem.travel_time(w)
+        return DiscreteSolution(
+            w=w, objective=obj, lower_bound=obj, gap=0.0, exact=True, exact_a_priori=True,
+            jerk_violation=0.0, refined=False, status="optimal",
+            solve_time=time.perf_counter() - t_start, extras={"backend": "pass"},
+        )
+
+    # Solve in units where the mean step and the largest bound are 1: well-scaled cones.
+    s_scale = float(np.mean(problem.h))
+    w_scale = float(np.max(problem.w_max))
+    time_scale = s_scale / np.sqrt(w_scale)
+    unit = problem.scaled(s_scale, w_scale)
+    relax = RELAXATION_BACKENDS[backend](unit)
+    w_relaxed = np.clip(relax.w * w_scale, 0.0, problem.w_max)
+    w_relaxed[0], w_relaxed[-1] = problem.w_start, problem.w_end
+    lower = min(relax.dual_objective, relax.primal_objective) * time_scale
+    relaxed_violation = problem.jerk_violation(w_relaxed)
+    exact = relaxed_violation <= problem.jerk_tol
+    extras: dict[str, Any] = {
+        "backend": backend,
+        "iterations": relax.iterations,
+        "relaxation_status": relax.status,
+        "relaxation_time": relax.solve_time + relax.setup_time,
+        "relaxed_jerk_violation": relaxed_violation,
+        "relaxed_w": w_relaxed,
+    }
+    w, status, refined = w_relaxed, "optimal" if exact else "relaxed", False
+
+    if refine == "always" or (refine == "auto" and not exact):
+        refined = True
+        ref = refine_ipopt(unit, relax.w)
+        w_ref = np.clip(ref.w * w_scale, 0.0, problem.w_max)
+        ref_ok = (
+            ref.success
+            and problem.linear_violation(w_ref) <= _linear_tol(problem)
+            and problem.jerk_violation(w_ref) <= problem.jerk_tol
+        )
+        extras.update(refine_status=ref.status, refine_time=ref.solve_time,
+                      refine_iterations=ref.iterations,
+                      refine_objective=problem.travel_time(w_ref) if ref_ok else None)
+        if not exact:
+            if ref_ok:
+                w, status = w_ref, "refined"
+            else:
+                fallback = _scale_into_jerk_bounds(problem, w_relaxed)
+                if fallback is None:
+                    raise SolverError(
+                        f"the relaxation is not exact (jerk violation {relaxed_violation:.3g}) "
+                        f"and IPOPT did not return a feasible point (status {ref.status})",
+                        backend="ipopt", status=ref.status,
+                    )
+                warnings.warn(
+                    f"IPOPT refinement failed (status {ref.status}); returning the relaxed "
+                    "solution scaled into the jerk bounds (status 'scaled')",
+                    RuntimeWarning, stacklevel=3,
+                )
+                w, status = fallback, "scaled"
+    elif not exact:
+        warnings.warn(
+            f"refine='never' and the relaxation is not exact: w violates jerk rows by up to "
+            f"{relaxed_violation:.3g} (status 'relaxed')",
+            RuntimeWarning, stacklevel=3,
+        )
+
+    objective = problem.travel_time(w)
+    return DiscreteSolution(
+        w=w,
+        objective=objective,
+        lower_bound=lower,
+        gap=(objective - lower) / lower,
+        exact=exact,
+        exact_a_priori=problem.satisfies_a_priori_exactness(),
+        jerk_violation=problem.jerk_violation(w),
+        refined=refined,
+        status=status,
+        solve_time=time.perf_counter() - t_start,
+        extras=extras,
+    )
+
+
+def _accel_pair(A: Any, n: int) -> tuple[FloatArray, FloatArray]:
+    if isinstance(A, tuple):
+        if len(A) != 2:
+            raise InvalidInputError(
+                f"`A` as a tuple must be (accel, decel); got a tuple of length {len(A)}"
+            )
+        return (broadcast_positive("A[0] (accel)", A[0], n - 1),
+                broadcast_positive("A[1] (decel)", A[1], n - 1))
+    acc = broadcast_positive("A", A, n - 1)
+    return acc, acc
+
+
+def solve_discrete(
+    w_max: Any,
+    A: Any,
+    J: Any,
+    h: float = 1.0,
+    *,
+    w_start: float = 0.0,
+    w_end: float = 0.0,
+    refine: str = "auto",
+    backend: str = "clarabel",
+) -> DiscreteSolution:
+    """Solve the paper's discrete speed-planning problem with a certificate of optimality.
+
+    minimise ``Σ_{i=2}^{n-1} h / sqrt(w_i)`` subject to ``|w_{i+1} - w_i| <= A_i h``,
+    ``0 <= w_i <= w_max_i``, ``|w_{i-1} - 2 w_i + w_{i+1}| sqrt(w_i) <= h² J_i`` and
+    ``w_1 = w_start``, ``w_n = w_end``.
+
+    Parameters
+    ----------
+    w_max : array_like, shape (n,)
+        Upper bounds on ``w = v²``; ``> 0`` at interior nodes.
+    A : float, array_like of shape (n-1,), or tuple (accel, decel)
+        Bound on ``|w_{i+1} - w_i| / h``. A *tuple* of two entries gives separate
+        acceleration and braking bounds (each scalar or length n-1).
+    J : float or array_like, shape (n-2,)
+        Jerk bound of each interior node; ``inf`` drops the row (``J=inf``: no jerk rows, solved
+        exactly by an O(n) pass without any solver).
+    h : float
+        Grid step.
+    w_start, w_end : float
+        Boundary values ``w_1`` and ``w_n`` (the paper: 0).
+    refine : {"auto", "always", "never"}
+        When to run the IPOPT refinement: when the relaxation is not exact, always (its result
+        is then in ``extras``), or never (a non-exact result has status ``"relaxed"`` and warns).
+    backend : str
+        Relaxation backend, one of :data:`RELAXATION_BACKENDS`.
+
+    Returns
+    -------
+    DiscreteSolution
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong shapes, NaN/inf, non-positive ``h``/``A``/``J``, negative ``w_max``.
+    InfeasibleError
+        The boundary values cannot be met (the message says which and where).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan import solve_discrete
+    >>> sol = solve_discrete(np.full(50, 4.0), A=0.5, J=0.2)
+    >>> sol.status, sol.exact, bool(sol.gap < 1e-6)
+    ('optimal', True, True)
+    >>> sol.w.max() <= 4.0
+    True
+    """
+    wm = as_array("w_max", w_max, ndim=1)
+    n = grid_size("w_max", wm.shape[0])
+    if n < 3:
+        raise InvalidInputError(f"`w_max` must have at least 3 entries; got {n}")
+    if (wm < 0).any():
+        i = int(np.flatnonzero(wm < 0)[0])
+        raise InvalidInputError(f"`w_max` must be >= 0; got {wm[i]!r} at index {i}")
+    if (wm[1:-1] <= 0).any():
+        i = int(np.flatnonzero(wm[1:-1] <= 0)[0]) + 1
+        raise InvalidInputError(
+            f"`w_max` must be > 0 at interior nodes (a stop inside the path makes the travel "
+            f"time infinite; split the problem there); got {wm[i]!r} at index {i}"
+        )
+    hh = as_scalar("h", h, positive=True)
+    accel, decel = _accel_pair(A, n)
+    jerk = broadcast_positive("J", J, n - 2, allow_inf=True)
+    problem = DiscreteProblem(
+        s=np.arange(n) * hh,
+        w_max=wm,
+        accel=accel,
+        decel=decel,
+        jerk=jerk,
+        w_start=as_scalar("w_start", w_start, nonnegative=True),
+        w_end=as_scalar("w_end", w_end, nonnegative=True),
+    )
+    return solve_problem(problem, refine=refine, backend=backend)
