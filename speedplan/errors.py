@@ -6,7 +6,14 @@ Every error a user can meet derives from :class:`SpeedplanError`, so one
 
 from __future__ import annotations
 
-__all__ = ["InfeasibleError", "InvalidInputError", "SolverError", "SpeedplanError"]
+__all__ = [
+    "InfeasibleError",
+    "InvalidInputError",
+    "LimitWarning",
+    "SolverError",
+    "SpeedplanError",
+    "SpeedplanWarning",
+]
 
 
 class SpeedplanError(Exception):
@@ -44,3 +51,11 @@ class SolverError(SpeedplanError):
         super().__init__(message)
         self.backend = backend
         self.status = status
+
+
+class SpeedplanWarning(RuntimeWarning):
+    """A result was produced but something about it deserves attention (see the message)."""
+
+
+class LimitWarning(SpeedplanWarning):
+    """A planned trajectory exceeds a limit by more than its documented tolerance."""

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from .._checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
-from ..errors import InvalidInputError, SolverError
+from ..errors import InvalidInputError, SolverError, SpeedplanWarning
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .ipopt_ import refine_ipopt
 from .nojerk import check_reachable, max_feasible_w
@@ -127,14 +127,14 @@ def solve_problem(
                 warnings.warn(
                     f"IPOPT refinement failed (status {ref.status}); returning the relaxed "
                     "solution scaled into the jerk bounds (status 'scaled')",
-                    RuntimeWarning, stacklevel=3,
+                    SpeedplanWarning, stacklevel=3,
                 )
                 w, status = fallback, "scaled"
     elif not exact:
         warnings.warn(
             f"refine='never' and the relaxation is not exact: w violates jerk rows by up to "
             f"{relaxed_violation:.3g} (status 'relaxed')",
-            RuntimeWarning, stacklevel=3,
+            SpeedplanWarning, stacklevel=3,
         )
 
     objective = problem.travel_time(w)

@@ -1,0 +1,70 @@
+"""Jerk-limited envelopes at the ends of a move.
+
+The paper's model leaves the acceleration free at a standstill: ``w`` may grow linearly from
+0, i.e. the vehicle jumps to full acceleration. A jerk-limited vehicle starting from
+``(v0, a0)`` cannot be faster at any ``s`` than the maximum-jerk motion
+``v(t) = v0 + a0 t + j t²/2``, ``s(t) = v0 t + a0 t²/2 + j t³/6``; from rest this is
+``w <= (j²/4) (6 s / j)^{4/3}``. Capping ``w_max`` by this envelope (and its mirror image at the
+end, with ``a0 -> -af``) makes the discrete optimum converge to the true jerk-limited optimum.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._checks import FloatArray
+from ..errors import InfeasibleError
+
+__all__ = ["max_jerk_envelope", "check_boundary_state"]
+
+
+def check_boundary_state(v: float, a: float, j_max: float, *, end: bool) -> None:
+    """Raise :class:`InfeasibleError` if a jerk-limited move cannot leave/reach ``(v, a)``.
+
+    Leaving ``v`` while decelerating at ``a < 0`` stops the vehicle unless ``v >= a²/(2 j)``;
+    arriving at ``v`` while accelerating at ``a > 0`` likewise needs ``v >= a²/(2 j)``.
+    """
+    slowing = -a if not end else a
+    if slowing > 0 and np.isfinite(j_max) and v < slowing**2 / (2 * j_max) * (1 - 1e-12):
+        which = ("vf", "af") if end else ("v0", "a0")
+        raise InfeasibleError(
+            f"`{which[0]}`={v:.6g} m/s with `{which[1]}`={a:.6g} m/s² is not reachable under "
+            f"j_max={j_max:.6g} m/s³: the speed would pass through zero (needs "
+            f"{which[0]} >= {which[1]}²/(2 j_max) = {slowing**2 / (2 * j_max):.6g} m/s)",
+            constraint="jerk",
+            s=None,
+        )
+
+
+def max_jerk_envelope(d: FloatArray, v: float, a: float, j_max: float) -> FloatArray:
+    """Largest ``w = v²`` reachable at distance ``d >= 0`` from state ``(v, a)`` under ``j_max``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    From rest with ``j_max = 0.5``: after 2 s the vehicle has covered ``j t³/6 = 2/3`` m at
+    ``v = j t²/2 = 1`` m/s.
+
+    >>> w = max_jerk_envelope(np.array([0.0, 2.0 / 3.0]), v=0.0, a=0.0, j_max=0.5)
+    >>> np.round(w, 12).tolist()
+    [0.0, 1.0]
+    """
+    d = np.maximum(np.asarray(d, dtype=np.float64), 0.0)
+    if not np.isfinite(j_max):
+        return np.full(d.shape, np.inf)
+    j = j_max
+    if v == 0.0 and a == 0.0:
+        return np.asarray((j * j / 4.0) * (6.0 * d / j) ** (4.0 / 3.0), dtype=np.float64)
+    # Solve s(t) = d for t by Newton from a safe start; s is increasing while v(t) > 0.
+    t = np.cbrt(6.0 * d / j)
+    if v > 0:
+        t = np.minimum(t, d / v)
+    for _ in range(60):
+        s = v * t + 0.5 * a * t * t + j * t**3 / 6.0
+        vt = v + a * t + 0.5 * j * t * t
+        step = (s - d) / np.maximum(vt, 1e-300)
+        t = np.maximum(t - step, 0.5 * t)
+        if np.all(np.abs(step) <= 1e-15 * np.maximum(t, 1e-300)):
+            break
+    vt = v + a * t + 0.5 * j * t * t
+    return np.asarray(vt * vt, dtype=np.float64)
