@@ -252,3 +252,14 @@ def test_unreachable_boundary_is_infeasible_with_location():
     assert info.value.constraint == "decel" and info.value.s == 10.0
     with pytest.raises(InfeasibleError, match="w_start"):
         solve_discrete(np.full(10, 1.0), 1.0, 1.0, w_start=2.0)
+
+
+@pytest.mark.parametrize("family", [("rnd", "cnst", "cnst"), ("rnd", "cnst", "logrnd")])
+def test_banded_backend_gives_the_same_certified_answer(family):
+    inst = paper_instance(*family, n=N_CI, seed=7)
+    ref = solve_discrete(inst.w_max, inst.A, inst.J, backend="clarabel")
+    fast = solve_discrete(inst.w_max, inst.A, inst.J, backend="banded")
+    assert fast.extras["backend"] == "banded"
+    assert (fast.exact, fast.status) == (ref.exact, ref.status)
+    assert fast.lower_bound == pytest.approx(ref.lower_bound, rel=1e-6)
+    assert fast.objective == pytest.approx(ref.objective, rel=1e-5)

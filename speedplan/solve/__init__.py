@@ -4,11 +4,12 @@
 :class:`DiscreteProblem` on any grid (used by :func:`speedplan.plan`).
 """
 
-from .discrete import RELAXATION_BACKENDS, REFINE_MODES, solve_discrete, solve_problem
+from .discrete import BACKENDS, REFINE_MODES, RELAXATION_BACKENDS, solve_discrete, solve_problem
 from .problem import JERK_TOL, JERK_TOL_REL, DiscreteProblem
 from .solution import STATUSES, DiscreteSolution
 
 __all__ = [
+    "BACKENDS",
     "JERK_TOL",
     "JERK_TOL_REL",
     "REFINE_MODES",

@@ -22,8 +22,17 @@ iteration with :func:`scipy.linalg.cholesky_banded` and solved twice (predictor 
 corrector). Assembly, scaling and step lengths are vectorised numpy over nodes, so an
 iteration costs O(n) time and memory.
 
-The problem is solved in internal units (``w`` scaled to at most 1, ``s`` to unit mean step)
-so that the constant ``1`` of the cone ``||(2z, w - 1)|| <= w + 1`` is well balanced.
+The problem is solved in internal units (``w`` scaled to at most 1, ``s`` to unit mean step),
+with every variable further scaled per node from the O(n) no-jerk profile ``w_ref``
+(``w = w_ref ŵ``, ``z = sqrt(w_ref) ẑ``, ``t = τ / sqrt(w_ref) t̂``) so that every node's cones
+become the same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``, and jerk rows are normalised. The
+start is CVXOPT's default (least-squares primal, least-norm dual, shifted into the cones);
+each Newton solve gets one round of iterative refinement once the gap is small.
+
+Near the optimum the NT scaling becomes ill-conditioned and rounding can stop progress a
+little short of ``tol`` (seen with strongly varying ``J``). The method then reports
+``status="AlmostSolved"`` (as Clarabel does) if the certified relative gap below is at most
+1e-6 and ``w`` is feasible, and raises :class:`~speedplan.errors.SolverError` otherwise.
 
 The returned ``dual_objective`` is a rigorous lower bound, independent of how well the
 iterates satisfy the dual equations: the Lagrangian of the relaxation with the solver's
@@ -39,6 +48,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
 
 from .._checks import FloatArray
@@ -53,6 +63,10 @@ __all__ = ["solve_relaxation_banded"]
 _STEP = 0.99
 #: Exponent of Mehrotra's centring heuristic ``σ = (1 - α_affine)^3``.
 _SIGMA_EXPONENT = 3.0
+#: Rounds of iterative refinement of each Newton solve (see :func:`_newton`).
+_REFINE_STEPS = 1
+#: Relative gap below which Newton solves are refined.
+_REFINE_BELOW = 1e-3
 
 
 @dataclass(frozen=True)
@@ -68,25 +82,38 @@ class _Data:
     d0: FloatArray  # second-difference weights of w_{i-1}, w_i, w_{i+1}, shape (m,)
     d1: FloatArray
     d2: FloatArray
-    jk: FloatArray  # indices (int) of interior nodes with finite J
+    jk: NDArray[np.intp]  # interior nodes with finite J
     cj: FloatArray  # τ_i / J_i at those nodes
     tau: FloatArray  # interior cell lengths, shape (m,)
     b_lin: FloatArray  # right-hand side of the linear rows
     w_full_const: FloatArray  # (n,) zeros with the fixed end values in place
     w_max: FloatArray  # interior upper bounds
     n_lin: int
+    jconst: FloatArray  # second difference of the fixed end values at jerk nodes
+    row: FloatArray  # scale of each linear row (jerk rows normalised to unit norm)
+    cw: FloatArray  # column scales: w = cw ŵ, t = ct t̂ (and z = sqrt(cw) ẑ)
+    ct: FloatArray
 
 
-def _prepare(p: DiscreteProblem) -> _Data:
-    """Flatten the (already scaled) problem into the arrays the iteration uses."""
+def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> _Data:
+    """Flatten the (already scaled) problem into the arrays the iteration uses.
+
+    Variables are scaled per node, ``w = cw ŵ``, ``z = sqrt(cw) ẑ``, ``t = ct t̂`` with
+    ``cw = w_ref`` and ``ct = τ / sqrt(cw)``, which turns both cones of every node into the
+    same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``; the acceleration rows get the coefficients
+    ``cw`` and the jerk rows are divided by ``ct``.
+    """
     n = p.n
     m = n - 2
     h0, h1 = p.h[:-1], p.h[1:]
     d0 = 2.0 / (h0 * (h0 + h1))
     d1 = -2.0 / (h0 * h1)
     d2 = 2.0 / (h1 * (h0 + h1))
+    cw = w_ref
+    ct = p.tau / np.sqrt(cw)
+    cwp = np.concatenate(([0.0], cw, [0.0]))
     jk = np.flatnonzero(np.isfinite(p.jerk))
-    cj = p.tau[jk] / p.jerk[jk]
+    cj = p.tau[jk] / p.jerk[jk] / ct[jk]
     w_const = np.zeros(n)
     w_const[0], w_const[-1] = p.w_start, p.w_end
     # G x + s = b with the fixed ends moved to b: b = bound - (row applied to the fixed ends).
@@ -96,14 +123,23 @@ def _prepare(p: DiscreteProblem) -> _Data:
         (
             p.accel * p.h - dconst,
             p.decel * p.h + dconst,
-            p.w_max[1:-1],
+            p.w_max[1:-1] / cw,
             -jconst,
             jconst,
         )
     )
+    dh0, dh1, dh2 = d0 * cwp[:-2], d1 * cw, d2 * cwp[2:]
+    # Jerk rows may still carry large coefficients; normalising them balances the starting
+    # point and the stopping tests.
+    row = np.ones(b_lin.size)
+    jnorm = 1.0 / np.sqrt(cj**2 * (dh0[jk] ** 2 + dh1[jk] ** 2 + dh2[jk] ** 2) + 1.0)
+    row[2 * (n - 1) + m :] = np.concatenate((jnorm, jnorm))
+    b_lin = b_lin * row
     return _Data(
-        m=m, d0=d0, d1=d1, d2=d2, jk=jk, cj=cj, tau=p.tau.copy(), b_lin=b_lin,
-        w_full_const=w_const, w_max=p.w_max[1:-1].copy(), n_lin=b_lin.size,
+        row=row, cw=cw, ct=ct,
+        m=m, d0=dh0, d1=dh1, d2=dh2, jk=jk, cj=cj, tau=np.ones(m), b_lin=b_lin,
+        w_full_const=w_const, w_max=p.w_max[1:-1] / cw, n_lin=b_lin.size,
+        jconst=jconst,
     )
 
 
@@ -128,10 +164,11 @@ def _second_diff_t(d: _Data, u: FloatArray) -> FloatArray:
 
 def _g_lin(d: _Data, w: FloatArray, t: FloatArray) -> FloatArray:
     """Linear rows of ``G x`` (no constants)."""
-    dw = np.diff(np.concatenate(([0.0], w, [0.0])))
+    dw = np.diff(np.concatenate(([0.0], d.cw * w, [0.0])))
     jw = d.cj * _second_diff(d, w)[d.jk]
     tj = t[d.jk]
-    return np.concatenate((dw, -dw, w, jw - tj, -jw - tj))
+    out: FloatArray = d.row * np.concatenate((dw, -dw, w, jw - tj, -jw - tj))
+    return out
 
 
 def _g_soc(w: FloatArray, t: FloatArray, z: FloatArray) -> FloatArray:
@@ -147,13 +184,14 @@ def _g_adjoint(
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """``G' y`` split into its ``w``, ``t`` and ``z`` parts."""
     m, nl, k = d.m, d.m + 1, d.jk.size
+    yl = yl * d.row
     acc = yl[:nl] - yl[nl : 2 * nl]
     ub = yl[2 * nl : 2 * nl + m]
     jp, jm = yl[2 * nl + m : 2 * nl + m + k], yl[2 * nl + m + k :]
     u = np.zeros(m)
     u[d.jk] = d.cj * (jp - jm)
     y1, y2 = ys[:, :m], ys[:, m:]
-    gw = acc[:-1] - acc[1:] + ub + _second_diff_t(d, u) - y1[0] - y1[2]
+    gw = d.cw * (acc[:-1] - acc[1:]) + ub + _second_diff_t(d, u) - y1[0] - y1[2]
     gt = -(y2[0] + y2[1])
     gt[d.jk] -= jp + jm
     gz = -2.0 * y1[1] - y2[0] + y2[1]
@@ -169,6 +207,21 @@ def _jdot(u: FloatArray, v: FloatArray) -> FloatArray:
     return out
 
 
+def _jnorm2(u: FloatArray) -> FloatArray:
+    """``u' J u`` per cone, computed as ``(u_0 - |u_a|)(u_0 + |u_a|) - u_b²``.
+
+    ``a`` is the larger of the two other components. Near the cone boundary the plain
+    ``u_0² - u_1² - u_2²`` cancels to the square of the largest entry; pairing ``u_0`` with the
+    largest entry first keeps the error relative to the smaller one (for ``z² <= w`` with
+    small ``w`` that is ``4 (w - z²)`` accurate to ``w`` instead of to 1).
+    """
+    a1, a2 = np.abs(u[1]), np.abs(u[2])
+    big = np.maximum(a1, a2)
+    small = np.minimum(a1, a2)
+    out: FloatArray = (u[0] - big) * (u[0] + big) - small * small
+    return out
+
+
 def _jordan(u: FloatArray, v: FloatArray) -> FloatArray:
     """Jordan product ``u ∘ v = (u'v, u_0 v̄ + v_0 ū)`` per cone."""
     return np.stack((u[0] * v[0] + u[1] * v[1] + u[2] * v[2],
@@ -177,15 +230,15 @@ def _jordan(u: FloatArray, v: FloatArray) -> FloatArray:
 
 def _jordan_solve(lam: FloatArray, b: FloatArray) -> FloatArray:
     """Solve ``lam ∘ u = b`` for ``u`` per cone."""
-    u0 = (lam[0] * b[0] - lam[1] * b[1] - lam[2] * b[2]) / _jdot(lam, lam)
+    u0 = (lam[0] * b[0] - lam[1] * b[1] - lam[2] * b[2]) / _jnorm2(lam)
     return np.stack((u0, (b[1] - u0 * lam[1]) / lam[0], (b[2] - u0 * lam[2]) / lam[0]))
 
 
 def _max_step_soc(u: FloatArray, du: FloatArray) -> float:
     """Largest ``α`` with ``u + α du`` in every cone (``u`` interior); ``inf`` if unbounded."""
-    a = _jdot(du, du)
+    a = _jnorm2(du)
     b = _jdot(u, du)
-    c = _jdot(u, u)
+    c = _jnorm2(u)
     disc = b * b - a * c
     # Roots of a α² + 2 b α + c = 0; c > 0, the first positive root is where u + α du exits.
     sq = np.sqrt(np.maximum(disc, 0.0))
@@ -206,11 +259,16 @@ def _max_step_soc(u: FloatArray, du: FloatArray) -> float:
     return float(np.min(np.minimum(root, r0), initial=big))
 
 
+def _interior_soc(u: FloatArray) -> bool:
+    """Whether every cone of ``u`` is strictly interior."""
+    return bool(np.all(u[0] > 0) and np.all(_jnorm2(u) > 0))
+
+
 def _max_step_lin(u: FloatArray, du: FloatArray) -> float:
-    neg = du < 0
-    if not neg.any():
-        return float("inf")
-    return float(np.min(-u[neg] / du[neg]))
+    """Largest ``α`` with ``u + α du >= 0`` (``u > 0``); ``inf`` if unbounded."""
+    # min over du < 0 of -u/du is 1 / max(-du/u): one pass, no boolean indexing.
+    worst = float(np.max(-du / u, initial=0.0))
+    return 1.0 / worst if worst > 0.0 else float("inf")
 
 
 def _min_eig_soc(u: FloatArray) -> float:
@@ -233,8 +291,8 @@ class _Scaling:
 def _scaling(sl: FloatArray, yl: FloatArray, ss: FloatArray, ys: FloatArray) -> _Scaling:
     """Compute the NT scaling of every cone (formulas of CVXOPT's ``misc.compute_scaling``)."""
     wl = np.sqrt(sl / yl)
-    sn = np.sqrt(_jdot(ss, ss))
-    yn = np.sqrt(_jdot(ys, ys))
+    sn = np.sqrt(_jnorm2(ss))
+    yn = np.sqrt(_jnorm2(ys))
     beta = np.sqrt(sn / yn)
     sb = ss / sn
     yb = ys / yn
@@ -269,7 +327,7 @@ def _apply_winv(sc: _Scaling, u: FloatArray) -> FloatArray:
 
 
 def _hessian_entries(sc: _Scaling) -> tuple[FloatArray, ...]:
-    """Entries ``H00, H01, H02, H11, H12, H22`` of ``H = W⁻² = (2 ŵ ŵ' - J) / β²``, ``ŵ = J wbar``."""
+    """Return entries 00, 01, 02, 11, 12, 22 of ``H = W⁻² = (2 ŵ ŵ' - J) / β²``, ``ŵ = J wbar``."""
     u0, u1, u2 = sc.wbar[0], -sc.wbar[1], -sc.wbar[2]
     ib2 = 1.0 / (sc.beta * sc.beta)
     return (
@@ -308,6 +366,8 @@ def _factor(d: _Data, hs: tuple[FloatArray, ...], hl: FloatArray) -> _Factor:
     m, nl, k = d.m, d.m + 1, d.jk.size
     h00, h01, h02, h11, h12, h22 = (x[:m] for x in hs)  # cones z² <= w
     g00, g01, _, g11, _, _ = (x[m:] for x in hs)  # cones t z >= τ
+    hl_rows = hl
+    hl = hl * d.row**2  # weights of the unscaled rows
     hp = hl[2 * nl + m : 2 * nl + m + k]
     hm = hl[2 * nl + m + k :]
     # (t, z) block per node.
@@ -330,6 +390,7 @@ def _factor(d: _Data, hs: tuple[FloatArray, ...], hl: FloatArray) -> _Factor:
     f = -q * a * bwz
     dg = hl[2 * nl : 2 * nl + m] + (h00 + 2.0 * h02 + h22) - r * bwz * bwz
     gacc = hl[:nl] + hl[nl : 2 * nl]
+    cw = d.cw
     # Pentadiagonal upper storage: ab[2] diagonal, ab[1, j] = S[j-1, j], ab[0, j] = S[j-2, j].
     diag = np.zeros(m + 2)
     diag[:-2] += e * d.d0**2
@@ -341,13 +402,13 @@ def _factor(d: _Data, hs: tuple[FloatArray, ...], hl: FloatArray) -> _Factor:
     off2 = np.zeros(m)  # pairs (p, p + 2)
     off2 += e * d.d0 * d.d2
     ab = np.zeros((3, m))
-    ab[2] = diag[1:-1] + gacc[:-1] + gacc[1:]
+    ab[2] = diag[1:-1] + cw * cw * (gacc[:-1] + gacc[1:])
     if m > 1:
-        ab[1, 1:] = off1[1:-1] - gacc[1:-1]
+        ab[1, 1:] = off1[1:-1] - cw[:-1] * cw[1:] * gacc[1:-1]
     if m > 2:
         ab[0, 2:] = off2[1:-1]
     chol = cholesky_banded(ab, lower=False, check_finite=False)
-    return _Factor(chol=chol, hl=hl, hs=hs, a=a, bwz=bwz, p=p, q=q, r=r)
+    return _Factor(chol=chol, hl=hl_rows, hs=hs, a=a, bwz=bwz, p=p, q=q, r=r)
 
 
 def _solve_normal(
@@ -381,6 +442,7 @@ def _newton(
     bys: FloatArray,
     bsl: FloatArray,
     bss: FloatArray,
+    refine: int = _REFINE_STEPS,
 ) -> tuple[tuple[FloatArray, FloatArray, FloatArray], FloatArray, FloatArray, FloatArray,
            FloatArray]:
     """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs``.
@@ -398,61 +460,87 @@ def _newton(
     gs = _g_soc(dw, dt, dz)
     dyl = fac.hl * gl - vl
     dys = _apply_h_soc(fac.hs, gs) - vs
+    # The last two equations hold by construction; only G'Δy = bx inherits the rounding of
+    # the reduced solve, which grows as H becomes ill-conditioned near the optimum. A round of
+    # iterative refinement with the same factor restores it (δy = H G δx, δs = -G δx).
+    for _ in range(refine):
+        ew, et, ez = _g_adjoint(d, dyl, dys)
+        ew, et, ez = bx[0] - ew, bx[1] - et, bx[2] - ez
+        cw, ct, cz = _solve_normal(d, fac, ew, et, ez)
+        cl = _g_lin(d, cw, ct)
+        cs = _g_soc(cw, ct, cz)
+        dw, dt, dz = dw + cw, dt + ct, dz + cz
+        gl, gs = gl + cl, gs + cs
+        dyl = dyl + fac.hl * cl
+        dys = dys + _apply_h_soc(fac.hs, cs)
     return (dw, dt, dz), byl - gl, bys - gs, dyl, dys
 
 
 # --- certificates -------------------------------------------------------------------------
 
 
-def _primal_t(d: _Data, w: FloatArray) -> FloatArray:
-    """Smallest feasible ``t`` for ``w`` (interior ``w > 0``)."""
-    t = d.tau / np.sqrt(w)
-    wfull = d.w_full_const.copy()
-    wfull[1:-1] = w
-    wpp = d.d0 * wfull[:-2] + d.d1 * wfull[1:-1] + d.d2 * wfull[2:]
-    t[d.jk] = np.maximum(t[d.jk], d.cj * np.abs(wpp[d.jk]))
+def _primal_t(p: DiscreteProblem, w: FloatArray) -> FloatArray:
+    """Smallest feasible ``t`` for the full ``w`` (interior ``w > 0``)."""
+    t: FloatArray = p.tau / np.sqrt(w[1:-1])
+    finite = np.isfinite(p.jerk)
+    wpp = p.second_difference @ w
+    t[finite] = np.maximum(t[finite], p.tau[finite] * np.abs(wpp[finite]) / p.jerk[finite])
     return t
 
 
-def _lagrangian_bound(d: _Data, yl: FloatArray) -> float:
-    """Lower bound from the multipliers of the acceleration and jerk rows (weak duality).
+def _lagrangian_bound(
+    p: DiscreteProblem, mu_acc: FloatArray, mu_dec: FloatArray, nu_p: FloatArray,
+    nu_m: FloatArray,
+) -> float:
+    """Lower bound from multipliers of the acceleration and jerk rows (weak duality).
 
-    With multipliers ``μ >= 0`` of the rows ``a_k' w <= b_k`` and ``ν± >= 0`` of the jerk rows,
-    ``λ_i = 1 - ν⁺_i - ν⁻_i >= 0`` on ``t_i >= τ_i / sqrt(w_i)`` makes the Lagrangian free of
-    ``t``; its minimum over ``0 <= w <= w_max`` is separable and closed-form.
+    With ``μ >= 0`` on the rows ``±(w_{k+1} - w_k) <= A_k h_k`` and ``ν± >= 0`` (per node,
+    zero where ``J = inf``) on ``±τ w'' / J - t <= 0``, the multiplier ``λ = 1 - ν⁺ - ν⁻ >= 0``
+    of ``t >= τ / sqrt(w)`` makes the Lagrangian free of ``t``; its minimum over the box
+    ``0 <= w <= w_max`` is separable and closed-form. Any such multipliers give a valid bound.
     """
-    m, nl, k = d.m, d.m + 1, d.jk.size
-    y = np.maximum(yl, 0.0)
-    jp = y[2 * nl + m : 2 * nl + m + k].copy()
-    jm = y[2 * nl + m + k :].copy()
-    excess = np.maximum(jp + jm, 1.0)  # λ_i >= 0 needs ν⁺ + ν⁻ <= 1
-    jp /= excess
-    jm /= excess
-    lam = np.ones(m)
-    lam[d.jk] = 1.0 - jp - jm
-    yk = np.zeros_like(y)
-    yk[: 2 * nl] = y[: 2 * nl]
-    yk[2 * nl + m : 2 * nl + m + k] = jp
-    yk[2 * nl + m + k :] = jm
-    # Linear coefficient of w in the Lagrangian (the t part vanishes by construction).
-    g = _g_adjoint(d, yk, np.zeros((3, 2 * m)))[0]
-    const = -float(yk @ d.b_lin)
-    c = lam * d.tau
-    with np.errstate(divide="ignore", invalid="ignore"):
-        w_star = np.where(g > 0, (c / (2.0 * np.where(g > 0, g, 1.0))) ** (2.0 / 3.0), np.inf)
-    w_opt = np.minimum(w_star, d.w_max)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        val = g * w_opt + np.where(c > 0, c / np.sqrt(w_opt), 0.0)
-    if not np.all(np.isfinite(val)):
+    mu_acc, mu_dec = np.maximum(mu_acc, 0.0), np.maximum(mu_dec, 0.0)
+    nu_p, nu_m = np.maximum(nu_p, 0.0), np.maximum(nu_m, 0.0)
+    excess = np.maximum(nu_p + nu_m, 1.0)  # λ >= 0 needs ν⁺ + ν⁻ <= 1
+    nu_p, nu_m = nu_p / excess, nu_m / excess
+    lam = 1.0 - nu_p - nu_m
+    finite = np.isfinite(p.jerk)
+    coef = np.where(finite, (nu_p - nu_m) * p.tau / np.where(finite, p.jerk, 1.0), 0.0)
+    # Linear coefficient of the full w in the Lagrangian.
+    net = mu_acc - mu_dec
+    g = np.zeros(p.n)
+    g[1:] += net
+    g[:-1] -= net
+    g += p.second_difference.T @ coef
+    const = (g[0] * p.w_start + g[-1] * p.w_end
+             - float(mu_acc @ (p.accel * p.h)) - float(mu_dec @ (p.decel * p.h)))
+    gi, c, wmax = g[1:-1], lam * p.tau, p.w_max[1:-1]
+    pos = gi > 0
+    w_opt = wmax.copy()
+    w_opt[pos] = np.minimum((c[pos] / (2.0 * gi[pos])) ** (2.0 / 3.0), wmax[pos])
+    val = gi * w_opt
+    cpos = c > 0
+    if np.any(cpos & (w_opt <= 0)):
         return -np.inf
-    return const + float(val.sum())
+    val[cpos] += c[cpos] / np.sqrt(w_opt[cpos])
+    return float(const + val.sum())
+
+
+def _row_multipliers(d: _Data, yl: FloatArray) -> tuple[FloatArray, ...]:
+    """Multipliers of the scaled problem's own rows from those of the internal rows."""
+    m, nl, k = d.m, d.m + 1, d.jk.size
+    y = yl * d.row
+    nu_p, nu_m = np.zeros(m), np.zeros(m)
+    nu_p[d.jk] = y[2 * nl + m : 2 * nl + m + k] / d.ct[d.jk]
+    nu_m[d.jk] = y[2 * nl + m + k :] / d.ct[d.jk]
+    return y[:nl], y[nl : 2 * nl], nu_p, nu_m
 
 
 # --- driver --------------------------------------------------------------------------------
 
 
 def _scales(problem: DiscreteProblem, w_feasible: FloatArray) -> tuple[float, float]:
-    """Internal units: ``w`` up to about 1 and unit mean step."""
+    """Return ``(s_scale, w_scale)`` of the internal units: ``w`` up to 1 and unit mean step."""
     w_scale = float(np.max(w_feasible))
     s_scale = float(np.mean(problem.h))
     return s_scale, w_scale
@@ -513,11 +601,12 @@ def _iterate(d: _Data, tol: float, max_iter: int) -> _Outcome:
     nu = d.n_lin + 2 * m  # barrier degree: one per linear row and per cone
     ones, zeros = np.ones(2 * m), np.zeros(2 * m)
     fac = _factor(d, (ones, zeros, zeros, ones, zeros, ones), np.ones(d.n_lin))
-    # Primal start: least-squares x of G x = b; dual start: least-norm y of G' y = -c.
+    # CVXOPT's default start: least-squares x of G x = b, least-norm y of G' y = -c, both
+    # shifted into the cones.
     w, t, z = _solve_normal(d, fac, *_g_adjoint(d, b_lin, b_soc))
     sl = b_lin - _g_lin(d, w, t)
     ss = b_soc - _g_soc(w, t, z)
-    uw, ut, uz = _solve_normal(d, fac, np.zeros(m), -np.ones(m), np.zeros(m))
+    uw, ut, uz = _solve_normal(d, fac, np.zeros(m), -d.ct, np.zeros(m))
     yl = _g_lin(d, uw, ut)
     ys = _g_soc(uw, ut, uz)
     _shift_into_cone(sl, ss)
@@ -528,22 +617,29 @@ def _iterate(d: _Data, tol: float, max_iter: int) -> _Outcome:
     e_soc[0] = 1.0
     status = "MaxIterations"
     it = 0
+    best_gap, stalled = np.inf, 0
     for it in range(max_iter + 1):
         gw, gt, gz = _g_adjoint(d, yl, ys)
-        gt += 1.0
+        gt += d.ct
         ryl = _g_lin(d, w, t) + sl - b_lin
         rys = _g_soc(w, t, z) + ss - b_soc
-        pcost = float(t.sum())
+        pcost = float(d.ct @ t)
         dcost = -float(yl @ b_lin) - float((ys * b_soc).sum())
         gap = float(sl @ yl) + float((ss * ys).sum())
         pres = np.sqrt(float(ryl @ ryl) + float((rys * rys).sum())) / res_y0
         dres = np.sqrt(float(gw @ gw) + float(gt @ gt) + float(gz @ gz)) / res_x0
         relgap = gap / max(min(abs(pcost), abs(dcost)), 1e-300)
-        if _VERBOSE:
-            print(f"{it:3d} p={pcost:.10e} d={dcost:.10e} gap={gap:.2e} pres={pres:.2e} "
-                  f"dres={dres:.2e}")
         if pres <= tol and dres <= tol and relgap <= tol:
             status = "Solved"
+            break
+        # Near the optimum the NT scaling becomes ill-conditioned and rounding may stop
+        # progress short of ``tol``; detect that instead of spinning to ``max_iter``.
+        if relgap < 0.5 * best_gap:
+            best_gap, stalled = relgap, 0
+        else:
+            stalled += 1
+        if stalled >= _STALL_ITERATIONS and best_gap < _ALMOST_GAP:
+            status = "Stalled"
             break
         if it == max_iter:
             break
@@ -557,11 +653,14 @@ def _iterate(d: _Data, tol: float, max_iter: int) -> _Outcome:
             status = "NumericalError"
             break
         mu = gap / nu
+        # Refinement only pays once the scaling is ill-conditioned, close to the optimum.
+        refine = _REFINE_STEPS if relgap < _REFINE_BELOW else 0
         lam_sq_l = sc.lam_l * sc.lam_l
         lam_sq_s = _jordan(sc.lam_s, sc.lam_s)
         bx = (-gw, -gt, -gz)
         # Predictor (affine-scaling) direction.
-        dx, dsl, dss, dyl, dys = _newton(d, sc, fac, bx, -ryl, -rys, -lam_sq_l, -lam_sq_s)
+        dx, dsl, dss, dyl, dys = _newton(
+            d, sc, fac, bx, -ryl, -rys, -lam_sq_l, -lam_sq_s, refine)
         alpha = min(_max_step_lin(sl, dsl), _max_step_lin(yl, dyl),
                     _max_step_soc(ss, dss), _max_step_soc(ys, dys))
         sigma = (1.0 - min(1.0, alpha)) ** _SIGMA_EXPONENT
@@ -570,27 +669,39 @@ def _iterate(d: _Data, tol: float, max_iter: int) -> _Outcome:
         dx, dsl, dss, dyl, dys = _newton(
             d, sc, fac, bx, -ryl, -rys,
             -lam_sq_l - dsl * dyl + sigma * mu,
-            -lam_sq_s - cor_s + sigma * mu * e_soc,
+            -lam_sq_s - cor_s + sigma * mu * e_soc, refine,
         )
-        alpha = min(_max_step_lin(sl, dsl), _max_step_lin(yl, dyl),
-                    _max_step_soc(ss, dss), _max_step_soc(ys, dys))
-        alpha = min(1.0, _STEP * alpha)
-        if _VERBOSE:
-            print(f"    sigma={sigma:.3f} alpha={alpha:.3f} steps: sl={_max_step_lin(sl, dsl):.3g} yl={_max_step_lin(yl, dyl):.3g} ss={_max_step_soc(ss, dss):.3g} ys={_max_step_soc(ys, dys):.3g}")
-        if not np.isfinite(alpha) or alpha <= 0.0:
+        alpha_p = alpha_d = min(1.0, _STEP * min(
+            _max_step_lin(sl, dsl), _max_step_lin(yl, dyl),
+            _max_step_soc(ss, dss), _max_step_soc(ys, dys)))
+        if not (np.isfinite(alpha_p) and np.isfinite(alpha_d)) or min(alpha_p, alpha_d) <= 0:
             status = "NumericalError"
             break
-        w = w + alpha * dx[0]
-        t = t + alpha * dx[1]
-        z = z + alpha * dx[2]
-        sl = sl + alpha * dsl
-        ss = ss + alpha * dss
-        yl = yl + alpha * dyl
-        ys = ys + alpha * dys
+        # The closed-form step to the boundary can be off by rounding for nearly degenerate
+        # cones; halve the step until every cone is strictly interior.
+        for _ in range(30):
+            ss_new, ys_new = ss + alpha_p * dss, ys + alpha_d * dys
+            if _interior_soc(ss_new) and _interior_soc(ys_new):
+                break
+            alpha_p *= 0.5
+            alpha_d *= 0.5
+        else:
+            status = "NumericalError"
+            break
+        w = w + alpha_p * dx[0]
+        t = t + alpha_p * dx[1]
+        z = z + alpha_p * dx[2]
+        sl = sl + alpha_p * dsl
+        ss = ss_new
+        yl = yl + alpha_d * dyl
+        ys = ys_new
     return _Outcome(w=w, yl=yl, iterations=it, status=status)
 
 
-_VERBOSE = False
+#: Iterations without halving the relative gap after which the method is declared stalled.
+_STALL_ITERATIONS = 5
+#: Certified relative gap accepted (as status "AlmostSolved") when the method stalls.
+_ALMOST_GAP = 1e-6
 
 
 def solve_relaxation_banded(
@@ -612,7 +723,8 @@ def solve_relaxation_banded(
     RelaxationResult
         ``w`` (n,) with the end values in place, the best ``t`` for it, ``primal_objective =
         Σ t``, ``dual_objective`` a certified lower bound on the relaxation's optimum,
-        ``status="Solved"``.
+        ``status="Solved"`` (residuals and gap within ``tol``) or ``"AlmostSolved"`` (the
+        method stalled with a certified relative gap <= 1e-6).
 
     Raises
     ------
@@ -633,6 +745,7 @@ def solve_relaxation_banded(
     >>> res = solve_relaxation_banded(p)
     >>> res.status, bool(res.dual_objective <= res.primal_objective)
     ('Solved', True)
+
     """
     t_start = time.perf_counter()
     if problem.n < 3:
@@ -641,29 +754,38 @@ def solve_relaxation_banded(
     wmf = _check_feasible(problem)
     s_scale, w_scale = _scales(problem, wmf[1:-1])
     scaled = problem.scaled(s_scale, w_scale)
-    d = _prepare(scaled)
+    d = _prepare(scaled, wmf[1:-1] / w_scale)
     t_setup = time.perf_counter()
     out = _iterate(d, tol, max_iter)
     obj_scale = s_scale / np.sqrt(w_scale)
-    if out.status != "Solved":
-        raise SolverError(
-            f"banded interior-point method stopped with status {out.status} after "
-            f"{out.iterations} iterations",
-            backend="banded",
-            status=out.status,
-        )
-    w_int = np.clip(out.w, 0.0, d.w_max)  # remove rounding-level excursions past the bounds
-    t = _primal_t(d, w_int)
-    w = np.concatenate(([problem.w_start], w_int * w_scale, [problem.w_end]))
+    # Back to the scaled problem's units; clip rounding-level excursions past the bounds.
+    w_sc = np.concatenate(([scaled.w_start], np.clip(out.w * d.cw, 0.0, scaled.w_max[1:-1]),
+                           [scaled.w_end]))
+    t = _primal_t(scaled, w_sc)
+    w = w_sc * w_scale
+    w[0], w[-1] = problem.w_start, problem.w_end
     primal = float(t.sum()) * obj_scale
-    dual = _lagrangian_bound(d, out.yl) * obj_scale
+    dual = _lagrangian_bound(scaled, *_row_multipliers(d, out.yl)) * obj_scale
+    status = out.status
+    if status != "Solved":
+        # Like Clarabel's AlmostSolved: accepted only with a certified gap and feasible w.
+        cert_gap = (primal - dual) / max(abs(primal), 1e-300)
+        feasible = problem.linear_violation(w) <= _ALMOST_GAP * max(1.0, w_scale)
+        if not (status == "Stalled" and cert_gap <= _ALMOST_GAP and feasible):
+            raise SolverError(
+                f"banded interior-point method stopped with status {status} after "
+                f"{out.iterations} iterations (certified relative gap {cert_gap:.2e})",
+                backend="banded",
+                status=status,
+            )
+        status = "AlmostSolved"
     t_end = time.perf_counter()
     return RelaxationResult(
         w=w,
         t=t * obj_scale,
         primal_objective=primal,
         dual_objective=dual,
-        status=out.status,
+        status=status,
         iterations=out.iterations,
         solve_time=t_end - t_setup,
         setup_time=t_setup - t_start,

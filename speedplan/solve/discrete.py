@@ -20,18 +20,24 @@ import numpy as np
 
 from .._checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
 from ..errors import InvalidInputError, SolverError, SpeedplanWarning
+from .banded import solve_relaxation_banded
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .ipopt_ import refine_ipopt
 from .nojerk import check_reachable, max_feasible_w
 from .problem import DiscreteProblem
 from .solution import DiscreteSolution
 
-__all__ = ["solve_discrete", "solve_problem", "RELAXATION_BACKENDS", "REFINE_MODES"]
+__all__ = ["BACKENDS", "REFINE_MODES", "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
 
 #: Relaxation backends by name; each maps a (normalised) problem to a RelaxationResult.
 RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = {
     "clarabel": solve_relaxation,
+    "banded": solve_relaxation_banded,
 }
+#: ``backend="auto"`` uses the banded interior-point method from this many nodes on
+#: (measured 2.8x faster than Clarabel at n = 10 000, on par at n = 1 000).
+AUTO_BANDED_FROM = 5000
+BACKENDS = ("auto", *RELAXATION_BACKENDS)
 REFINE_MODES = ("auto", "always", "never")
 
 
@@ -69,7 +75,9 @@ def solve_problem(
     """
     t_start = time.perf_counter()
     refine = choice("refine", refine, REFINE_MODES)
-    backend = choice("backend", backend, RELAXATION_BACKENDS)
+    backend = choice("backend", backend, BACKENDS)
+    if backend == "auto":
+        backend = "banded" if problem.n >= AUTO_BANDED_FROM else "clarabel"
     check_reachable(problem)
     if not problem.has_jerk or problem.n < 3:
         w = max_feasible_w(problem)
@@ -174,7 +182,7 @@ def solve_discrete(
     w_start: float = 0.0,
     w_end: float = 0.0,
     refine: str = "auto",
-    backend: str = "clarabel",
+    backend: str = "auto",
 ) -> DiscreteSolution:
     """Solve the paper's discrete speed-planning problem with a certificate of optimality.
 
@@ -199,8 +207,9 @@ def solve_discrete(
     refine : {"auto", "always", "never"}
         When to run the IPOPT refinement: when the relaxation is not exact, always (its result
         is then in ``extras``), or never (a non-exact result has status ``"relaxed"`` and warns).
-    backend : str
-        Relaxation backend, one of :data:`RELAXATION_BACKENDS`.
+    backend : {"auto", "clarabel", "banded"}
+        Relaxation backend: Clarabel (reference), the structure-exploiting banded
+        interior-point method, or ``"auto"`` (banded from :data:`AUTO_BANDED_FROM` nodes on).
 
     Returns
     -------
