@@ -2,20 +2,51 @@
 acceleration and true jerk limits, with a certificate of optimality.
 """
 
-from .errors import InfeasibleError, InvalidInputError, SolverError, SpeedplanError
+from .batch import BatchResult, plan_many
+from .errors import (
+    InfeasibleError,
+    InvalidInputError,
+    LimitWarning,
+    SolverError,
+    SpeedplanError,
+    SpeedplanWarning,
+)
+from .geometry import Path, SpeedZone, speed_bounds
 from .limits import Limits
+from .plan import plan
 from .solve import DiscreteProblem, DiscreteSolution, solve_discrete
+from .timing import SpeedProfile, Trajectory, Verification
 
 __version__ = "0.1.0"
 
+
+def profile_from_waypoints(*args: object, **kwargs: object) -> Trajectory:
+    """See :func:`speedplan.waypoints.profile_from_waypoints`."""
+    from .waypoints import profile_from_waypoints as _impl
+
+    return _impl(*args, **kwargs)  # type: ignore[arg-type]
+
+
 __all__ = [
+    "BatchResult",
     "DiscreteProblem",
     "DiscreteSolution",
     "InfeasibleError",
     "InvalidInputError",
+    "LimitWarning",
     "Limits",
+    "Path",
     "SolverError",
+    "SpeedProfile",
+    "SpeedZone",
     "SpeedplanError",
+    "SpeedplanWarning",
+    "Trajectory",
+    "Verification",
     "__version__",
+    "plan",
+    "plan_many",
+    "profile_from_waypoints",
     "solve_discrete",
+    "speed_bounds",
 ]

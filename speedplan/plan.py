@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -14,16 +15,32 @@ from .geometry import Path, SpeedZone, speed_bounds
 from .limits import Limits
 from .solve import DiscreteProblem, solve_problem
 from .solve.boundary import check_boundary_state, max_jerk_envelope
-from .solve.discrete import RELAXATION_BACKENDS, REFINE_MODES
+from .solve.discrete import BACKENDS, REFINE_MODES
 from .solve.grid import adaptive_grid, uniform_grid
 from .timing import SpeedProfile, TimeLaw
 
-__all__ = ["plan", "STANDSTILL_MODES"]
+__all__ = ["STANDSTILL_MODES", "SpeedBound", "plan"]
 
 #: ``"smooth"``: acceleration is 0 at a standstill and jerk-limited from the first instant.
 #: ``"free"``: the paper's model, where acceleration may jump at a standstill.
 STANDSTILL_MODES = ("smooth", "free")
 _NO_JERK_NODES = 1001
+
+
+@dataclass(frozen=True)
+class SpeedBound:
+    """``s -> mu+(s)`` for one path, limits and zones: a picklable callable [m²/s²]."""
+
+    path: Path
+    limits: Limits
+    zones: list[SpeedZone] | None = None
+    v_limit: Any = None
+
+    def __call__(self, s: FloatArray) -> FloatArray:
+        return np.asarray(
+            speed_bounds(self.path, self.limits, s, zones=self.zones, v_limit=self.v_limit),
+            dtype=np.float64,
+        )
 
 
 def _check_boundary(limits: Limits, v0: float, a0: float, vf: float, af: float,
@@ -59,7 +76,7 @@ def plan(
     v_limit: Any = None,
     refine: str = "auto",
     standstill: str = "smooth",
-    backend: str = "clarabel",
+    backend: str = "auto",
 ) -> SpeedProfile:
     """Plan the minimum-time speed law along ``path`` under ``limits``.
 
@@ -85,8 +102,8 @@ def plan(
     standstill : {"smooth", "free"}
         ``"smooth"`` (default): acceleration 0 at a standstill, jerk-limited from the first
         instant. ``"free"``: the paper's model, where acceleration may jump at a standstill.
-    backend : str
-        Relaxation backend (see :data:`speedplan.solve.RELAXATION_BACKENDS`).
+    backend : {"auto", "clarabel", "banded"}
+        Relaxation backend (see :func:`speedplan.solve_discrete`).
 
     Returns
     -------
@@ -124,7 +141,7 @@ def plan(
         raise InvalidInputError(f"`limits` must be a speedplan.Limits; got {type(limits).__name__}")
     choice("refine", refine, REFINE_MODES)
     choice("standstill", standstill, STANDSTILL_MODES)
-    choice("backend", backend, RELAXATION_BACKENDS)
+    choice("backend", backend, BACKENDS)
     if n is not None and ds is not None:
         raise InvalidInputError("pass at most one of `n` and `ds`")
     if n is not None and (isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 3):
@@ -137,10 +154,7 @@ def plan(
     _check_boundary(limits, v0, a0, vf, af, standstill)
     L = float(path.length)
     zone_list = list(zones) if zones is not None else None
-
-    def bound(s: FloatArray) -> FloatArray:
-        return np.asarray(speed_bounds(path, limits, s, zones=zone_list, v_limit=v_limit),
-                          dtype=np.float64)
+    bound = SpeedBound(path, limits, zone_list, v_limit)
 
     ends = bound(np.array([0.0, L]))
     for name, v, b, where in (("v0", v0, ends[0], 0.0), ("vf", vf, ends[1], L)):

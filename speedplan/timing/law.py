@@ -221,27 +221,33 @@ class TimeLaw:
         out: FloatArray = np.where(to_end, T[j + 1] - part, T[j] + part)
         return out
 
+    @cached_property
+    def node_times(self) -> FloatArray:
+        """Times at the grid nodes ``s`` [s]."""
+        return self.time_at(self.s)
+
     def position_at(self, t: FloatArray, *, tol: float = 1e-13) -> FloatArray:
         """Arc length ``s(t)`` at times ``t``: Newton on ``t(s) = t`` safeguarded by bisection.
 
-        Newton steps are taken only while they at least halve the previous step (the
-        Numerical Recipes ``rtsafe`` rule), so convergence is guaranteed near standstill too.
+        Starts from linear interpolation between the grid nodes; Newton steps are taken only
+        while they at least halve the previous step (the Numerical Recipes ``rtsafe`` rule), so
+        convergence is guaranteed near standstill too.
         """
         t = np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration)
-        x, T = self._knots[0], self.knot_times
-        j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, x.size - 2)
-        lo, hi = x[j].copy(), x[j + 1].copy()
-        span = np.maximum(T[j + 1] - T[j], 1e-300)
-        q = lo + (hi - lo) * np.clip((t - T[j]) / span, 0.0, 1.0)
+        T, grid = self.node_times, self.s
+        j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, grid.size - 2)
+        lo, hi = grid[j].copy(), grid[j + 1].copy()
+        q = np.interp(t, T, grid)
         step_old = hi - lo
         ttol = tol * max(self.duration, 1.0)
+        stol = 4e-16 * max(self.length, 1.0)
         active = np.arange(t.size)
         for _ in range(200):
             if active.size == 0:
                 break
             qa = q[active]
             f = self.time_at(qa) - t[active]
-            keep = (np.abs(f) > ttol) & (hi[active] - lo[active] > 1e-15 * max(self.length, 1.0))
+            keep = (np.abs(f) > ttol) & (hi[active] - lo[active] > stol)
             active, qa, f = active[keep], qa[keep], f[keep]
             la = np.where(f < 0, qa, lo[active])
             ha = np.where(f > 0, qa, hi[active])
@@ -251,5 +257,7 @@ class TimeLaw:
             new_q = np.where(use_newton, qa - newton_step, 0.5 * (la + ha))
             step_old[active] = np.abs(new_q - qa)
             lo[active], hi[active], q[active] = la, ha, new_q
+            moving = step_old[active] > stol
+            active = active[moving]
         out: FloatArray = q
         return out

@@ -152,9 +152,9 @@ class SpeedProfile:
         Parameters
         ----------
         dt : float, optional
-            Sampling period [s]; default ``min(1 ms, duration / 200 000)``.
+            Sampling period [s]; default 1 ms, or ``duration / 200 000`` if that is longer.
         """
-        step = dt if dt is not None else min(1e-3, self.duration / 200_000)
+        step = dt if dt is not None else max(1e-3, self.duration / 200_000)
         traj = self.sample(step)
         lim = self.limits
         bound = self.speed_bound(traj.s)
