@@ -16,15 +16,9 @@ from .limits import Limits
 from .plan import plan
 from .solve import DiscreteProblem, DiscreteSolution, solve_discrete
 from .timing import SpeedProfile, Trajectory, Verification
+from .waypoints import profile_from_waypoints
 
 __version__ = "0.1.0"
-
-
-def profile_from_waypoints(*args: object, **kwargs: object) -> Trajectory:
-    """See :func:`speedplan.waypoints.profile_from_waypoints`."""
-    from .waypoints import profile_from_waypoints as _impl
-
-    return _impl(*args, **kwargs)  # type: ignore[arg-type]
 
 
 __all__ = [

@@ -1,0 +1,49 @@
+"""profile_from_waypoints(): from a list of (x, y) points to a sampled trajectory in one call."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from .geometry import Path, SpeedZone
+from .limits import Limits
+from .plan import plan
+from .timing import Trajectory
+
+__all__ = ["profile_from_waypoints"]
+
+
+def profile_from_waypoints(
+    xy: Any,
+    *,
+    v_max: float,
+    a_max: float,
+    a_lat_max: float,
+    j_max: float,
+    a_decel: float | None = None,
+    dt: float = 0.01,
+    kind: str = "clothoid",
+    zones: Sequence[SpeedZone] | None = None,
+    v0: float = 0.0,
+    a0: float = 0.0,
+    vf: float = 0.0,
+    af: float = 0.0,
+    **plan_options: Any,
+) -> Trajectory:
+    """Plan through waypoints and return the trajectory sampled every ``dt`` seconds.
+
+    The waypoints are joined by a drivable G1 path (a clothoid chain by default; see
+    :meth:`speedplan.Path.from_waypoints` for ``kind``), then planned with :func:`speedplan.plan`.
+
+    Examples
+    --------
+    >>> import speedplan as sp
+    >>> traj = sp.profile_from_waypoints([[0, 0], [8, 0], [12, 3]], v_max=2, a_max=1,
+    ...                                  a_lat_max=1, j_max=0.5, dt=0.05)
+    >>> bool(traj.v[0] == 0 and traj.v.max() <= 2 * 1.005), bool(abs(traj.a[-1]) < 1e-9)
+    (True, True)
+    """
+    path = Path.from_waypoints(xy, kind=kind)
+    limits = Limits(v_max=v_max, a_max=a_max, a_lat_max=a_lat_max, j_max=j_max, a_decel=a_decel)
+    profile = plan(path, limits, zones=zones, v0=v0, a0=a0, vf=vf, af=af, **plan_options)
+    return profile.sample(dt)
