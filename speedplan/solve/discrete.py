@@ -61,6 +61,27 @@ def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArr
     return w * (c * (1.0 - 1e-12))
 
 
+def _relax_with_fallback(
+    unit: DiscreteProblem, backend: str
+) -> tuple[RelaxationResult, str, str | None]:
+    """Solve the relaxation; if the backend stalls, retry once with the other backend.
+
+    Both are interior-point methods on the same SOCP, but they fail on different instances
+    (Clarabel can stall at ``InsufficientProgress`` on long, strongly graded grids).
+    """
+    try:
+        return RELAXATION_BACKENDS[backend](unit), backend, None
+    except SolverError as first:
+        other = "banded" if backend == "clarabel" else "clarabel"
+        try:
+            return RELAXATION_BACKENDS[other](unit), other, f"{backend}: {first}"
+        except SolverError as second:
+            raise SolverError(
+                f"both relaxation backends failed ({backend}: {first}; {other}: {second})",
+                backend=f"{backend},{other}", status=second.status,
+            ) from second
+
+
 def solve_problem(
     problem: DiscreteProblem, *, refine: str = "auto", backend: str = "clarabel"
 ) -> DiscreteSolution:
@@ -93,7 +114,7 @@ def solve_problem(
     w_scale = float(np.max(problem.w_max))
     time_scale = s_scale / np.sqrt(w_scale)
     unit = problem.scaled(s_scale, w_scale)
-    relax = RELAXATION_BACKENDS[backend](unit)
+    relax, backend, fallback_reason = _relax_with_fallback(unit, backend)
     w_relaxed = np.clip(relax.w * w_scale, 0.0, problem.w_max)
     w_relaxed[0], w_relaxed[-1] = problem.w_start, problem.w_end
     lower = min(relax.dual_objective, relax.primal_objective) * time_scale
@@ -101,6 +122,7 @@ def solve_problem(
     exact = relaxed_violation <= problem.jerk_tol
     extras: dict[str, Any] = {
         "backend": backend,
+        "backend_fallback": fallback_reason,
         "iterations": relax.iterations,
         "relaxation_status": relax.status,
         "relaxation_time": relax.solve_time + relax.setup_time,

@@ -22,7 +22,7 @@ __all__ = ["adaptive_grid", "uniform_grid", "DEFAULT_PER_PHASE", "MAX_DEFAULT_NO
 #: straight rest-to-rest move; see the convergence table in the docs).
 DEFAULT_PER_PHASE = 80
 MAX_DEFAULT_NODES = 20_000
-MIN_NODES = 50
+MIN_NODES = 200
 
 
 def uniform_grid(length: float, *, n: int | None = None, ds: float | None = None) -> FloatArray:

@@ -1,0 +1,183 @@
+"""plan(): physics of the planned trajectories, sampled at 1 ms and finite-differenced."""
+
+from __future__ import annotations
+
+import glob
+import warnings
+
+import numpy as np
+import pytest
+from ruckig import InputParameter, Result, Ruckig, Trajectory
+
+from speedplan import (
+    InfeasibleError,
+    InvalidInputError,
+    Limits,
+    LimitWarning,
+    Path,
+    SpeedZone,
+    plan,
+)
+from speedplan.geometry import Arc, Clothoid, Line
+from speedplan.io import read_path, read_zones
+from speedplan.timing import TOLERANCES
+
+LGV = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+ROAD = Limits(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0)
+DT = 1e-3
+
+
+def ruckig_duration(length, lim):
+    otg = Ruckig(1)
+    inp = InputParameter(1)
+    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [0.0], [0.0]
+    inp.target_position, inp.target_velocity, inp.target_acceleration = [length], [0.0], [0.0]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [lim.v_max], [lim.a_max], [lim.j_max]
+    inp.min_acceleration = [-lim.a_decel]
+    traj = Trajectory(1)
+    assert otg.calculate(inp, traj) == Result.Working
+    return traj.duration
+
+
+def assert_physics(profile, lim=None, tol=TOLERANCES):
+    """Sample at 1 ms and finite-difference positions and speeds against the limits."""
+    lim = lim or profile.limits
+    traj = profile.sample(DT)
+    t, xy = traj.t[:-1], np.column_stack((traj.x, traj.y))[:-1]  # uniform part only
+    v_fd = np.linalg.norm(np.diff(xy, axis=0), axis=1) / DT
+    v_mid = 0.5 * (traj.v[:-2] + traj.v[1:-1])
+    assert np.abs(v_fd - v_mid).max() <= 1e-3 * lim.v_max  # positions and speeds agree
+    a_fd = np.diff(traj.v[:-1]) / DT
+    j_fd = np.diff(a_fd) / DT
+    bound = np.sqrt(profile.speed_bound(traj.s))
+    assert np.all(traj.v <= bound * (1 + tol["speed"]) + 1e-12)
+    assert a_fd.max() <= lim.a_max * (1 + tol["accel"])
+    assert -a_fd.min() <= lim.a_decel * (1 + tol["decel"])
+    assert np.abs(traj.a_lat).max() <= lim.a_lat_max * (1 + tol["lateral"])
+    assert np.abs(j_fd).max() <= lim.j_max * (1 + tol["jerk"])
+    assert np.all(np.isfinite(np.column_stack(list(traj.to_dict().values()))))
+    assert traj.t[0] == 0 and traj.t[-1] == pytest.approx(profile.duration)
+    assert len(t) > 0
+    return traj
+
+
+@pytest.mark.parametrize(
+    ("length", "lim"),
+    [(30.0, LGV), (3.0, LGV), (0.5, LGV), (400.0, ROAD),
+     (25.0, Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5, a_decel=0.6))],
+)
+def test_straight_rest_to_rest_converges_to_the_true_jerk_limited_optimum(length, lim):
+    reference = ruckig_duration(length, lim)
+    profile = plan(Path.from_segments([Line(length)]), lim)
+    assert profile.status == "optimal" and profile.exact
+    assert profile.duration <= reference * 1.005
+    assert profile.duration >= reference * (1 - 0.001)
+    traj = assert_physics(profile)
+    assert traj.v[0] == 0 and traj.v[-1] == pytest.approx(0, abs=1e-12)
+    assert traj.a[0] == 0 and traj.a[-1] == pytest.approx(0, abs=1e-9)
+
+
+def test_closed_form_thirty_metres_is_nineteen_seconds():
+    # Jerk phases of a/j = 2 s reach v = a²/j = v_max exactly: 4 s + 22 m / 2 m/s + 4 s.
+    profile = plan(Path.from_segments([Line(30.0)]), LGV)
+    assert profile.duration == pytest.approx(19.0, rel=0.005)
+
+
+def test_paper_free_standstill_model_is_faster_than_physics_allows():
+    free = plan(Path.from_segments([Line(30.0)]), LGV, standstill="free", n=600)
+    assert free.duration < 18.5  # the acceleration jumps at standstill (the paper's model)
+    assert free.sample(0.01).a[0] > 0
+
+
+@pytest.mark.parametrize("R", [0.5, 2.0, 8.0])
+def test_constant_radius_arc_cruises_at_the_lateral_limit(R):
+    profile = plan(Path.from_segments([Arc(R, 3 * np.pi)]), LGV)
+    traj = assert_physics(profile)
+    cruise = min(LGV.v_max, np.sqrt(LGV.a_lat_max * R))
+    mid = traj.v[np.argmin(np.abs(traj.s - profile.path.length / 2))]
+    assert mid == pytest.approx(cruise, rel=1e-3)
+
+
+@pytest.mark.parametrize("transitions", [False, True])
+def test_line_arc_line(transitions):
+    segs = [Line(10.0), Arc(2.0, np.pi / 2), Line(10.0)]
+    if transitions:
+        segs = [Line(10.0), Clothoid(1.5, 0, 0.5), Arc(2.0, np.pi / 2 - 0.75), Clothoid(1.5, 0.5, 0),
+                Line(10.0)]
+    profile = plan(Path.from_segments(segs), LGV)
+    assert profile.options["verification"].ok
+    assert_physics(profile)
+
+
+@pytest.mark.parametrize("file", sorted(glob.glob("paths/*.csv") + glob.glob("paths/*.json")))
+def test_every_sample_path(file):
+    lim = ROAD if "road" in file else LGV
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        profile = plan(read_path(file), lim, zones=read_zones(file) or None)
+    assert profile.status in ("optimal", "refined")
+    assert_physics(profile)
+
+
+def test_limit_ratios_shrink_as_the_grid_is_refined():
+    path = Path.from_segments([Line(30.0)])
+    with pytest.warns(LimitWarning, match="jerk"):  # too coarse: plan() says so
+        coarse = plan(path, LGV, n=300).verify()
+    assert not coarse.ok and "jerk" in coarse.violations
+    fine = plan(path, LGV, n=2400).verify()
+    assert fine.ratios["jerk"] < coarse.ratios["jerk"]
+    assert fine.ratios["jerk"] <= 1.0 + TOLERANCES["jerk"] / 2
+
+
+def test_moving_start_begins_exactly_at_the_given_state():
+    profile = plan(Path.from_segments([Line(20.0)]), LGV, v0=1.2, a0=0.3)
+    traj = assert_physics(profile)
+    assert traj.v[0] == pytest.approx(1.2, abs=1e-12)
+    assert traj.a[0] == pytest.approx(0.3, abs=1e-12)
+    end_moving = plan(Path.from_segments([Line(20.0)]), LGV, vf=1.0, af=-0.2)
+    traj = assert_physics(end_moving)
+    assert traj.v[-1] == pytest.approx(1.0, abs=1e-9) and traj.a[-1] == pytest.approx(-0.2, abs=1e-9)
+
+
+def test_impossible_boundary_states():
+    line = Path.from_segments([Line(20.0)])
+    with pytest.raises(InvalidInputError, match="`a0`"):
+        plan(line, LGV, v0=1.0, a0=1.5)
+    with pytest.raises(InvalidInputError, match="`v0`"):
+        plan(line, LGV, v0=2.5)
+    with pytest.raises(InvalidInputError, match="`a0`"):
+        plan(line, LGV, v0=0.0, a0=0.3)
+    with pytest.raises(InfeasibleError, match="passes through zero|pass through zero"):
+        plan(line, LGV, v0=0.2, a0=-0.9)
+    zone = SpeedZone([(1.0, -1.0), (5.0, -1.0), (5.0, 1.0), (1.0, 1.0)], v_max=0.5)
+    with pytest.raises(InfeasibleError, match="cannot brake from v0=2") as info:
+        plan(line, LGV, v0=2.0, zones=[zone])
+    assert info.value.s == pytest.approx(1.0, abs=0.05)
+
+
+def test_millimetres_and_metres_give_the_same_trajectory():
+    pts = np.array([[0, 0], [8, 0], [12, 3], [12, 9]], dtype=float)
+    m = plan(Path.from_waypoints(pts), LGV)
+    k = 1000.0
+    mm = plan(Path.from_waypoints(pts * k),
+              Limits(v_max=2 * k, a_max=1 * k, a_lat_max=1 * k, j_max=0.5 * k))
+    assert mm.duration == pytest.approx(m.duration, rel=1e-6)
+    a, b = m.sample(0.05), mm.sample(0.05)
+    assert b.s / k == pytest.approx(a.s, rel=1e-6, abs=1e-9)
+
+
+def test_same_inputs_give_bitwise_identical_outputs():
+    path = Path.from_waypoints([[0, 0], [8, 0], [12, 3]])
+    a, b = plan(path, LGV).sample(0.02), plan(path, LGV).sample(0.02)
+    for name, col in a.to_dict().items():
+        assert np.array_equal(col, b.to_dict()[name]), name
+
+
+def test_bad_arguments_name_themselves():
+    line = Path.from_segments([Line(5.0)])
+    for kwargs, name in [({"n": 2}, "n"), ({"ds": -1.0}, "ds"), ({"refine": "x"}, "refine"),
+                         ({"standstill": "x"}, "standstill"), ({"v0": np.nan}, "v0")]:
+        with pytest.raises(InvalidInputError, match=f"`{name}`"):
+            plan(line, LGV, **kwargs)
+    with pytest.raises(InvalidInputError, match="`path`"):
+        plan([[0, 0], [1, 0]], LGV)
