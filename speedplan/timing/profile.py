@@ -185,6 +185,13 @@ class SpeedProfile:
             dt=float(step),
         )
 
+    def plot(self, file: str | None = None, **options: Any) -> Any:
+        """Figure of the profile; see :func:`speedplan.plot.plot_profile` (``plot`` extra)."""
+        # Lazy: matplotlib is optional and the plotting module sits above this layer.
+        from ..plot import plot_profile
+
+        return plot_profile(self, file, **options)
+
     def __repr__(self) -> str:
         return (
             f"SpeedProfile(duration={self.duration:.6g} s, length={self.path.length:.6g} m, "
