@@ -1,5 +1,6 @@
-"""speedplan: minimum-time speed laws along a path under speed, acceleration, lateral
-acceleration and true jerk limits, with a certificate of optimality.
+"""speedplan: minimum-time speed laws along a path, with a certificate of optimality.
+
+Speed, tangential-acceleration, lateral-acceleration and true jerk limits; see :func:`plan`.
 """
 
 from .batch import BatchResult, plan_many

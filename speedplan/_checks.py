@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 from .errors import InvalidInputError
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
 
 #: Largest grid a single solve accepts; beyond it memory, not the solver, becomes the limit.
 MAX_GRID_POINTS = 5_000_000
@@ -79,7 +80,9 @@ def as_scalar(
     return x
 
 
-def broadcast_positive(name: str, value: Any, length: int, *, allow_inf: bool = False) -> FloatArray:
+def broadcast_positive(
+    name: str, value: Any, length: int, *, allow_inf: bool = False
+) -> FloatArray:
     """Return a positive scalar-or-vector bound as an array of ``length``."""
     arr = as_array(name, value, allow_inf=allow_inf)
     if arr.ndim == 0:

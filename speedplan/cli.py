@@ -18,7 +18,7 @@ import numpy as np
 from .errors import InfeasibleError, InvalidInputError, LimitWarning, SolverError, SpeedplanError
 from .limits import Limits
 
-__all__ = ["main", "EXIT_CODES"]
+__all__ = ["EXIT_CODES", "main"]
 
 EXIT_CODES = {"ok": 0, "usage": 2, "infeasible": 3, "solver": 4, "limits": 5}
 DEMO_PATH = "warehouse_loop.json"
@@ -42,7 +42,8 @@ def _add_limits(p: argparse.ArgumentParser, defaults: dict[str, float] | None = 
         key = flag.replace("-", "_")
         g.add_argument(f"--{flag}", type=float, required=key not in d, default=d.get(key),
                        help=help_)
-    g.add_argument("--a-decel", type=float, default=None, help="braking limit [m/s²] (default a-max)")
+    g.add_argument("--a-decel", type=float, default=None,
+                   help="braking limit [m/s²] (default a-max)")
 
 
 def _parser() -> argparse.ArgumentParser:

@@ -29,7 +29,7 @@ import numpy as np
 from .errors import InvalidInputError
 from .geometry import Path, SpeedZone
 
-__all__ = ["read_path", "read_zones", "path_from_dict", "zones_from_dict"]
+__all__ = ["path_from_dict", "read_path", "read_zones", "zones_from_dict"]
 
 
 def _load(file: str | PathLike[str]) -> tuple[FsPath, Any]:
@@ -55,11 +55,15 @@ def _read_csv(fs: FsPath) -> Path:
         raise InvalidInputError(f"{fs.name}: empty file")
     header = [h.strip().lower() for h in rows[0]]
     if "x" not in header or "y" not in header:
-        raise InvalidInputError(f"{fs.name}: the header must name columns 'x' and 'y'; got {rows[0]}")
+        raise InvalidInputError(
+            f"{fs.name}: the header must name columns 'x' and 'y'; got {rows[0]}"
+        )
     try:
         data = np.array([[float(r[i]) for i in range(len(header))] for r in rows[1:]])
     except (ValueError, IndexError) as exc:
-        raise InvalidInputError(f"{fs.name}: every row needs {len(header)} numbers ({exc})") from exc
+        raise InvalidInputError(
+            f"{fs.name}: every row needs {len(header)} numbers ({exc})"
+        ) from exc
     if data.ndim != 2 or data.shape[0] < 2:
         raise InvalidInputError(f"{fs.name}: needs at least two waypoints")
     xy = data[:, [header.index("x"), header.index("y")]]

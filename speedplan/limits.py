@@ -56,16 +56,16 @@ class Limits:
         set_(self, "a_decel", as_scalar("a_decel", decel, positive=True))
 
     @property
-    def A(self) -> float:  # noqa: N802 - the paper's symbol
+    def A(self) -> float:
         """Paper's acceleration bound on ``w' = d(v²)/ds``: ``2 a_max`` [m/s²]."""
         return 2.0 * self.a_max
 
     @property
-    def A_decel(self) -> float:  # noqa: N802 - the paper's symbol
+    def A_decel(self) -> float:
         """Braking bound on ``-w'``: ``2 a_decel`` [m/s²]."""
         return 2.0 * self.a_decel
 
     @property
-    def J(self) -> float:  # noqa: N802 - the paper's symbol
+    def J(self) -> float:
         """Paper's jerk bound on ``w'' sqrt(w)``: ``2 j_max`` [m/s³]."""
         return 2.0 * self.j_max

@@ -37,6 +37,7 @@ class SpeedBound:
     v_limit: Any = None
 
     def __call__(self, s: FloatArray) -> FloatArray:
+        """Bound at arc lengths ``s`` [m²/s²]."""
         return np.asarray(
             speed_bounds(self.path, self.limits, s, zones=self.zones, v_limit=self.v_limit),
             dtype=np.float64,

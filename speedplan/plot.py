@@ -36,8 +36,10 @@ def plot_profile(
     trajectory: Trajectory | None = None,
     dt: float = 0.01,
 ) -> Any:
-    """Four panels: the path coloured by speed; ``v(s)`` against ``sqrt(mu+(s))``; ``a(t)`` and
-    ``a_lat(t)`` against their limits; ``j(t)`` against ``±j_max``.
+    """Draw a profile in four panels, optionally saved to ``file``.
+
+    The path coloured by speed; ``v(s)`` against ``sqrt(mu+(s))``; ``a(t)`` and ``a_lat(t)``
+    against their limits; ``j(t)`` against ``±j_max``.
 
     Parameters
     ----------
@@ -47,6 +49,8 @@ def plot_profile(
         Where to save the figure (PNG, SVG, PDF by extension).
     trajectory : Trajectory, optional
         A sampled trajectory to draw; default ``profile.sample(dt)``.
+    dt : float
+        Sampling period [s] when ``trajectory`` is not given.
 
     Returns
     -------
@@ -61,7 +65,8 @@ def plot_profile(
 
     pts = np.column_stack((traj.x, traj.y))
     segs = np.stack((pts[:-1], pts[1:]), axis=1)
-    lc = LineCollection(segs, array=0.5 * (traj.v[:-1] + traj.v[1:]), cmap="viridis", linewidths=3)
+    speed = 0.5 * (traj.v[:-1] + traj.v[1:])
+    lc = LineCollection(list(segs), array=speed, cmap="viridis", linewidths=3)
     ax.add_collection(lc)
     ax.autoscale()
     ax.set_aspect("equal", adjustable="datalim")

@@ -76,7 +76,7 @@ def test_cli_errors_are_one_line_with_documented_exit_codes(args, code, text, re
 def test_bad_files_raise_invalid_input(tmp_path):
     bad_json = tmp_path / "bad.json"
     bad_json.write_text("{not json")
-    with pytest.raises(sp.InvalidInputError, match="bad.json"):
+    with pytest.raises(sp.InvalidInputError, match=r"bad\.json"):
         read_path(bad_json)
     no_xy = tmp_path / "w.csv"
     no_xy.write_text("a,b\n1,2\n3,4\n")

@@ -38,11 +38,12 @@ def test_primitive_lengths_curvatures_and_end_points_match_closed_forms():
 
     x = quad(lambda u: np.cos(theta(u)), 0, 4, epsabs=1e-13, epsrel=1e-13)[0]
     y = quad(lambda u: np.sin(theta(u)), 0, 4, epsabs=1e-13, epsrel=1e-13)[0]
-    assert p.point(p.length) == pytest.approx(end_arc + [x, y], abs=1e-11)
+    assert p.point(p.length) == pytest.approx(end_arc + np.array([x, y]), abs=1e-11)
 
 
 def test_heading_is_continuous_across_g1_joints():
-    p = Path.from_segments([Line(1.0), Clothoid(2.0, 0.0, 0.5), Arc(2.0, 1.0), Clothoid(2.0, 0.5, 0.0)])
+    p = Path.from_segments([Line(1.0), Clothoid(2.0, 0.0, 0.5), Arc(2.0, 1.0),
+                            Clothoid(2.0, 0.5, 0.0)])
     for joint in p.offsets[1:-1]:
         before, after = p.heading(joint - 1e-12), p.heading(joint + 1e-12)
         assert abs(after - before) < 1e-9
@@ -53,7 +54,8 @@ def test_clothoid_chain_passes_through_every_waypoint_g1():
     p = Path.from_waypoints(pts)
     assert p.point(p.offsets) == pytest.approx(pts, abs=1e-9)
     for joint in p.offsets[1:-1]:
-        assert abs(np.angle(np.exp(1j * (p.heading(joint + 1e-12) - p.heading(joint - 1e-12))))) < 1e-9
+        jump = p.heading(joint + 1e-12) - p.heading(joint - 1e-12)
+        assert abs(np.angle(np.exp(1j * jump))) < 1e-9
 
 
 def test_g1_hermite_clothoid_hits_the_target_pose():

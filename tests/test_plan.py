@@ -102,8 +102,8 @@ def test_constant_radius_arc_cruises_at_the_lateral_limit(R):
 def test_line_arc_line(transitions):
     segs = [Line(10.0), Arc(2.0, np.pi / 2), Line(10.0)]
     if transitions:
-        segs = [Line(10.0), Clothoid(1.5, 0, 0.5), Arc(2.0, np.pi / 2 - 0.75), Clothoid(1.5, 0.5, 0),
-                Line(10.0)]
+        segs = [Line(10.0), Clothoid(1.5, 0, 0.5), Arc(2.0, np.pi / 2 - 0.75),
+                Clothoid(1.5, 0.5, 0), Line(10.0)]
     profile = plan(Path.from_segments(segs), LGV)
     assert profile.options["verification"].ok
     assert_physics(profile)
@@ -136,7 +136,8 @@ def test_moving_start_begins_exactly_at_the_given_state():
     assert traj.a[0] == pytest.approx(0.3, abs=1e-12)
     end_moving = plan(Path.from_segments([Line(20.0)]), LGV, vf=1.0, af=-0.2)
     traj = assert_physics(end_moving)
-    assert traj.v[-1] == pytest.approx(1.0, abs=1e-9) and traj.a[-1] == pytest.approx(-0.2, abs=1e-9)
+    assert traj.v[-1] == pytest.approx(1.0, abs=1e-9)
+    assert traj.a[-1] == pytest.approx(-0.2, abs=1e-9)
 
 
 def test_impossible_boundary_states():
@@ -147,7 +148,7 @@ def test_impossible_boundary_states():
         plan(line, LGV, v0=2.5)
     with pytest.raises(InvalidInputError, match="`a0`"):
         plan(line, LGV, v0=0.0, a0=0.3)
-    with pytest.raises(InfeasibleError, match="passes through zero|pass through zero"):
+    with pytest.raises(InfeasibleError, match=r"pass through zero"):
         plan(line, LGV, v0=0.2, a0=-0.9)
     zone = SpeedZone([(1.0, -1.0), (5.0, -1.0), (5.0, 1.0), (1.0, 1.0)], v_max=0.5)
     with pytest.raises(InfeasibleError, match="cannot brake from v0=2") as info:

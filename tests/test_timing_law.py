@@ -27,7 +27,7 @@ def test_constant_acceleration_from_speed_is_exact_with_w_interpolation():
     w = 1.0 + 2 * 0.5 * s
     law = TimeLaw(s, w, p=1.0)
     assert law.duration == pytest.approx((3.0 - 1.0) / 0.5, rel=1e-12)
-    _, v, a, _ = law.kinematics(np.array([0.0, 4.0, 8.0]))
+    _, _, a, _ = law.kinematics(np.array([0.0, 4.0, 8.0]))
     assert a == pytest.approx(0.5, rel=1e-12)
 
 

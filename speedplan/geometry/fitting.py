@@ -11,7 +11,7 @@ from .._checks import FloatArray, as_array, as_scalar, choice
 from ..errors import InvalidInputError
 from .pieces import ClothoidPiece, CurvePiece, Piece
 
-__all__ = ["KINDS", "fit_waypoints", "fit_clothoid"]
+__all__ = ["KINDS", "fit_clothoid", "fit_waypoints"]
 
 KINDS = ("clothoid", "spline", "polyline")
 #: Default corner rounding of polylines: each corner arc starts this fraction of the shorter
@@ -181,6 +181,8 @@ def fit_waypoints(
 
     Parameters
     ----------
+    xy : array_like, shape (n, 2)
+        Waypoints [m]; n >= 2, finite, no consecutive duplicates.
     kind : {"clothoid", "spline", "polyline"}
         ``"clothoid"`` (default): one clothoid per leg (curvature linear in s), tangent-continuous
         (G1) at every waypoint, passing through every waypoint exactly; headings from ``headings``

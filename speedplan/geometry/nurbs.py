@@ -59,12 +59,12 @@ def nurbs_piece(degree: int, knots: Any, control_points: Any, weights: Any = Non
         p, wt = h0[:, :2], h0[:, 2:3]
         r = p / wt
         if nu == 0:
-            return r
+            return np.asarray(r, dtype=np.float64)
         h1 = derivs[1](tau)
         dp, dw = h1[:, :2], h1[:, 2:3]
         r1 = (dp - r * dw) / wt
         if nu == 1:
-            return r1
+            return np.asarray(r1, dtype=np.float64)
         h2 = derivs[2](tau)
         d2p, d2w = h2[:, :2], h2[:, 2:3]
         out: FloatArray = (d2p - 2 * r1 * dw - r * d2w) / wt

@@ -131,7 +131,8 @@ class Path:
     def _dispatch(self, s: Any, attr: str) -> FloatArray:
         q = np.clip(as_array("s", s), 0.0, self.length)
         flat = q.ravel()
-        idx = np.clip(np.searchsorted(self.offsets, flat, side="right") - 1, 0, len(self.pieces) - 1)
+        last = len(self.pieces) - 1
+        idx = np.clip(np.searchsorted(self.offsets, flat, side="right") - 1, 0, last)
         trailing = (2,) if attr == "point" else ()
         out = np.empty(flat.shape + trailing)
         for k in np.unique(idx):
@@ -227,5 +228,7 @@ class Path:
         import shapely
 
         if not isinstance(line, shapely.LineString):
-            raise InvalidInputError(f"`line` must be a shapely LineString; got {type(line).__name__}")
+            raise InvalidInputError(
+                f"`line` must be a shapely LineString; got {type(line).__name__}"
+            )
         return cls.from_waypoints(np.asarray(line.coords)[:, :2], kind, **options)

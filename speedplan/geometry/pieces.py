@@ -31,12 +31,15 @@ class Piece:
     length: float
 
     def point(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
+        """Positions at local arc lengths ``u``, shape ``u.shape + (2,)`` [m]."""
         raise NotImplementedError
 
     def heading(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
+        """Headings at local arc lengths ``u`` [rad]."""
         raise NotImplementedError
 
     def curvature(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
+        """Signed curvatures at local arc lengths ``u`` [1/m]."""
         raise NotImplementedError
 
 
@@ -64,11 +67,14 @@ class ClothoidPiece(Piece):
         object.__setattr__(self, "_knot_xy", xy)
 
     def heading(self, u: FloatArray) -> FloatArray:
+        """Heading ``θ0 + k0 u + (k1 - k0) u² / (2 length)`` [rad]."""
         u = np.asarray(u, dtype=np.float64)
-        out: FloatArray = self.theta0 + self.k0 * u + 0.5 * (self.k1 - self.k0) * u * u / self.length
+        sharpness = (self.k1 - self.k0) / self.length
+        out: FloatArray = self.theta0 + self.k0 * u + 0.5 * sharpness * u * u
         return out
 
     def curvature(self, u: FloatArray) -> FloatArray:
+        """Curvature, linear from ``k0`` to ``k1`` [1/m]."""
         u = np.asarray(u, dtype=np.float64)
         out: FloatArray = self.k0 + (self.k1 - self.k0) * u / self.length
         return out
@@ -79,6 +85,7 @@ class ClothoidPiece(Piece):
         return np.column_stack(((np.cos(th) * width) @ _GW, (np.sin(th) * width) @ _GW))
 
     def point(self, u: FloatArray) -> FloatArray:
+        """Positions: the nearest knot's position plus a 16-point quadrature from it [m]."""
         u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
         flat = u.ravel()
         j = np.clip(np.searchsorted(self._knots, flat, side="right") - 1, 0, self._knots.size - 2)
@@ -133,15 +140,18 @@ class CurvePiece(Piece):
         return tau
 
     def point(self, u: FloatArray) -> FloatArray:
+        """Positions at arc lengths ``u`` [m]."""
         u = np.asarray(u, dtype=np.float64)
         return self.curve(self.parameter(u), 0).reshape(*u.shape, 2)
 
     def heading(self, u: FloatArray) -> FloatArray:
+        """Direction of ``r'(τ)`` [rad]."""
         u = np.asarray(u, dtype=np.float64)
         d1 = self.curve(self.parameter(u), 1)
         return np.arctan2(d1[:, 1], d1[:, 0]).reshape(u.shape)
 
     def curvature(self, u: FloatArray) -> FloatArray:
+        """``(x'y'' - y'x'') / |r'|³`` [1/m]."""
         u = np.asarray(u, dtype=np.float64)
         tau = self.parameter(u)
         d1, d2 = self.curve(tau, 1), self.curve(tau, 2)
@@ -158,15 +168,23 @@ class ReversedPiece(Piece):
 
     @property
     def length(self) -> float:  # type: ignore[override]
+        """Length of the underlying piece [m]."""
         return self.piece.length
 
+    def _mirror(self, u: FloatArray) -> FloatArray:
+        out: FloatArray = self.piece.length - np.asarray(u, dtype=np.float64)
+        return out
+
     def point(self, u: FloatArray) -> FloatArray:
-        return self.piece.point(self.piece.length - np.asarray(u, dtype=np.float64))
+        """Positions, travelled backwards [m]."""
+        return self.piece.point(self._mirror(u))
 
     def heading(self, u: FloatArray) -> FloatArray:
-        out: FloatArray = self.piece.heading(self.piece.length - np.asarray(u, dtype=np.float64)) + np.pi
+        """Headings turned by π [rad]."""
+        out: FloatArray = self.piece.heading(self._mirror(u)) + np.pi
         return out
 
     def curvature(self, u: FloatArray) -> FloatArray:
-        out: FloatArray = -self.piece.curvature(self.piece.length - np.asarray(u, dtype=np.float64))
+        """Curvatures with the opposite sign [1/m]."""
+        out: FloatArray = -self.piece.curvature(self._mirror(u))
         return out

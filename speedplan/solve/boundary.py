@@ -15,7 +15,7 @@ import numpy as np
 from .._checks import FloatArray
 from ..errors import InfeasibleError
 
-__all__ = ["max_jerk_envelope", "check_boundary_state"]
+__all__ = ["check_boundary_state", "max_jerk_envelope"]
 
 
 def check_boundary_state(v: float, a: float, j_max: float, *, end: bool) -> None:

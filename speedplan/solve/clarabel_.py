@@ -17,7 +17,7 @@ import clarabel
 import numpy as np
 import scipy.sparse as sp
 
-from .._checks import FloatArray
+from .._checks import FloatArray, IntArray
 from ..errors import InfeasibleError, SolverError
 from .problem import DiscreteProblem
 
@@ -42,13 +42,15 @@ class RelaxationResult:
     setup_time: float
 
 
-def _rows(n_rows: int, cols: list[FloatArray], vals: list[FloatArray]) -> sp.coo_matrix:
-    """Stack per-row column/value arrays of equal length into a COO block."""
+def _rows(
+    n_rows: int, cols: list[Any], vals: list[Any]
+) -> tuple[IntArray, IntArray, FloatArray]:
+    """Row, column and value arrays of ``n_rows`` rows with one entry per ``cols`` item."""
     k = len(cols)
-    r = np.repeat(np.arange(n_rows), k)
-    c = np.column_stack(cols).ravel()
-    v = np.column_stack(vals).ravel()
-    return r, c, v  # type: ignore[return-value]
+    r: IntArray = np.repeat(np.arange(n_rows), k)
+    c: IntArray = np.column_stack(cols).ravel()
+    v: FloatArray = np.column_stack(vals).ravel().astype(np.float64)
+    return r, c, v
 
 
 def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, FloatArray, list[Any]]:
@@ -60,13 +62,13 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
     h, tau = problem.h, problem.tau
     interior = np.arange(1, n - 1)
     seg = np.arange(n - 1)
-    blocks_r: list[FloatArray] = []
-    blocks_c: list[FloatArray] = []
+    blocks_r: list[IntArray] = []
+    blocks_c: list[IntArray] = []
     blocks_v: list[FloatArray] = []
     b_parts: list[FloatArray] = []
     row0 = 0
 
-    def add(n_rows: int, cols: list[FloatArray], vals: list[FloatArray], rhs: FloatArray) -> None:
+    def add(n_rows: int, cols: list[Any], vals: list[Any], rhs: FloatArray) -> None:
         nonlocal row0
         r, c, v = _rows(n_rows, cols, vals)
         blocks_r.append(np.asarray(r) + row0)

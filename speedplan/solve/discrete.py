@@ -271,7 +271,7 @@ def solve_discrete(
     accel, decel = _accel_pair(A, n)
     jerk = broadcast_positive("J", J, n - 2, allow_inf=True)
     problem = DiscreteProblem(
-        s=np.arange(n) * hh,
+        s=np.arange(n, dtype=np.float64) * hh,
         w_max=wm,
         accel=accel,
         decel=decel,

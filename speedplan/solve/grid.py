@@ -16,7 +16,7 @@ from .._checks import FloatArray, grid_size
 from .nojerk import max_feasible_w
 from .problem import DiscreteProblem
 
-__all__ = ["adaptive_grid", "uniform_grid", "DEFAULT_PER_PHASE", "MAX_DEFAULT_NODES"]
+__all__ = ["DEFAULT_PER_PHASE", "MAX_DEFAULT_NODES", "adaptive_grid", "uniform_grid"]
 
 #: Nodes per jerk transition of the default grid (measured: jerk within 6 % of j_max on a
 #: straight rest-to-rest move; see the convergence table in the docs).

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -20,7 +21,7 @@ from .problem import DiscreteProblem
 __all__ = ["RefineResult", "refine_ipopt"]
 
 #: IPOPT options: printing off, tight tolerances (the problem is scaled to O(1) before).
-IPOPT_OPTIONS: dict[str, object] = {
+IPOPT_OPTIONS: dict[str, Any] = {
     "print_level": 0,
     "sb": "yes",
     "tol": 1e-10,

@@ -14,7 +14,7 @@ from .._checks import FloatArray
 from ..errors import InfeasibleError
 from .problem import DiscreteProblem
 
-__all__ = ["max_feasible_w", "check_reachable"]
+__all__ = ["check_reachable", "max_feasible_w"]
 
 
 def _forward(bound: FloatArray, rate_h: FloatArray) -> FloatArray:

@@ -7,7 +7,7 @@ from typing import Any
 
 from .._checks import FloatArray
 
-__all__ = ["DiscreteSolution", "STATUSES"]
+__all__ = ["STATUSES", "DiscreteSolution"]
 
 #: Closed set of ``DiscreteSolution.status`` values and their meaning.
 STATUSES: dict[str, str] = {

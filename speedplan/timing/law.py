@@ -26,7 +26,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .._checks import FloatArray
+from .._checks import FloatArray, IntArray
 
 __all__ = ["TimeLaw"]
 
@@ -89,9 +89,9 @@ class TimeLaw:
         return float(self.s[-1] - self.s[0])
 
     def _u_piece(
-        self, j: FloatArray, dx: FloatArray, dr: FloatArray
+        self, j: IntArray, dx: FloatArray, dr: FloatArray
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``u, u', u''`` on piece ``j`` at offset ``dx`` from its left knot (``dr`` from its right).
+        """``u, u', u''`` on piece ``j``, ``dx`` after its left knot and ``dr`` before its right.
 
         ``u`` is evaluated from the nearer knot, so it stays accurate relative to its own size
         next to a standstill end, where it tends to 0.
@@ -112,9 +112,9 @@ class TimeLaw:
             ddu = ddu + c * (6 - 12 * z) / L**2
         return np.maximum(u, 0.0), du, ddu
 
-    def _piece(self, q: FloatArray) -> FloatArray:
+    def _piece(self, q: FloatArray) -> IntArray:
         x = self._knots[0]
-        out: FloatArray = np.clip(np.searchsorted(x, q, side="right") - 1, 0, x.size - 2)
+        out: IntArray = np.clip(np.searchsorted(x, q, side="right") - 1, 0, x.size - 2)
         return out
 
     def _u(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -143,7 +143,7 @@ class TimeLaw:
         return w, v, a, jerk
 
     # ---- time -------------------------------------------------------------------------------
-    def _integral(self, j: FloatArray, lo: FloatArray, hi: FloatArray,
+    def _integral(self, j: IntArray, lo: FloatArray, hi: FloatArray,
                   singular_at: FloatArray) -> FloatArray:
         """∫ ds / v over offsets ``[lo, hi]`` of piece ``j``.
 
@@ -181,7 +181,7 @@ class TimeLaw:
         u_ends, _, _ = self._u(np.array([x[0], x[-1]]))
         return bool(u_ends[0] <= 0.0), bool(u_ends[1] <= 0.0)
 
-    def _singularity(self, j: FloatArray) -> FloatArray:
+    def _singularity(self, j: IntArray) -> FloatArray:
         x = self._knots[0]
         rest_start, rest_end = self._rest
         sing = np.zeros(j.shape, dtype=np.float64)

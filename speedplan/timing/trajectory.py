@@ -12,7 +12,7 @@ import numpy as np
 
 from .._checks import FloatArray
 
-__all__ = ["Trajectory", "COLUMNS"]
+__all__ = ["COLUMNS", "Trajectory"]
 
 #: Column names with their units, in export order.
 COLUMNS: dict[str, str] = {
