@@ -14,7 +14,7 @@ from .errors import InfeasibleError, InvalidInputError, LimitWarning
 from .geometry import Path, SpeedZone, speed_bounds
 from .limits import Limits
 from .solve import DiscreteProblem, solve_problem
-from .solve.boundary import check_boundary_state, max_jerk_envelope
+from .solve.boundary import check_boundary_state, jerk_motion_w, max_jerk_envelope
 from .solve.discrete import BACKENDS, REFINE_MODES
 from .solve.grid import adaptive_grid, uniform_grid
 from .timing import SpeedProfile, TimeLaw
@@ -167,11 +167,25 @@ def plan(
     jerk_limited = np.isfinite(limits.j_max)
     smooth = jerk_limited and standstill == "smooth"
 
+    j = limits.j_max
+
     def envelope_cap(s: FloatArray, w: FloatArray) -> FloatArray:
+        # Fastest jerk-limited motion leaving (v0, a0), and arriving at (vf, af) (time-reversed).
         if smooth:
-            w = np.minimum(w, max_jerk_envelope(s, v0, a0, limits.j_max))
-            w = np.minimum(w, max_jerk_envelope(L - s, vf, -af, limits.j_max))
+            w = np.minimum(w, jerk_motion_w(s, v0, a0, j, limits.a_max))
+            w = np.minimum(w, jerk_motion_w(L - s, vf, -af, j, limits.a_decel))
         return w
+
+    def envelope_floor(s: FloatArray) -> FloatArray | None:
+        # Slowest jerk-limited motion leaving a moving state (and arriving at one).
+        if not smooth or (v0 == 0.0 and vf == 0.0):
+            return None
+        lo = np.zeros_like(s)
+        if v0 > 0:
+            lo = np.maximum(lo, jerk_motion_w(s, v0, min(a0, 0.0), -j, -limits.a_decel))
+        if vf > 0:
+            lo = np.maximum(lo, jerk_motion_w(L - s, vf, min(-af, 0.0), -j, -limits.a_max))
+        return lo
 
     def capped(s: FloatArray) -> FloatArray:
         return envelope_cap(s, bound(s))
@@ -201,7 +215,7 @@ def plan(
     problem = DiscreteProblem(
         s=s, w_max=w_max,
         accel=np.full(m - 1, limits.A), decel=np.full(m - 1, limits.A_decel),
-        jerk=jerk, w_start=v0 * v0, w_end=vf * vf,
+        jerk=jerk, w_start=v0 * v0, w_end=vf * vf, w_min=envelope_floor(s),
     )
     try:
         solution = solve_problem(problem, refine=refine, backend=backend)
@@ -285,6 +299,10 @@ def _explain(exc: InfeasibleError, problem: DiscreteProblem, limits: Limits, v0:
     if exc.constraint == "decel":
         msg = (f"cannot brake from v0={v0:.6g} m/s to {v_there:.6g} m/s (the speed bound at "
                f"s={where:.4g} m) under a_decel={limits.a_decel:.6g} m/s²")
+    elif exc.constraint == "jerk":
+        msg = (f"cannot brake from v0={v0:.6g} m/s to {v_there:.6g} m/s (the speed bound at "
+               f"s={where:.4g} m) under j_max={limits.j_max:.6g} m/s³ and "
+               f"a_decel={limits.a_decel:.6g} m/s²")
     elif exc.constraint == "accel":
         msg = (f"cannot reach vf={vf:.6g} m/s at the end from {v_there:.6g} m/s (the speed bound "
                f"at s={where:.4g} m) under a_max={limits.a_max:.6g} m/s²")

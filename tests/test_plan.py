@@ -182,3 +182,17 @@ def test_bad_arguments_name_themselves():
             plan(line, LGV, **kwargs)
     with pytest.raises(InvalidInputError, match="`path`"):
         plan([[0, 0], [1, 0]], LGV)
+
+
+def test_moving_start_that_must_brake_is_jerk_limited_from_its_first_instant():
+    line = Path.from_segments([Line(20.0)])
+    zone = SpeedZone([(6.0, -1.0), (9.0, -1.0), (9.0, 1.0), (6.0, 1.0)], v_max=0.3)
+    profile = plan(line, LGV, v0=2.0, zones=[zone])
+    traj = assert_physics(profile)
+    assert traj.v[0] == pytest.approx(2.0) and traj.a[0] == 0.0
+    assert traj.v[np.searchsorted(traj.s, 6.0)] <= 0.3 * 1.005
+    near = Path.from_segments([Line(20.0)])
+    close_zone = SpeedZone([(2.0, -1.0), (6.0, -1.0), (6.0, 1.0), (2.0, 1.0)], v_max=0.3)
+    with pytest.raises(InfeasibleError, match="j_max") as info:
+        plan(near, LGV, v0=2.0, zones=[close_zone])
+    assert info.value.constraint == "jerk" and info.value.s == pytest.approx(2.0, abs=0.05)

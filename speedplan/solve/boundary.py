@@ -41,10 +41,10 @@ def max_jerk_envelope(d: FloatArray, v: float, a: float, j_max: float) -> FloatA
 
     Examples
     --------
-    >>> import numpy as np
     From rest with ``j_max = 0.5``: after 2 s the vehicle has covered ``j t³/6 = 2/3`` m at
     ``v = j t²/2 = 1`` m/s.
 
+    >>> import numpy as np
     >>> w = max_jerk_envelope(np.array([0.0, 2.0 / 3.0]), v=0.0, a=0.0, j_max=0.5)
     >>> np.round(w, 12).tolist()
     [0.0, 1.0]
@@ -68,3 +68,51 @@ def max_jerk_envelope(d: FloatArray, v: float, a: float, j_max: float) -> FloatA
             break
     vt = v + a * t + 0.5 * j * t * t
     return np.asarray(vt * vt, dtype=np.float64)
+
+
+def jerk_motion_w(d: FloatArray, v: float, a: float, jerk: float, a_limit: float) -> FloatArray:
+    """``w = v²`` at distance ``d`` along a motion with constant ``jerk`` until the acceleration
+    reaches ``a_limit``, constant acceleration afterwards; 0 once the motion has stopped.
+
+    With ``jerk = -j_max``, ``a_limit = -a_decel`` and ``a <= 0`` this is the slowest a
+    jerk-limited vehicle leaving ``(v, a)`` can be at each distance: a valid lower bound on
+    ``w`` (for ``a > 0`` pass ``min(a, 0)``, which keeps it valid).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> jerk_motion_w(np.array([0.0, 100.0]), v=2.0, a=0.0, jerk=-0.5, a_limit=-1.0).tolist()
+    [4.0, 0.0]
+    """
+    d = np.maximum(np.asarray(d, dtype=np.float64), 0.0)
+    t1 = max((a_limit - a) / jerk, 0.0)  # end of the jerk phase
+    v1 = v + a * t1 + 0.5 * jerk * t1 * t1
+    s1 = v * t1 + 0.5 * a * t1 * t1 + jerk * t1**3 / 6.0
+
+    def state(t: FloatArray) -> tuple[FloatArray, FloatArray]:
+        tj = np.minimum(t, t1)
+        tc = np.maximum(t - t1, 0.0)
+        vj = v + a * tj + 0.5 * jerk * tj * tj
+        sj = v * tj + 0.5 * a * tj * tj + jerk * tj**3 / 6.0
+        in_const = t > t1
+        vel = np.where(in_const, v1 + a_limit * tc, vj)
+        pos = np.where(in_const, s1 + v1 * tc + 0.5 * a_limit * tc * tc, sj)
+        return pos, vel
+
+    # Time until the motion stops (speed reaches 0), or a horizon beyond every d.
+    horizon = 1.0
+    for _ in range(200):
+        pos, vel = state(np.array([horizon]))
+        if vel[0] <= 0 or pos[0] >= d.max():
+            break
+        horizon *= 2.0
+    lo, hi = np.zeros_like(d), np.full_like(d, horizon)
+    for _ in range(100):  # bisection on t: s(t) increases while v > 0
+        mid = 0.5 * (lo + hi)
+        pos, vel = state(mid)
+        beyond = (pos >= d) | (vel <= 0)
+        hi = np.where(beyond, mid, hi)
+        lo = np.where(beyond, lo, mid)
+    _, vel = state(hi)
+    out: FloatArray = np.maximum(vel, 0.0) ** 2
+    return np.where(d == 0, v * v, out)

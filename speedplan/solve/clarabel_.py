@@ -84,6 +84,12 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
     add(n - 1, [iw + seg + 1, iw + seg], [one(n - 1), -one(n - 1)], problem.accel * h)
     add(n - 1, [iw + seg, iw + seg + 1], [one(n - 1), -one(n - 1)], problem.decel * h)
     add(m, [iw + interior], [one(m)], problem.w_max[1:-1])
+    n_lower = 0
+    if problem.has_lower_bounds:
+        assert problem.w_min is not None
+        low = np.flatnonzero(problem.w_min[1:-1] > 0) + 1
+        n_lower = low.size
+        add(n_lower, [iw + low], [-one(n_lower)], -problem.w_min[low])
     finite = np.flatnonzero(np.isfinite(problem.jerk))
     n_jerk = 0
     if finite.size:
@@ -100,7 +106,7 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
                 np.zeros(k),
             )
         n_jerk = 2 * k
-    n_nonneg = 2 * (n - 1) + m + n_jerk
+    n_nonneg = 2 * (n - 1) + m + n_lower + n_jerk
     # Second-order cones, interleaved per node: (w+1, 2z, w-1) and (t+z, t-z, 2 sqrt(τ)).
     j = np.arange(m)
     wc, tc, zc = iw + interior, it + j, iz + j

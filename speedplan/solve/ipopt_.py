@@ -72,9 +72,12 @@ def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
     try:
         solver = ca.nlpsol("refine", "ipopt", nlp, {"ipopt": IPOPT_OPTIONS, "print_time": False})
         ub = problem.w_max[1:-1]
-        start = np.clip(w0[1:-1], np.minimum(wmin, ub), ub)
+        lb = np.minimum(wmin, ub)
+        if problem.w_min is not None:
+            lb = np.maximum(lb, problem.w_min[1:-1])
+        start = np.clip(w0[1:-1], lb, ub)
         sol = solver(
-            x0=start, lbx=np.minimum(wmin, ub), ubx=ub, lbg=np.concatenate(lbg),
+            x0=start, lbx=lb, ubx=ub, lbg=np.concatenate(lbg),
             ubg=np.concatenate(ubg),
         )
     except RuntimeError as exc:

@@ -79,6 +79,21 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
             constraint="decel",
             s=float(s[j]),
         )
+    if problem.has_lower_bounds:
+        assert problem.w_min is not None
+        short = problem.w_min - max_feasible_w(problem)
+        if (short > tol).any():
+            j = int(np.argmax(short > tol))
+            # The bound ahead that the braking from node j cannot reach in time.
+            c = np.concatenate(([0.0], np.cumsum(problem.decel * problem.h)))
+            k = j + int(np.argmin(problem.w_max[j:] + c[j:]))
+            raise InfeasibleError(
+                f"cannot slow down in time for the bound w_max={problem.w_max[k]:.6g} at "
+                f"s={s[k]:.6g}{units}: the slowest jerk-limited motion still has "
+                f"w={problem.w_min[j]:.6g} at s={s[j]:.6g}{units}",
+                constraint="jerk",
+                s=float(s[k]),
+            )
     acc_h = problem.accel * problem.h
     c = np.concatenate(([0.0], np.cumsum(acc_h)))
     reach_fwd = problem.w_max.copy()

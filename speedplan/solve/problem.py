@@ -46,6 +46,10 @@ class DiscreteProblem:
         Bounds ``J_i`` on ``|w''_i| sqrt(w_i)``; ``inf`` drops the row.
     w_start, w_end : float
         Fixed boundary values of ``w``.
+    w_min : ndarray, shape (n,), optional
+        Lower bounds on ``w`` (e.g. a jerk-limited vehicle leaving a moving state cannot
+        slow down faster than its envelope). Lower bounds can make the relaxation inexact
+        (the paper's Section 5.1); the refinement then applies.
     """
 
     s: FloatArray
@@ -55,6 +59,7 @@ class DiscreteProblem:
     jerk: FloatArray
     w_start: float = 0.0
     w_end: float = 0.0
+    w_min: FloatArray | None = None
 
     @property
     def n(self) -> int:
@@ -76,6 +81,11 @@ class DiscreteProblem:
         """Whether the grid is uniform (to rounding)."""
         h = self.h
         return bool(np.ptp(h) <= 1e-9 * h.mean())
+
+    @cached_property
+    def has_lower_bounds(self) -> bool:
+        """Whether some interior node has a positive lower bound."""
+        return self.w_min is not None and bool((self.w_min[1:-1] > 0).any())
 
     @cached_property
     def has_jerk(self) -> bool:
@@ -135,6 +145,7 @@ class DiscreteProblem:
             np.max(-dw - self.decel * self.h, initial=0.0),
             np.max(w - self.w_max, initial=0.0),
             np.max(-w, initial=0.0),
+            np.max(self.w_min - w, initial=0.0) if self.w_min is not None else 0.0,
             abs(w[0] - self.w_start),
             abs(w[-1] - self.w_end),
         )
@@ -148,6 +159,8 @@ class DiscreteProblem:
         """
         if not self.has_jerk or self.n < 3:
             return True
+        if self.has_lower_bounds:
+            return False  # the corollary assumes no lower bounds (paper, Section 5.1)
         constant = (
             self.uniform
             and np.ptp(self.accel) == 0
@@ -181,4 +194,5 @@ class DiscreteProblem:
             jerk=self.jerk / j_scale,
             w_start=self.w_start / w_scale,
             w_end=self.w_end / w_scale,
+            w_min=None if self.w_min is None else self.w_min / w_scale,
         )
