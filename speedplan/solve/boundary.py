@@ -71,8 +71,10 @@ def max_jerk_envelope(d: FloatArray, v: float, a: float, j_max: float) -> FloatA
 
 
 def jerk_motion_w(d: FloatArray, v: float, a: float, jerk: float, a_limit: float) -> FloatArray:
-    """``w = v²`` at distance ``d`` along a motion with constant ``jerk`` until the acceleration
-    reaches ``a_limit``, constant acceleration afterwards; 0 once the motion has stopped.
+    """Squared speed at distance ``d`` along a jerk-then-constant-acceleration motion.
+
+    The motion leaves ``(v, a)`` with constant ``jerk`` until the acceleration reaches
+    ``a_limit``, then keeps that acceleration; ``w`` is 0 once the motion has stopped.
 
     With ``jerk = -j_max``, ``a_limit = -a_decel`` and ``a <= 0`` this is the slowest a
     jerk-limited vehicle leaving ``(v, a)`` can be at each distance: a valid lower bound on
