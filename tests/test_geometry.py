@@ -1,184 +1,224 @@
-"""Geometry layer: closed forms, G1 continuity, arc-length parametrisation, bad input."""
+"""Geometry layer, primitives and Path: closed forms, G1 joints, domain, pickling."""
 
 from __future__ import annotations
 
-import re
+import pickle
 
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
-from hypothesis import strategies as st
 from scipy.integrate import quad
+from scipy.special import fresnel
 
-from speedplan import InvalidInputError, Limits, Path, SpeedZone, speed_bounds
-from speedplan.geometry import Arc, Clothoid, Line, zone_intervals
-from speedplan.geometry.fitting import fit_clothoid
+from speedplan import InvalidInputError, Path
+from speedplan.geometry import Arc, Clothoid, Line, PathSamples
 
-LIM = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+TWO_PI = 2 * np.pi
 
 
-def test_primitive_lengths_curvatures_and_end_points_match_closed_forms():
-    R, ang = 3.0, 2.0
-    p = Path.from_segments([Line(5.0), Arc(R, ang), Clothoid(4.0, 1 / R, -0.2)])
-    assert p.length == pytest.approx(5.0 + R * ang + 4.0, rel=1e-12)
-    assert p.curvature(5.0 + 1.0) == pytest.approx(1 / R, rel=1e-12)
-    # The arc ends at the centre + R (sin, -cos) rotated by the angle turned.
-    end_arc = p.point(5.0 + R * ang)
-    centre = np.array([5.0, R])
-    assert end_arc == pytest.approx(centre + R * np.array([np.sin(ang), -np.cos(ang)]), abs=1e-12)
-    # Clothoid: curvature linear in s, end point equal to an independent quadrature.
-    s = 5.0 + R * ang + np.linspace(0, 4, 9)
-    assert p.curvature(s) == pytest.approx(1 / R + (-0.2 - 1 / R) * np.linspace(0, 1, 9),
-                                           abs=1e-12)
-    th0 = ang
+def clothoid_end_by_quad(theta0, length, k0, k1):
+    """Independent end point: adaptive quadrature of cos/sin of the quadratic heading."""
+    c = (k1 - k0) / length
 
     def theta(u):
-        return th0 + u / R + 0.5 * (-0.2 - 1 / R) * u * u / 4.0
+        return theta0 + k0 * u + 0.5 * c * u * u
 
-    x = quad(lambda u: np.cos(theta(u)), 0, 4, epsabs=1e-13, epsrel=1e-13)[0]
-    y = quad(lambda u: np.sin(theta(u)), 0, 4, epsabs=1e-13, epsrel=1e-13)[0]
-    assert p.point(p.length) == pytest.approx(end_arc + np.array([x, y]), abs=1e-11)
-
-
-def test_heading_is_continuous_across_g1_joints():
-    p = Path.from_segments([Line(1.0), Clothoid(2.0, 0.0, 0.5), Arc(2.0, 1.0),
-                            Clothoid(2.0, 0.5, 0.0)])
-    for joint in p.offsets[1:-1]:
-        before, after = p.heading(joint - 1e-12), p.heading(joint + 1e-12)
-        assert abs(after - before) < 1e-9
+    opts = {"epsabs": 1e-11, "epsrel": 1e-12, "limit": 1000}
+    x = quad(lambda u: np.cos(theta(u)), 0, length, **opts)[0]
+    y = quad(lambda u: np.sin(theta(u)), 0, length, **opts)[0]
+    return np.array([x, y])
 
 
-def test_clothoid_chain_passes_through_every_waypoint_g1():
-    pts = np.array([[0, 0], [10, 0], [14, 4], [14, 12], [8, 16]], dtype=float)
-    p = Path.from_waypoints(pts)
-    assert p.point(p.offsets) == pytest.approx(pts, abs=1e-9)
-    for joint in p.offsets[1:-1]:
-        jump = p.heading(joint + 1e-12) - p.heading(joint - 1e-12)
-        assert abs(np.angle(np.exp(1j * jump))) < 1e-9
+def test_line_is_exact():
+    p = Path.from_segments([Line(7.5)], start=(1.0, -2.0), heading=np.pi / 6)
+    s = np.linspace(0, 7.5, 11)
+    expected = np.array([1.0, -2.0]) + s[:, None] * [np.cos(np.pi / 6), np.sin(np.pi / 6)]
+    assert p.length == 7.5
+    np.testing.assert_allclose(p.point(s), expected, rtol=0, atol=1e-14)
+    assert (p.curvature(s) == 0).all() and np.allclose(p.heading(s), np.pi / 6, atol=0)
 
 
-def test_g1_hermite_clothoid_hits_the_target_pose():
-    piece = fit_clothoid(np.array([1.0, 2.0]), 0.3, np.array([6.0, 4.0]), 1.4)
-    assert piece.point(np.array(piece.length)) == pytest.approx([6.0, 4.0], abs=1e-10)
-    assert float(piece.heading(np.array(piece.length))) == pytest.approx(1.4, abs=1e-12)
-
-
-def test_spline_is_parametrised_by_true_arc_length():
-    from scipy.interpolate import CubicSpline
-
-    pts = np.array([[0, 0], [3, 1], [5, 4], [9, 5]], dtype=float)
-    p = Path.from_waypoints(pts, kind="spline")
-    tau = np.concatenate(([0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
-    cs = CubicSpline(tau, pts)
-    ref = quad(lambda t: float(np.linalg.norm(cs(t, 1))), 0, tau[-1], points=tau[1:-1],
-               epsabs=1e-13, epsrel=1e-13)[0]
-    assert p.length == pytest.approx(ref, abs=1e-6)
-    s = np.linspace(0, p.length, 401)
-    speed = np.linalg.norm(np.diff(p.point(s), axis=0), axis=1) / np.diff(s)
-    assert speed == pytest.approx(1.0, abs=1e-4)  # chord/arc ratio over a 2.5 cm step
-
-
-def _de_boor(k, t, c, x):
-    """Independent de Boor evaluation of a B-spline (for the NURBS test)."""
-    j = np.searchsorted(t, x, side="right") - 1
-    j = min(max(j, k), len(c) - 1)
-    d = [c[j + r - k].copy() for r in range(k + 1)]
-    for r in range(1, k + 1):
-        for i in range(k, r - 1, -1):
-            alpha = (x - t[i + j - k]) / (t[i + 1 + j - r] - t[i + j - k])
-            d[i] = (1 - alpha) * d[i - 1] + alpha * d[i]
-    return d[k]
-
-
-def test_nurbs_points_equal_independent_de_boor():
-    k, knots = 3, np.array([0, 0, 0, 0, 0.4, 0.7, 1, 1, 1, 1], dtype=float)
-    ctrl = np.array([[0, 0], [3, 0], [6, 0.5], [8, 2.5], [9, 5], [9, 8]], dtype=float)
-    w = np.array([1, 1, 1.2, 1, 1, 1.0])
-    p = Path.from_nurbs(k, knots, ctrl, w)
-    piece = p.pieces[0]
-    for u in np.linspace(0, p.length, 13):
-        tau = float(piece.parameter(np.array([u]))[0])
-        h = _de_boor(k, knots, np.column_stack((ctrl * w[:, None], w)), min(tau, 1 - 1e-15))
-        assert p.point(u) == pytest.approx(h[:2] / h[2], abs=1e-9)
-    assert p.point(0.0) == pytest.approx([0, 0]) and p.point(p.length) == pytest.approx([9, 8])
-
-
-@settings(max_examples=25, deadline=None)
-@given(
-    pts=st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=2, max_size=6),
-    kind=st.sampled_from(["clothoid", "spline", "polyline"]),
-    n=st.integers(2, 300),
-)
-def test_properties_resample_unit_speed_and_reversal(pts, kind, n):
-    xy = np.array(pts)
-    legs = np.linalg.norm(np.diff(xy, axis=0), axis=1)
-    if (legs < 1.0).any():
-        return
-    turns = np.diff(np.unwrap(np.arctan2(np.diff(xy[:, 1]), np.diff(xy[:, 0]))))
-    if (np.abs(turns) > 2.5).any():
-        return
-    try:
-        p = Path.from_waypoints(xy, kind=kind)
-    except InvalidInputError:
-        return  # e.g. no clothoid with those headings: rejected with a clear message
-    samples = p.resample(n=n)
-    assert samples.s[0] == 0 and samples.s[-1] == pytest.approx(p.length)
-    assert samples.xy[0] == pytest.approx(xy[0], abs=1e-9)
-    assert samples.xy[-1] == pytest.approx(xy[-1], abs=1e-8)
-    s = np.linspace(0, p.length, 200)
-    h = 1e-4 * p.length
-    fd = np.linalg.norm(p.point(np.clip(s + h, 0, p.length)) - p.point(np.clip(s - h, 0, p.length)),
-                        axis=1) / (np.clip(s + h, 0, p.length) - np.clip(s - h, 0, p.length))
-    assert fd == pytest.approx(1.0, abs=1e-4)
-    r = p.reversed()
-    assert r.length == pytest.approx(p.length)
-    assert r.curvature(s) == pytest.approx(-p.curvature(p.length - s), abs=1e-9)
-    assert r.point(0.0) == pytest.approx(p.point(p.length), abs=1e-9)
-
-
-def test_speed_bounds_line_arc_and_zone():
-    R = 0.5
-    p = Path.from_segments([Line(10.0), Arc(R, np.pi / 2), Line(10.0)])
-    w = speed_bounds(p, LIM, [5.0, 10.0 + R, 15.0])
-    assert w == pytest.approx([4.0, 1.0 * R, 4.0])
-    zone = SpeedZone(shapely.box(3.0, -1.0, 6.0, 1.0), v_max=0.5)
-    w = speed_bounds(p, LIM, [2.9, 3.0, 4.5, 6.0, 6.1], zones=[zone])
-    assert w == pytest.approx([4.0, 0.25, 0.25, 0.25, 4.0])
-    (a, b, v), = zone_intervals(p, [zone])
-    assert (a, b, v) == (pytest.approx(3.0, abs=1e-6), pytest.approx(6.0, abs=1e-6), 0.5)
-    w = speed_bounds(p, LIM, [0.0, 5.0], v_limit=([0.0, 10.0], [1.0, 0.5]))
-    assert w == pytest.approx([1.0, 0.75**2])
-
-
-def test_linestring_round_trip():
-    ls = shapely.LineString([(0, 0), (4, 0), (4, 3)])
-    p = Path.from_linestring(ls)
-    assert p.point(0.0) == pytest.approx([0, 0]) and p.point(p.length) == pytest.approx([4, 3])
-    back = p.to_linestring(ds=0.01)
-    assert back.length == pytest.approx(p.length, rel=1e-4)
+@pytest.mark.parametrize(("R", "angle"), [(3.0, 2.0), (0.4, -5.5), (150.0, 0.01), (2.5, TWO_PI)])
+def test_arc_length_curvature_and_points_match_the_circle(R, angle):
+    p = Path.from_segments([Arc(R, angle)], start=(1.0, 2.0), heading=0.3)
+    assert p.length == pytest.approx(R * abs(angle), rel=1e-12)
+    s = np.linspace(0, p.length, 57)
+    np.testing.assert_allclose(p.curvature(s), np.sign(angle) / R, rtol=1e-12)
+    np.testing.assert_allclose(p.heading(s), 0.3 + np.sign(angle) * s / R, atol=1e-12)
+    # Every point lies on the circle through the start whose centre is R to the turning side.
+    normal = np.sign(angle) * np.array([-np.sin(0.3), np.cos(0.3)])
+    centre = np.array([1.0, 2.0]) + R * normal
+    radius = np.linalg.norm(p.point(s) - centre, axis=1)
+    np.testing.assert_allclose(radius, R, rtol=1e-12)
+    phi = 0.3 + angle - np.sign(angle) * np.pi / 2
+    end = centre + R * np.array([np.cos(phi), np.sin(phi)])
+    np.testing.assert_allclose(p.point(p.length), end, atol=1e-11 * max(R, 1))
 
 
 @pytest.mark.parametrize(
-    ("call", "name"),
+    ("theta0", "length", "k0", "k1"),
     [
-        (lambda: Path.from_waypoints([[0, 0], [np.nan, 1]]), "xy"),
-        (lambda: Path.from_waypoints([[0, 0]]), "xy"),
-        (lambda: Path.from_waypoints([[1, 1], [1, 1]]), "xy"),
-        (lambda: Path.from_waypoints([[0, 0], [1, 0], [1, 0], [2, 0]]), "xy"),
-        (lambda: Path.from_waypoints(np.zeros((3, 3))), "xy"),
-        (lambda: Path.from_waypoints([[0, 0], [1, 0]], kind="bezier"), "kind"),
-        (lambda: Path.from_waypoints([[0, 0], [2, 0], [0, 0]], kind="polyline"), "xy"),
-        (lambda: Path.from_segments([Line(-1.0)]), "segments[0].length"),
-        (lambda: Path.from_segments([Arc(-2.0, 1.0)]), "segments[0].radius"),
-        (lambda: Path.from_segments([{"type": "spiral", "length": 1}]), "segments[0]"),
-        (lambda: Path.from_segments([]), "segments"),
-        (lambda: Path.from_nurbs(2, [0, 0, 1, 0.5, 1, 1], [[0, 0], [1, 1], [2, 0]]), "knots"),
-        (lambda: Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[0, 0], [1, 1], [2, 0]], [1, -1, 1]),
-         "weights"),
-        (lambda: Path.from_segments([Line(1.0)]).point(np.nan), "s"),
+        (0.0, 4.0, 0.0, 0.5),         # standard clothoid
+        (1.0, 6.0, 1 / 3, -0.2),      # k0 != 0, sign change
+        (-2.0, 10.0, 0.0, 5.0),       # tight: turns 25 rad
+        (0.5, 20.0, 0.1, 0.1 + 1e-13),  # near-zero sharpness: an arc to rounding
+        (0.0, 80.0, -0.01, 0.002),    # long and gentle, road-like
     ],
 )
-def test_bad_input_names_the_argument(call, name):
-    with pytest.raises(InvalidInputError, match=re.escape(f"`{name}")):
-        call()
+def test_clothoid_matches_independent_quadrature(theta0, length, k0, k1):
+    p = Path.from_segments([Clothoid(length, k0, k1)], heading=theta0)
+    assert p.length == pytest.approx(length, rel=1e-12)
+    s = np.linspace(0, length, 41)
+    np.testing.assert_allclose(p.curvature(s), k0 + (k1 - k0) * s / length, atol=1e-12)
+    np.testing.assert_allclose(
+        p.heading(s), theta0 + k0 * s + 0.5 * (k1 - k0) / length * s**2, atol=1e-12
+    )
+    end = clothoid_end_by_quad(theta0, length, k0, k1)
+    np.testing.assert_allclose(p.point(length), end, rtol=0, atol=1e-9 * length)
+    mid = clothoid_end_by_quad(theta0, length / 3, k0, k0 + (k1 - k0) / 3)
+    np.testing.assert_allclose(p.point(length / 3), mid, rtol=0, atol=1e-9 * length)
+
+
+def test_standard_clothoid_equals_scipy_fresnel_closed_form():
+    c = 0.7  # sharpness [1/m²]: heading c s² / 2
+    L = 5.0
+    p = Path.from_segments([Clothoid(L, 0.0, c * L)])
+    s = np.linspace(0, L, 23)
+    S, C = fresnel(s * np.sqrt(c / np.pi))
+    expected = np.sqrt(np.pi / c) * np.column_stack((C, S))
+    np.testing.assert_allclose(p.point(s), expected, rtol=0, atol=1e-12)
+
+
+def test_segments_are_g1_and_lengths_add_up():
+    segs = [Line(1.0), Clothoid(2.0, 0.0, 0.5), Arc(2.0, 1.0), Clothoid(2.0, 0.5, -0.3),
+            Arc(4.0, -0.7), Line(3.0)]
+    p = Path.from_segments(segs, start=(3, 4), heading=-1.0)
+    assert p.length == pytest.approx(1 + 2 + 2 + 2 + 4 * 0.7 + 3, rel=1e-12)
+    joints = p.offsets[1:-1]
+    eps = 1e-10
+    jump_heading = p.heading(joints + eps) - p.heading(joints - eps)
+    jump_point = np.linalg.norm(p.point(joints + eps) - p.point(joints - eps), axis=1)
+    assert np.abs(jump_heading).max() < 1e-9
+    assert jump_point.max() < 1e-9
+    # Each piece's start pose equals the previous piece's end pose exactly (by construction).
+    for prev, nxt in zip(p.pieces[:-1], p.pieces[1:], strict=True):
+        end, theta = prev.end
+        assert np.allclose(nxt.start, end, rtol=0, atol=1e-12) and nxt.theta0 == theta
+
+
+def test_dict_segments_equal_dataclass_segments():
+    a = Path.from_segments([Line(2.0), Arc(1.5, -1.0), Clothoid(3.0, 0.2, 0.0)])
+    b = Path.from_segments([{"type": "line", "length": 2.0},
+                            {"type": "arc", "radius": 1.5, "angle": -1.0},
+                            {"type": "clothoid", "length": 3.0, "k0": 0.2, "k1": 0.0}])
+    s = np.linspace(0, a.length, 50)
+    np.testing.assert_array_equal(a.point(s), b.point(s))
+
+
+def test_heading_is_continuous_beyond_pi_and_closed_loops_are_detected():
+    circle = Path.from_segments([Arc(2.0, TWO_PI)])
+    s = np.linspace(0, circle.length, 1001)
+    assert (np.diff(circle.heading(s)) > 0).all()
+    assert circle.heading(circle.length) == pytest.approx(TWO_PI, abs=1e-12)
+    assert circle.is_closed
+    assert not Path.from_segments([Arc(2.0, np.pi)]).is_closed
+
+
+def test_out_of_range_s_raises_but_rounding_is_clipped():
+    p = Path.from_segments([Line(10.0)])
+    assert p.point(10.0 + 1e-9).tolist() == [10.0, 0.0]  # 1e-10 * length: rounding, clipped
+    assert p.point(-5e-9).tolist() == [0.0, 0.0]
+    for bad in (10.001, -0.001, [0.0, 11.0]):
+        with pytest.raises(InvalidInputError, match="`s`"):
+            p.point(bad)
+    with pytest.raises(InvalidInputError, match="`s`"):
+        p.curvature(np.inf)
+
+
+def test_vectorised_shapes_and_evaluate_agree_with_separate_calls():
+    p = Path.from_waypoints([[0, 0], [4, 1], [7, 5], [12, 5]], kind="spline")
+    s = np.linspace(0, p.length, 12).reshape(3, 4)
+    xy, th, k = p.evaluate(s)
+    assert xy.shape == (3, 4, 2) and th.shape == (3, 4) and k.shape == (3, 4)
+    np.testing.assert_array_equal(xy, p.point(s))
+    np.testing.assert_array_equal(th, p.heading(s))
+    np.testing.assert_array_equal(k, p.curvature(s))
+    assert p.point(1.0).shape == (2,) and p.heading(1.0).shape == ()
+
+
+def test_resample_grid_and_sample_values():
+    p = Path.from_segments([Line(3.0), Arc(1.0, 1.0)])
+    smp = p.resample(ds=0.3)
+    assert isinstance(smp, PathSamples)
+    assert smp.s[0] == 0.0 and smp.s[-1] == p.length
+    assert np.diff(smp.s).max() <= 0.3 + 1e-15
+    np.testing.assert_allclose(np.diff(smp.s), np.diff(smp.s)[0], rtol=1e-12)
+    np.testing.assert_array_equal(smp.xy, p.point(smp.s))
+    np.testing.assert_array_equal(smp.curvature, p.curvature(smp.s))
+    assert p.resample(n=7).s.size == 7
+    assert p.resample(ds=p.length).s.tolist() == [0.0, p.length]
+    with pytest.raises(InvalidInputError, match="exactly one"):
+        p.resample()
+    with pytest.raises(InvalidInputError, match="exactly one"):
+        p.resample(n=3, ds=0.1)
+    with pytest.raises(InvalidInputError, match="`n`"):
+        p.resample(n=1)
+    with pytest.raises(InvalidInputError, match="`ds`"):
+        p.resample(ds=-1.0)
+
+
+def test_reversed_mirrors_point_heading_and_curvature():
+    p = Path.from_segments([Line(2.0), Clothoid(3.0, 0.0, 0.6), Arc(5 / 3, -2.0)])
+    r = p.reversed()
+    s = np.linspace(0, p.length, 101)
+    # At a joint with a curvature jump each path returns its following piece's value, i.e.
+    # the other one-sided limit: compare away from joints.
+    s = s[np.abs(s[:, None] - (p.length - p.offsets)[None, :]).min(axis=1) > 1e-9]
+    np.testing.assert_allclose(r.point(s), p.point(p.length - s), atol=1e-12)
+    np.testing.assert_allclose(r.curvature(s), -p.curvature(p.length - s), atol=1e-12)
+    dh = r.heading(s) - p.heading(p.length - s) - np.pi
+    np.testing.assert_allclose(np.angle(np.exp(1j * dh)), 0.0, atol=1e-12)
+    twice = r.reversed()
+    np.testing.assert_allclose(twice.point(s), p.point(s), atol=1e-12)
+
+
+def test_linestring_round_trip_keeps_vertices():
+    ls = shapely.LineString([(0, 0), (4, 0), (4, 3)])
+    p = Path.from_linestring(ls, max_deviation=0.1)
+    assert p.point(0.0).tolist() == [0.0, 0.0]
+    np.testing.assert_allclose(p.point(p.length), [4, 3], atol=1e-12)
+    back = p.to_linestring(ds=0.01)
+    assert back.length == pytest.approx(p.length, rel=1e-5)  # chords on the arc
+    assert back.hausdorff_distance(ls) == pytest.approx(0.1, rel=1e-3)  # the corner arc
+    # Piece joints are vertices of the exported LineString (exact polylines stay exact).
+    joints = shapely.points(p.point(p.offsets))
+    assert shapely.distance(back, joints).max() < 1e-12
+    assert Path.from_linestring(ls, kind="clothoid").point(p.offsets[:1]).shape == (1, 2)
+    z = shapely.LineString([(0, 0, 5), (3, 4, 6)])
+    assert Path.from_linestring(z).length == pytest.approx(5.0, rel=1e-15)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: Path.from_segments([Line(2.0), Arc(1.0, 1.0), Clothoid(1.0, 1.0, 0.0)]),
+        lambda: Path.from_waypoints([[0, 0], [3, 1], [5, 4]], kind="spline"),
+        lambda: Path.from_waypoints([[0, 0], [3, 1], [5, 4]]),
+        lambda: Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[0, 0], [1, 1], [2, 0]], [1, 2, 1]),
+        lambda: Path.from_waypoints([[0, 0], [3, 1], [5, 4]], kind="spline").reversed(),
+    ],
+)
+def test_paths_pickle(make):
+    """plan_many ships paths to worker processes."""
+    p = make()
+    q = pickle.loads(pickle.dumps(p))
+    s = np.linspace(0, p.length, 9)
+    np.testing.assert_array_equal(q.point(s), p.point(s))
+    np.testing.assert_array_equal(q.curvature(s), p.curvature(s))
+
+
+def test_path_is_immutable_and_has_a_short_repr():
+    p = Path.from_segments([Line(2.0)])
+    with pytest.raises(AttributeError):
+        p.pieces = ()  # type: ignore[misc]
+    assert repr(p) == "Path(length=2 m, pieces=1, closed=False)"

@@ -1,4 +1,20 @@
-"""Geometry: arc-length parametrised paths, their constructors and speed bounds."""
+"""Geometry: arc-length parametrised paths, their constructors and speed bounds.
+
+Modules, one job each:
+
+* :mod:`~speedplan.geometry.path` — :class:`Path` (immutable chain of pieces, vectorised
+  ``point``/``heading``/``curvature`` over ``s``) and :class:`PathSamples`;
+* :mod:`~speedplan.geometry.primitives` — :class:`Line`, :class:`Arc`, :class:`Clothoid` and
+  their exact evaluation;
+* :mod:`~speedplan.geometry.pieces` — the piece interface and arc-length reparametrisation of
+  parametric curves;
+* :mod:`~speedplan.geometry.fitting` — waypoints to G1 clothoid chain, spline or polyline;
+* :mod:`~speedplan.geometry.nurbs` — NURBS (VDA 5050 ``trajectory``);
+* :mod:`~speedplan.geometry.bounds` — :func:`speed_bounds` ``mu+(s)``, :class:`SpeedZone`,
+  :func:`zone_intervals`.
+
+This layer imports only ``errors``, ``_checks`` and ``limits``.
+"""
 
 from .bounds import SpeedZone, speed_bounds, zone_intervals
 from .path import Arc, Clothoid, Line, Path, PathSamples

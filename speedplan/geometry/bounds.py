@@ -19,7 +19,15 @@ __all__ = ["SpeedZone", "speed_bounds", "zone_intervals"]
 
 @dataclass(frozen=True)
 class SpeedZone:
-    """A polygon (shapely ``Polygon`` or a list of ``(x, y)`` vertices) with its speed limit.
+    """A region with its own speed limit.
+
+    Parameters
+    ----------
+    polygon : shapely.Polygon or array_like, shape (m, 2)
+        The region (vertices [m], m >= 3, when not a Polygon); must be valid with positive
+        area. Points on its boundary count as inside.
+    v_max : float
+        Speed limit inside [m/s], >= 0.
 
     Examples
     --------
@@ -38,12 +46,15 @@ class SpeedZone:
             pts = as_array("polygon", poly)
             if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 3:
                 raise InvalidInputError(
-                    f"`polygon` must be a shapely Polygon or (m, 2) vertices with m >= 3; "
+                    "`polygon` must be a shapely Polygon or (m, 2) vertices with m >= 3; "
                     f"got shape {pts.shape}"
                 )
             poly = shapely.Polygon(pts)
-        if not poly.is_valid or poly.area <= 0:
-            raise InvalidInputError("`polygon` must be a valid polygon with positive area")
+        if poly.is_empty or not poly.is_valid or not poly.area > 0:
+            raise InvalidInputError(
+                "`polygon` must be a valid polygon with positive area (no self-intersections)"
+            )
+        shapely.prepare(poly)  # speeds up the vectorised point-in-polygon tests
         object.__setattr__(self, "polygon", poly)
         object.__setattr__(self, "v_max", as_scalar("v_max", self.v_max, nonnegative=True))
 
@@ -56,81 +67,152 @@ def speed_bounds(
     zones: Sequence[SpeedZone] | None = None,
     v_limit: Any = None,
 ) -> FloatArray:
-    """Upper bound ``mu+(s)`` on ``w = v²`` [m²/s²] at arc lengths ``s``.
+    """Upper bound ``mu+(s)`` on ``w = v²`` [m²/s²] at arc lengths ``s`` [m].
 
-    ``min(v_max², a_lat_max / |k(s)|)``, further limited to ``zone.v_max²`` where the path point
-    lies inside or on the boundary of a zone, and by ``v_limit = (s_knots, v_knots)``: a
-    per-position speed limit interpolated linearly in ``s`` (held constant beyond its ends).
+    ``mu+(s) = min(v_max², a_lat_max / |k(s)|)``; where ``a_lat_max`` is ``inf`` or the
+    curvature is 0 there is no lateral bound. It is further lowered to ``zone.v_max²`` wherever
+    the path point lies inside or on the boundary of a zone's polygon, and by ``v_limit``.
+
+    Parameters
+    ----------
+    path : Path
+        The path.
+    limits : Limits
+        Uses ``v_max`` [m/s] and ``a_lat_max`` [m/s²].
+    s : array_like
+        Arc lengths [m] in ``[0, path.length]``.
+    zones : sequence of SpeedZone, optional
+        Speed-limit regions (inside or on the boundary counts).
+    v_limit : (s_knots, v_knots), optional
+        Per-position speed limit [m, m/s]: ``s_knots`` strictly increasing, ``v_knots >= 0``
+        (``inf`` allowed). **Piecewise linear** in ``s`` between knots and held constant beyond
+        the ends (``numpy.interp``); for a step, repeat the position with a tiny offset. Linear
+        because a limit sampled from another profile (a previous plan, a sensor map) is then
+        reproduced without staircase artefacts.
+
+    Returns
+    -------
+    ndarray
+        ``mu+(s)``, same shape as ``s`` [m²/s²].
 
     Examples
     --------
     >>> import numpy as np
     >>> from speedplan import Limits, Path
-    >>> from speedplan.geometry import Arc, speed_bounds
-    >>> arc = Path.from_segments([Arc(radius=2.0, angle=np.pi)])
-    >>> speed_bounds(arc, Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5), [0.0, 3.0]).tolist()
-    [2.0, 2.0]
+    >>> from speedplan.geometry import Arc, Line, speed_bounds
+    >>> lim = Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
+    >>> p = Path.from_segments([Line(5.0), Arc(radius=2.0, angle=np.pi)])
+    >>> speed_bounds(p, lim, [1.0, 6.0]).tolist()      # v_max², then a_lat_max * R
+    [4.0, 2.0]
+    >>> speed_bounds(p, lim, [1.0, 4.0], v_limit=([0.0, 5.0], [1.0, 0.0])).round(12).tolist()
+    [0.64, 0.04]
     """
+    if not isinstance(path, Path):
+        raise InvalidInputError(f"`path` must be a speedplan.Path; got {type(path).__name__}")
+    if not isinstance(limits, Limits):
+        raise InvalidInputError(f"`limits` must be a speedplan.Limits; got {type(limits).__name__}")
+    zone_list = _check_zones(zones)
     q = as_array("s", s)
     w = np.full(q.shape, limits.v_max**2)
-    kappa = np.abs(path.curvature(q))
+    kappa = np.abs(path.curvature(q))  # also checks that s lies on the path
     if np.isfinite(limits.a_lat_max):
         with np.errstate(divide="ignore"):
             w = np.minimum(w, np.where(kappa > 0, limits.a_lat_max / kappa, np.inf))
-    if zones:
+    if zone_list:
         xy = path.point(q)
-        for zone in zones:
+        for zone in zone_list:
             inside = shapely.intersects_xy(zone.polygon, xy[..., 0], xy[..., 1])
             w = np.where(inside, np.minimum(w, zone.v_max**2), w)
     if v_limit is not None:
-        try:
-            sk, vk = v_limit
-        except (TypeError, ValueError) as exc:
-            raise InvalidInputError("`v_limit` must be a pair (s_knots, v_knots)") from exc
-        sk = as_array("v_limit[0]", sk, ndim=1)
-        vk = as_array("v_limit[1]", vk, ndim=1, length=sk.size, allow_inf=True)
-        if (np.diff(sk) <= 0).any() or (vk < 0).any():
-            raise InvalidInputError("`v_limit` needs increasing s knots and non-negative speeds")
-        w = np.minimum(w, np.interp(q, sk, vk) ** 2)
+        sk, vk = _check_v_limit(v_limit)
+        v = np.interp(q, sk, vk)
+        w = np.minimum(w, np.where(np.isnan(v), np.inf, v) ** 2)  # inf knots may give inf*0
     return w
 
 
-def zone_intervals(path: Path, zones: Sequence[SpeedZone], *, tol: float = 1e-9
-                   ) -> list[tuple[float, float, float]]:
+def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:
+    try:
+        sk, vk = v_limit
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(
+            "`v_limit` must be a pair (s_knots, v_knots) of 1-D arrays"
+        ) from exc
+    sk = as_array("v_limit[0]", sk, ndim=1)
+    vk = as_array("v_limit[1]", vk, ndim=1, length=sk.size, allow_inf=True)
+    if sk.size == 0:
+        raise InvalidInputError("`v_limit` is empty; pass at least one knot")
+    if (np.diff(sk) <= 0).any():
+        raise InvalidInputError("`v_limit[0]` (s knots) must be strictly increasing")
+    if (vk < 0).any():
+        raise InvalidInputError("`v_limit[1]` (speeds) must be >= 0")
+    return sk, vk
+
+
+def zone_intervals(
+    path: Path, zones: Sequence[SpeedZone], *, tol: float = 1e-9
+) -> list[tuple[float, float, float]]:
     """Where the path is inside each zone: ``[(s_enter, s_exit, v_max), ...]`` sorted by entry.
 
-    Entry and exit are located by bisection to ``tol`` metres.
+    A point on the polygon boundary counts as inside. Membership is scanned on a grid of
+    spacing ``max(0.01 m, length / 200000)``; every change is then located by bisection to
+    ``tol`` metres (excursions shorter than the grid spacing may be missed). A path starting
+    (ending) inside a zone enters at 0 (leaves at ``length``).
+
+    Parameters
+    ----------
+    path : Path
+        The path.
+    zones : sequence of SpeedZone
+        Speed-limit regions.
+    tol : float
+        Accuracy of the entry and exit positions [m].
+
+    Examples
+    --------
+    >>> import shapely
+    >>> from speedplan.geometry import Line, Path, SpeedZone, zone_intervals
+    >>> p = Path.from_segments([Line(10.0)])
+    >>> [(round(a, 9), round(b, 9), v) for a, b, v in
+    ...  zone_intervals(p, [SpeedZone(shapely.box(2, -1, 5, 1), 0.5)])]
+    [(2.0, 5.0, 0.5)]
     """
-    n = max(2001, int(path.length / 0.01) + 1)
-    s = np.linspace(0.0, path.length, min(n, 200_001))
+    zone_list = _check_zones(zones)
+    tol = as_scalar("tol", tol, positive=True)
+    L = path.length
+    s = np.linspace(0.0, L, int(np.clip(np.ceil(L / 0.01), 2000, 200_000)) + 1)
     xy = path.point(s)
     out: list[tuple[float, float, float]] = []
-
-    def inside(zone: SpeedZone, q: FloatArray) -> FloatArray:
-        p = path.point(q)
-        out_: FloatArray = shapely.intersects_xy(zone.polygon, p[..., 0], p[..., 1])
-        return out_
-
-    def refine(zone: SpeedZone, a: float, b: float, entering: bool) -> float:
-        while b - a > tol:
+    for zone in zone_list:
+        flags = shapely.intersects_xy(zone.polygon, xy[:, 0], xy[:, 1])
+        change = np.flatnonzero(flags[1:] != flags[:-1])
+        # Bisect every bracket at once; invariant: flags at a differ from flags at b.
+        a, b = s[change], s[change + 1]
+        entering = flags[change + 1]
+        for _ in range(int(np.ceil(np.log2(max(s[1], tol) / tol))) + 1):
+            if a.size == 0:
+                break
             mid = 0.5 * (a + b)
-            if bool(inside(zone, np.array(mid))) == entering:
-                b = mid
-            else:
-                a = mid
-        return b if entering else a
-
-    for zone in zones:
-        flags = shapely.intersects_xy(zone.polygon, xy[:, 0], xy[:, 1]).astype(int)
-        change = np.flatnonzero(np.diff(flags))
-        enter = [0.0] if flags[0] else []
-        exits: list[float] = []
-        for i in change:
-            if flags[i + 1]:
-                enter.append(refine(zone, s[i], s[i + 1], True))
-            else:
-                exits.append(refine(zone, s[i], s[i + 1], False))
-        if flags[-1]:
-            exits.append(path.length)
-        out.extend((a, b, zone.v_max) for a, b in zip(enter, exits, strict=True))
+            p = path.point(mid)
+            inside = shapely.intersects_xy(zone.polygon, p[:, 0], p[:, 1])
+            to_b = inside == entering  # mid already has the state after the crossing
+            b = np.where(to_b, mid, b)
+            a = np.where(to_b, a, mid)
+        enters = list(b[entering]) if flags[0] == 0 else [0.0, *b[entering]]
+        exits = list(a[~entering]) + ([L] if flags[-1] else [])
+        out.extend((float(e), float(x), zone.v_max) for e, x in zip(enters, exits, strict=True))
     return sorted(out)
+
+
+def _check_zones(zones: Any) -> list[SpeedZone]:
+    if zones is None:
+        return []
+    try:
+        zone_list = list(zones)
+    except TypeError as exc:
+        raise InvalidInputError(
+            f"`zones` must be a sequence of SpeedZone; got {type(zones).__name__}"
+        ) from exc
+    for i, z in enumerate(zone_list):
+        if not isinstance(z, SpeedZone):
+            raise InvalidInputError(f"`zones[{i}]` must be a SpeedZone; got {type(z).__name__}")
+    return zone_list

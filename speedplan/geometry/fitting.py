@@ -1,7 +1,8 @@
-"""Paths through waypoints: polyline with rounded corners, arc-length cubic spline, G1 clothoids."""
+"""Paths through waypoints: G1 clothoid chain, arc-length cubic spline, rounded polyline."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -9,165 +10,272 @@ from scipy.interpolate import CubicSpline
 
 from .._checks import FloatArray, as_array, as_scalar, choice
 from ..errors import InvalidInputError
-from .pieces import ClothoidPiece, CurvePiece, Piece
+from ._checks import check_waypoints, wrap_angle
+from .pieces import CurvePiece, Piece
+from .primitives import ClothoidPiece
 
-__all__ = ["KINDS", "fit_clothoid", "fit_waypoints"]
+__all__ = ["CORNER_FRACTION", "KINDS", "SplineCurve", "clothoid_chain", "fit_clothoid",
+           "fit_waypoints", "rounded_polyline", "spline_piece"]
 
 KINDS = ("clothoid", "spline", "polyline")
-#: Default corner rounding of polylines: each corner arc starts this fraction of the shorter
-#: adjacent leg before the corner (scale-free, so millimetres and metres give the same path).
+
+#: Default polyline corner rounding: each arc starts this fraction of the shorter adjacent leg
+#: before the corner (scale-free: the same path in millimetres or in metres).
 CORNER_FRACTION = 0.25
 
-_GX, _GW = np.polynomial.legendre.leggauss(64)
-_GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW
+# Composite Gauss–Legendre rule on [0, 1] (4 cells x 24 nodes) for the generalised Fresnel
+# integrals of the G1 Hermite problem; the heading there varies by at most a few π.
+_x, _w = np.polynomial.legendre.leggauss(24)
+_T = ((np.arange(4)[:, None] + 0.5 * (_x[None, :] + 1.0)) / 4.0).ravel()
+_TW = np.tile(_w / 8.0, 4)
+del _x, _w
+
+# Bertolazzi & Frego's fitted initial guess for A (their eq. 19 coefficients).
+_CF = (2.989696028701907, 0.716228953608281, -0.458969738821509, -0.502821153340377,
+       0.261062141752652, -0.045854475238709)
 
 
-def _wrap(a: FloatArray | float) -> Any:
-    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
+def fit_clothoid(p0: Any, theta0: float, p1: Any, theta1: float) -> ClothoidPiece:
+    """The clothoid from pose ``(p0, theta0)`` to pose ``(p1, theta1)`` (G1 Hermite problem).
 
+    Bertolazzi & Frego (2015): in the chord's frame the heading over ``t ∈ [0, 1]`` is
+    ``θ(t) = φ0 + (δ - A) t + A t²`` with ``δ = φ1 - φ0``; ``A`` solves the generalised Fresnel
+    equation ``∫₀¹ sin θ(t) dt = 0`` by Newton's method from their fitted guess, then
+    ``L = |p1 - p0| / ∫₀¹ cos θ(t) dt``, ``k0 = (δ - A)/L`` and ``k1 = (δ + A)/L``.
 
-def check_waypoints(xy: Any, name: str = "xy") -> FloatArray:
-    """Validate waypoints: shape (n, 2), n >= 2, finite, no consecutive duplicates."""
-    pts = as_array(name, xy)
-    if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 2:
-        raise InvalidInputError(
-            f"`{name}` must have shape (n, 2) with n >= 2; got {pts.shape}"
-        )
-    legs = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    scale = max(float(np.ptp(pts, axis=0).max()), 1e-300)
-    if (legs <= 1e-12 * scale).any():
-        i = int(np.flatnonzero(legs <= 1e-12 * scale)[0])
-        if scale <= 1e-300 or np.all(legs <= 1e-12 * scale):
-            raise InvalidInputError(f"`{name}` needs at least two distinct points")
-        raise InvalidInputError(
-            f"`{name}` has repeated consecutive points at rows {i} and {i + 1}; remove duplicates"
-        )
-    return pts
+    Parameters
+    ----------
+    p0, p1 : array_like, shape (2,)
+        Start and end points [m], distinct.
+    theta0, theta1 : float
+        Start and end headings [rad]; the piece starts with exactly ``theta0`` and ends with
+        ``theta1`` modulo 2π.
 
+    Returns
+    -------
+    ClothoidPiece
+        Exists for every pair of headings; when both point nearly back along the chord
+        (``φ0 ≈ -φ1 ≈ ±π``) it is a long spiral (length unbounded as they reach ±π).
 
-def fit_clothoid(p0: FloatArray, theta0: float, p1: FloatArray, theta1: float) -> ClothoidPiece:
-    """The clothoid from ``(p0, theta0)`` to ``(p1, theta1)`` (G1 Hermite interpolation).
+    Raises
+    ------
+    InvalidInputError
+        Newton's iteration did not converge (not observed for headings in ``(-π, π)``).
 
-    Bertolazzi & Frego's formulation: in the frame of the chord the heading is
-    ``θ(t) = A t² + (δ - A) t + φ0`` for ``t ∈ [0, 1]``; ``A`` solves ``∫ sin θ = 0`` (Newton),
-    then ``L = |p1 - p0| / ∫ cos θ``.
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry.fitting import fit_clothoid
+    >>> c = fit_clothoid([0, 0], 0.0, [4, 2], np.pi / 2)
+    >>> c.point(np.array(c.length)).round(10).tolist(), round(float(c.heading(c.length)), 12)
+    ([4.0, 2.0], 1.570796326795)
     """
-    d = np.asarray(p1, dtype=np.float64) - np.asarray(p0, dtype=np.float64)
-    r = float(np.hypot(*d))
+    a = np.asarray(p0, dtype=np.float64)
+    d = np.asarray(p1, dtype=np.float64) - a
+    r = float(np.hypot(d[0], d[1]))
     phi = float(np.arctan2(d[1], d[0]))
-    phi0 = float(_wrap(theta0 - phi))
-    phi1 = float(_wrap(theta1 - phi))
+    phi0 = float(wrap_angle(theta0 - phi))
+    phi1 = float(wrap_angle(theta1 - phi))
+    if phi0 == 0.0 and phi1 == 0.0:  # collinear: a line, without quadrature rounding
+        return ClothoidPiece((float(a[0]), float(a[1])), float(theta0), r, 0.0, 0.0)
     delta = phi1 - phi0
-    t = _GX
-
-    def theta(A: float) -> FloatArray:
-        out: FloatArray = A * t * t + (delta - A) * t + phi0
-        return out
-
-    A = 3.0 * (phi0 + phi1)
-    for _ in range(100):
-        th = theta(A)
-        g = float(np.sin(th) @ _GW)
-        dg = float(((t * t - t) * np.cos(th)) @ _GW)
-        step = g / dg if dg != 0 else 0.0
-        A -= step
-        if abs(step) <= 1e-15 * max(1.0, abs(A)):
+    X, Y = phi0 / np.pi, phi1 / np.pi
+    xy = X * Y
+    A = (phi0 + phi1) * (_CF[0] + xy * (_CF[1] + xy * _CF[2])
+                         + (_CF[3] + xy * _CF[4]) * (X * X + Y * Y) + _CF[5] * (X**4 + Y**4))
+    converged = False
+    for _ in range(50):
+        th = phi0 + (delta - A) * _T + A * _T * _T
+        g = float(np.sin(th) @ _TW)
+        dg = float(((_T * _T - _T) * np.cos(th)) @ _TW)
+        if abs(g) <= 1e-15 or dg == 0.0:
+            converged = abs(g) <= 1e-13
             break
-    th = theta(A)
-    if abs(float(np.sin(th) @ _GW)) > 1e-12 or float(np.cos(th) @ _GW) <= 0:
+        step = g / dg
+        A -= step
+        if abs(step) <= 1e-14 * max(1.0, abs(A)):
+            converged = True
+            break
+    th = phi0 + (delta - A) * _T + A * _T * _T
+    c = float(np.cos(th) @ _TW)
+    if not converged or abs(float(np.sin(th) @ _TW)) > 1e-12 or not c > 1e-9:
         raise InvalidInputError(
-            f"no clothoid joins ({p0[0]:.6g}, {p0[1]:.6g}) to ({p1[0]:.6g}, {p1[1]:.6g}) with the "
-            "requested headings; add an intermediate waypoint"
+            f"no clothoid joins ({a[0]:.6g}, {a[1]:.6g}) with heading {theta0:.6g} rad to "
+            f"({a[0] + d[0]:.6g}, {a[1] + d[1]:.6g}) with heading {theta1:.6g} rad; change "
+            "the `headings` or add an intermediate waypoint"
         )
-    L = r / float(np.cos(th) @ _GW)
-    return ClothoidPiece((float(p0[0]), float(p0[1])), float(theta0), L, (delta - A) / L,
+    L = r / c
+    return ClothoidPiece((float(a[0]), float(a[1])), float(theta0), L, (delta - A) / L,
                          (delta + A) / L)
 
 
-def _estimate_headings(pts: FloatArray) -> FloatArray:
-    """Tangent directions of a chord-parametrised cubic spline through the points."""
+def _chord_parameter(pts: FloatArray) -> FloatArray:
+    return np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
+
+
+def _chord_spline(pts: FloatArray) -> CubicSpline:
+    """Chord-length cubic spline: periodic for closed point sets, not-a-knot otherwise."""
+    tau = _chord_parameter(pts)
     if pts.shape[0] == 2:
-        d = pts[1] - pts[0]
-        return np.full(2, np.arctan2(d[1], d[0]))
-    tau = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
-    closed = np.allclose(pts[0], pts[-1])
-    cs = CubicSpline(tau, pts, bc_type="periodic" if closed else "not-a-knot")
-    d1 = cs(tau, 1)
-    out: FloatArray = np.arctan2(d1[:, 1], d1[:, 0])
-    return out
+        return CubicSpline(tau, pts, bc_type="natural")
+    closed = bool(np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * tau[-1]))
+    if closed:
+        pts = pts.copy()
+        pts[-1] = pts[0]  # periodic splines need exactly equal ends
+    return CubicSpline(tau, pts, bc_type="periodic" if closed else "not-a-knot")
 
 
-def _clothoid_chain(pts: FloatArray, headings: Any) -> list[Piece]:
+def clothoid_chain(pts: FloatArray, headings: Any = None) -> tuple[ClothoidPiece, ...]:
+    """One clothoid per leg through ``pts``, G1 at every waypoint.
+
+    The headings at the waypoints are ``headings`` or, by default, the tangent directions of
+    a chord-length cubic spline through the points (periodic for a closed point set). Each leg
+    solves the G1 Hermite problem (:func:`fit_clothoid`); each leg starts with the previous
+    leg's end heading, so the heading is continuous (not only modulo 2π).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry.fitting import clothoid_chain
+    >>> chain = clothoid_chain(np.array([[0.0, 0.0], [5.0, 0.0], [10.0, 0.0]]))
+    >>> [(round(c.length, 12), c.k0, c.k1) for c in chain]
+    [(5.0, 0.0, 0.0), (5.0, 0.0, 0.0)]
+    """
+    n = pts.shape[0]
     if headings is None:
-        th = _estimate_headings(pts)
+        d1 = _chord_spline(pts)(_chord_parameter(pts), 1)
+        th = np.arctan2(d1[:, 1], d1[:, 0])
+        if n == 2:
+            th[:] = np.arctan2(*(pts[1] - pts[0])[::-1])  # exactly the chord direction
     else:
-        th = as_array("headings", headings, ndim=1, length=pts.shape[0])
-    return [fit_clothoid(pts[i], float(th[i]), pts[i + 1], float(th[i + 1]))
-            for i in range(pts.shape[0] - 1)]
+        th = as_array("headings", headings, ndim=1, length=n)
+    pieces: list[ClothoidPiece] = []
+    theta = float(th[0])
+    for i in range(n - 1):
+        piece = fit_clothoid(pts[i], theta, pts[i + 1], float(th[i + 1]))
+        pieces.append(piece)
+        theta = piece.end[1]
+    return tuple(pieces)
 
 
-def _spline(pts: FloatArray) -> list[Piece]:
-    tau = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
-    if pts.shape[0] == 2:
-        cs = CubicSpline(tau, pts, bc_type="natural")
-    else:
-        closed = np.allclose(pts[0], pts[-1])
-        cs = CubicSpline(tau, pts, bc_type="periodic" if closed else "not-a-knot")
+@dataclass(frozen=True, eq=False)
+class SplineCurve:
+    """A :class:`scipy.interpolate.CubicSpline` as a picklable parametric curve.
 
-    def curve(t: FloatArray, nu: int) -> FloatArray:
-        out: FloatArray = cs(np.asarray(t), nu).reshape(-1, 2)
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.interpolate import CubicSpline
+    >>> from speedplan.geometry.fitting import SplineCurve
+    >>> c = SplineCurve(CubicSpline([0.0, 1.0], [[0.0, 0.0], [1.0, 1.0]]))
+    >>> c(np.array([0.5]), 0).tolist(), c.breaks.tolist()
+    ([[0.5, 0.5]], [0.0, 1.0])
+    """
+
+    spline: CubicSpline
+
+    @property
+    def breaks(self) -> FloatArray:
+        """Knots of the spline."""
+        out: FloatArray = np.asarray(self.spline.x, dtype=np.float64)
         return out
 
-    return [CurvePiece(curve, tau)]
+    def __call__(self, tau: FloatArray, nu: int) -> FloatArray:
+        """``nu``-th derivative at parameters ``tau``, shape (m, 2)."""
+        out: FloatArray = self.spline(np.asarray(tau, dtype=np.float64).ravel(), nu)
+        return out
 
 
-def _polyline(pts: FloatArray, max_deviation: float | None) -> list[Piece]:
+def spline_piece(pts: FloatArray) -> CurvePiece:
+    """Chord-length cubic spline through ``pts``, reparametrised by arc length.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry.fitting import spline_piece
+    >>> round(spline_piece(np.array([[0.0, 0.0], [3.0, 4.0]])).length, 12)
+    5.0
+    """
+    return CurvePiece(SplineCurve(_chord_spline(pts)))
+
+
+def rounded_polyline(
+    pts: FloatArray,
+    corner_radius: float | None = None,
+    max_deviation: float | None = None,
+) -> tuple[ClothoidPiece, ...]:
+    """Straight legs joined by circular arcs tangent to both legs at every corner.
+
+    Each corner's arc has the largest radius allowed by ``corner_radius`` and by
+    ``max_deviation`` (distance from the corner to the arc's midpoint); with neither, the arc
+    starts ``CORNER_FRACTION`` (a quarter) of the shorter adjacent leg before the corner. The
+    tangent points never pass the middle of a leg, so the radius is reduced where legs are
+    short. Why round by default: a corner of zero radius has infinite curvature, so the
+    lateral-acceleration bound forces the vehicle to stop there; a scale-free default keeps
+    the polyline drivable whatever the unit of length. Sharp corners (``0``) are rejected:
+    split the path at the corners to plan a stop at each.
+
+    Raises
+    ------
+    InvalidInputError
+        The polyline reverses direction (a 180° turn), or a rounding parameter is not > 0.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry.fitting import rounded_polyline
+    >>> legs = rounded_polyline(np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]]),
+    ...                         max_deviation=0.5)
+    >>> [round(p.length, 6) for p in legs], round(1 / legs[1].k0, 6)
+    ([8.792893, 1.896119, 8.792893], 1.207107)
+    """
     d = np.diff(pts, axis=0)
     legs = np.linalg.norm(d, axis=1)
+    unit = d / legs[:, None]
     head = np.arctan2(d[:, 1], d[:, 0])
-    turn = _wrap(np.diff(head))
+    turn = wrap_angle(np.diff(head))
     if (np.abs(turn) > np.pi - 1e-9).any():
         i = int(np.flatnonzero(np.abs(turn) > np.pi - 1e-9)[0]) + 1
         raise InvalidInputError(
-            f"`xy` reverses direction at row {i} (a cusp); a path cannot turn by 180°"
+            f"`xy` reverses direction at row {i} (a 180° cusp); split the path there"
         )
-    # Tangent length of each corner arc, capped at half of each adjacent leg.
-    half_tan = np.tan(0.5 * np.abs(turn))
-    cap = 0.5 * np.minimum(legs[:-1], legs[1:])
-    if max_deviation is None:
-        tangent = CORNER_FRACTION * np.minimum(legs[:-1], legs[1:])
-    else:
-        dev = as_scalar("max_deviation", max_deviation, nonnegative=True)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            radius = dev / (1.0 / np.cos(0.5 * turn) - 1.0)
-        tangent = np.minimum(np.where(np.isfinite(radius), radius * half_tan, cap), cap)
-    tangent = np.where(np.abs(turn) < 1e-12, 0.0, tangent)
-    if max_deviation is not None and (tangent == 0).any() and (np.abs(turn) >= 1e-12).any():
-        sharp = np.flatnonzero((tangent == 0) & (np.abs(turn) >= 1e-12))
-        if sharp.size:
-            raise InvalidInputError(
-                "`max_deviation`=0 leaves sharp corners (infinite curvature) at rows "
-                f"{(sharp + 1).tolist()}; a vehicle must stop there — pass max_deviation > 0 "
-                "or split the path at the corners"
-            )
-    pieces: list[Piece] = []
-    start = pts[0]
+    half = 0.5 * np.abs(turn)
+    shorter = np.minimum(legs[:-1], legs[1:])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tangent = np.full(turn.shape, np.inf)
+        if corner_radius is not None:
+            radius = as_scalar("corner_radius", corner_radius, positive=True)
+            tangent = np.minimum(tangent, radius * np.tan(half))
+        if max_deviation is not None:
+            dev = as_scalar("max_deviation", max_deviation, nonnegative=True)
+            if dev == 0.0:
+                raise InvalidInputError(
+                    "`max_deviation`=0 keeps sharp corners, where the curvature is infinite "
+                    "and a vehicle must stop; pass max_deviation > 0, or split the path at the "
+                    "corners and plan each leg"
+                )
+            # Corner-to-arc distance d = R (1/cos(α/2) - 1), tangent length R tan(α/2).
+            tangent = np.minimum(tangent, dev * np.sin(half) / (1.0 - np.cos(half)))
+        if corner_radius is None and max_deviation is None:
+            tangent = CORNER_FRACTION * shorter
+    tangent = np.where(np.abs(turn) < 1e-12, 0.0, np.minimum(tangent, 0.5 * shorter))
+    heading = head[0] + np.concatenate(([0.0], np.cumsum(turn)))  # continuous, not wrapped
     before = np.concatenate(([0.0], tangent))
     after = np.concatenate((tangent, [0.0]))
+    pieces: list[ClothoidPiece] = []
     for i in range(legs.size):
         straight = legs[i] - before[i] - after[i]
-        p = pts[i] + d[i] / legs[i] * before[i]
         if straight > 1e-12 * legs[i]:
-            pieces.append(ClothoidPiece((float(p[0]), float(p[1])), float(head[i]), float(straight),
-                                        0.0, 0.0))
+            p = pts[i] + unit[i] * before[i]
+            pieces.append(ClothoidPiece((float(p[0]), float(p[1])), float(heading[i]),
+                                        float(straight), 0.0, 0.0))
         if i < turn.size and tangent[i] > 0:
-            radius = tangent[i] / half_tan[i]
-            p = pts[i + 1] - d[i] / legs[i] * tangent[i]
-            k = float(np.sign(turn[i]) / radius)
-            pieces.append(ClothoidPiece((float(p[0]), float(p[1])), float(head[i]),
-                                        float(radius * abs(turn[i])), k, k))
-    del start
-    return pieces
+            radius_i = tangent[i] / np.tan(half[i])
+            p = pts[i + 1] - unit[i] * tangent[i]
+            k = float(np.sign(turn[i]) / radius_i)
+            pieces.append(ClothoidPiece((float(p[0]), float(p[1])), float(heading[i]),
+                                        float(radius_i * abs(turn[i])), k, k))
+    return tuple(pieces)
 
 
 def fit_waypoints(
@@ -175,37 +283,35 @@ def fit_waypoints(
     kind: str = "clothoid",
     *,
     headings: Any = None,
+    corner_radius: float | None = None,
     max_deviation: float | None = None,
+    name: str = "xy",
 ) -> tuple[Piece, ...]:
-    """Pieces of a path through the waypoints ``xy`` (shape (n, 2), metres).
+    """Pieces of a path through the waypoints ``xy``; see :meth:`Path.from_waypoints`.
 
-    Parameters
-    ----------
-    xy : array_like, shape (n, 2)
-        Waypoints [m]; n >= 2, finite, no consecutive duplicates.
-    kind : {"clothoid", "spline", "polyline"}
-        ``"clothoid"`` (default): one clothoid per leg (curvature linear in s), tangent-continuous
-        (G1) at every waypoint, passing through every waypoint exactly; headings from ``headings``
-        or, by default, from a cubic spline through the points. ``"spline"``: a cubic spline,
-        reparametrised by true arc length (C², curvature continuous). ``"polyline"``: straight
-        legs whose corners are rounded by circular arcs.
-    headings : array_like, optional
-        Headings [rad] at the waypoints (``"clothoid"`` only).
-    max_deviation : float, optional
-        ``"polyline"`` only: largest distance [m] between a corner and its rounding arc. By
-        default each arc starts a quarter of the shorter adjacent leg before the corner (a
-        corner of zero radius would force the vehicle to stop; rounding keeps the path
-        drivable and is independent of the unit of length). ``0`` keeps sharp corners and is
-        rejected, because the speed bound there is zero.
+    ``name`` is the argument name used in error messages.
+
+    Examples
+    --------
+    >>> from speedplan.geometry.fitting import fit_waypoints
+    >>> len(fit_waypoints([[0, 0], [4, 0], [4, 4]], "polyline"))
+    3
     """
     choice("kind", kind, KINDS)
-    pts = check_waypoints(xy)
+    pts = check_waypoints(xy, name)
     if headings is not None and kind != "clothoid":
         raise InvalidInputError("`headings` applies to kind='clothoid' only")
-    if max_deviation is not None and kind != "polyline":
-        raise InvalidInputError("`max_deviation` applies to kind='polyline' only")
+    if (corner_radius is not None or max_deviation is not None) and kind != "polyline":
+        raise InvalidInputError(
+            "`corner_radius` and `max_deviation` apply to kind='polyline' only"
+        )
     if kind == "clothoid":
-        return tuple(_clothoid_chain(pts, headings))
+        return clothoid_chain(pts, headings)
     if kind == "spline":
-        return tuple(_spline(pts))
-    return tuple(_polyline(pts, max_deviation))
+        return (spline_piece(pts),)
+    try:
+        return rounded_polyline(pts, corner_radius, max_deviation)
+    except InvalidInputError as exc:
+        if name == "xy":
+            raise
+        raise InvalidInputError(str(exc).replace("`xy`", f"`{name}`")) from exc

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -9,31 +10,95 @@ from scipy.interpolate import BSpline
 
 from .._checks import FloatArray, as_array
 from ..errors import InvalidInputError
+from ._checks import as_int
 from .pieces import CurvePiece
 
-__all__ = ["nurbs_piece"]
+__all__ = ["NurbsCurve", "nurbs_piece"]
 
 
-def nurbs_piece(degree: int, knots: Any, control_points: Any, weights: Any = None) -> CurvePiece:
-    """Arc-length parametrised piece of the NURBS curve.
+@dataclass(frozen=True, eq=False)
+class NurbsCurve:
+    """A rational B-spline ``r(τ) = P(τ) / W(τ)`` as a picklable parametric curve.
 
-    Evaluated as a B-spline in homogeneous coordinates ``(w x, w y, w)`` (``scipy.interpolate
-    .BSpline``), divided through by ``w``; derivatives by the quotient rule.
+    ``P`` and ``W`` are the B-splines of the homogeneous control points ``(w x, w y)`` and of
+    the weights ``w`` (one :class:`scipy.interpolate.BSpline` with three columns); derivatives
+    follow from the quotient rule.
 
-    Parameters
-    ----------
-    degree : int
-        Polynomial degree (>= 1).
-    knots : array_like
-        Non-decreasing knot vector of length ``len(control_points) + degree + 1``.
-    control_points : array_like, shape (m, 2)
-        Control points [m].
-    weights : array_like, shape (m,), optional
-        Positive weights (default all 1: a plain B-spline).
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry.nurbs import NurbsCurve
+    >>> c = NurbsCurve(1, np.array([0, 0, 1, 1.0]), np.array([[0, 0], [2, 2.0]]), np.ones(2))
+    >>> c(np.array([0.5]), 0).tolist(), c(np.array([0.5]), 1).tolist()
+    ([[1.0, 1.0]], [[2.0, 2.0]])
     """
-    if isinstance(degree, bool) or int(degree) != degree or degree < 1:
-        raise InvalidInputError(f"`degree` must be an integer >= 1; got {degree!r}")
-    k = int(degree)
+
+    degree: int
+    knots: FloatArray
+    control_points: FloatArray
+    weights: FloatArray
+    _spline: BSpline = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        homog = np.column_stack((self.control_points * self.weights[:, None], self.weights))
+        object.__setattr__(self, "_spline", BSpline(self.knots, homog, self.degree))
+
+    def _homogeneous(self, tau: FloatArray, nu: int) -> FloatArray:
+        # Derivatives of the local polynomial piece: fine at repeated knots, where
+        # BSpline.derivative() refuses (the curve is smooth there when its heading is).
+        if nu > self.degree:
+            return np.zeros((tau.size, 3))
+        out: FloatArray = self._spline(tau, nu)
+        return out
+
+    @property
+    def domain(self) -> tuple[float, float]:
+        """Parameter range ``[t_degree, t_m]`` where the basis sums to one."""
+        m = self.control_points.shape[0]
+        return float(self.knots[self.degree]), float(self.knots[m])
+
+    @property
+    def breaks(self) -> FloatArray:
+        """Distinct knots inside the domain."""
+        lo, hi = self.domain
+        t = np.unique(self.knots)
+        out: FloatArray = t[(t >= lo) & (t <= hi)]
+        return out
+
+    def __call__(self, tau: FloatArray, nu: int) -> FloatArray:
+        """``nu``-th derivative (0, 1 or 2) at parameters ``tau`` (clipped to the domain)."""
+        lo, hi = self.domain
+        tau = np.clip(np.asarray(tau, dtype=np.float64).ravel(), lo, hi)
+        h0 = self._homogeneous(tau, 0)
+        wt = h0[:, 2:3]
+        r = h0[:, :2] / wt
+        if nu == 0:
+            return np.asarray(r, dtype=np.float64)
+        h1 = self._homogeneous(tau, 1)
+        r1 = (h1[:, :2] - r * h1[:, 2:3]) / wt
+        if nu == 1:
+            return np.asarray(r1, dtype=np.float64)
+        h2 = self._homogeneous(tau, 2)
+        out: FloatArray = (h2[:, :2] - 2.0 * r1 * h1[:, 2:3] - r * h2[:, 2:3]) / wt
+        return out
+
+
+def nurbs_piece(degree: Any, knots: Any, control_points: Any, weights: Any = None) -> CurvePiece:
+    """Arc-length parametrised piece of a NURBS curve (see :meth:`Path.from_nurbs`).
+
+    Raises
+    ------
+    InvalidInputError
+        Bad degree, shapes, knots (decreasing, wrong length, empty domain), weights (not > 0),
+        a curve of zero length, or a corner (heading jump at a repeated knot).
+
+    Examples
+    --------
+    >>> from speedplan.geometry.nurbs import nurbs_piece
+    >>> nurbs_piece(1, [0, 0, 1, 1], [[0, 0], [3, 4]]).length
+    5.0
+    """
+    k = as_int("degree", degree, minimum=1)
     ctrl = as_array("control_points", control_points)
     if ctrl.ndim != 2 or ctrl.shape[1] != 2 or ctrl.shape[0] < k + 1:
         raise InvalidInputError(
@@ -41,37 +106,50 @@ def nurbs_piece(degree: int, knots: Any, control_points: Any, weights: Any = Non
             f"got {ctrl.shape}"
         )
     m = ctrl.shape[0]
-    t = as_array("knots", knots, ndim=1, length=m + k + 1)
+    t = as_array("knots", knots, ndim=1)
+    if t.size != m + k + 1:
+        raise InvalidInputError(
+            f"`knots` must have len(control_points) + degree + 1 = {m + k + 1} entries; "
+            f"got {t.size}"
+        )
     if (np.diff(t) < 0).any():
-        raise InvalidInputError("`knots` must be non-decreasing")
-    w = np.ones(m) if weights is None else as_array("weights", weights, ndim=1, length=m)
-    if not (w > 0).all():
-        raise InvalidInputError("`weights` must all be > 0")
-    lo, hi = t[k], t[m]
-    if not hi > lo:
-        raise InvalidInputError("`knots` span an empty parameter range")
-    spline = BSpline(t, np.column_stack((ctrl * w[:, None], w)), k)
-    derivs = [spline] + [spline.derivative(i) for i in (1, 2)]
-
-    def curve(tau: FloatArray, nu: int) -> FloatArray:
-        tau = np.clip(np.asarray(tau, dtype=np.float64).ravel(), lo, hi)
-        h0 = derivs[0](tau)
-        p, wt = h0[:, :2], h0[:, 2:3]
-        r = p / wt
-        if nu == 0:
-            return np.asarray(r, dtype=np.float64)
-        h1 = derivs[1](tau)
-        dp, dw = h1[:, :2], h1[:, 2:3]
-        r1 = (dp - r * dw) / wt
-        if nu == 1:
-            return np.asarray(r1, dtype=np.float64)
-        h2 = derivs[2](tau)
-        d2p, d2w = h2[:, :2], h2[:, 2:3]
-        out: FloatArray = (d2p - 2 * r1 * dw - r * d2w) / wt
-        return out
-
-    breaks = np.unique(t[k : m + 1])
-    piece = CurvePiece(curve, breaks)
-    if not piece.length > 0:
-        raise InvalidInputError("the NURBS curve has zero length")
+        i = int(np.flatnonzero(np.diff(t) < 0)[0])
+        raise InvalidInputError(
+            f"`knots` must be non-decreasing; knots[{i + 1}]={t[i + 1]!r} < knots[{i}]={t[i]!r}"
+        )
+    if not t[m] > t[k]:
+        raise InvalidInputError(
+            f"`knots` give an empty parameter range [knots[{k}], knots[{m}]] = [{t[k]}, {t[m]}]"
+        )
+    if weights is None:
+        w = np.ones(m)
+    else:
+        w = as_array("weights", weights, ndim=1, length=m)
+        if not (w > 0).all():
+            i = int(np.flatnonzero(~(w > 0))[0])
+            raise InvalidInputError(f"`weights` must all be > 0; weights[{i}]={w[i]!r}")
+    curve = NurbsCurve(k, t, ctrl, w)
+    piece = CurvePiece(curve)
+    if not piece.length > 1e-12 * max(float(np.ptp(ctrl, axis=0).max()), 1e-300):
+        raise InvalidInputError("`control_points` give a NURBS curve of zero length")
+    _reject_corners(curve, t, k)
     return piece
+
+
+def _reject_corners(curve: NurbsCurve, t: FloatArray, k: int) -> None:
+    """A knot repeated ``degree`` times may leave only C0 continuity: refuse a heading jump."""
+    values, counts = np.unique(t, return_counts=True)
+    lo, hi = curve.domain
+    inner = values[(counts >= k) & (values > lo) & (values < hi)]
+    if inner.size == 0:
+        return
+    eps = 1e-7 * (hi - lo)
+    left, right = curve(inner - eps, 1), curve(inner + eps, 1)
+    jump = np.abs(np.angle((right[:, 0] + 1j * right[:, 1]) / (left[:, 0] + 1j * left[:, 1])))
+    if (jump > 1e-3).any():
+        i = int(np.argmax(jump))
+        raise InvalidInputError(
+            f"`knots`: the NURBS curve has a corner at parameter {inner[i]:.6g} (heading jumps "
+            f"by {jump[i]:.3g} rad, a knot repeated {k} times); a vehicle must stop there — "
+            "split the edge at that knot"
+        )

@@ -9,43 +9,40 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import FloatArray, as_array, as_scalar
+from .._checks import FloatArray, IntArray, as_array, as_scalar, grid_size
 from ..errors import InvalidInputError
-from .pieces import ClothoidPiece, Piece, ReversedPiece
+from ._checks import as_int
+from .pieces import Piece
+from .primitives import Arc, Clothoid, Line, as_segment, segment_piece
 
 __all__ = ["Arc", "Clothoid", "Line", "Path", "PathSamples"]
 
-
-@dataclass(frozen=True)
-class Line:
-    """Straight segment of ``length`` [m]."""
-
-    length: float
-
-
-@dataclass(frozen=True)
-class Arc:
-    """Circular arc of ``radius`` > 0 [m] turning by ``angle`` [rad] (positive: left)."""
-
-    radius: float
-    angle: float
-
-
-@dataclass(frozen=True)
-class Clothoid:
-    """Clothoid of ``length`` [m] whose curvature goes linearly from ``k0`` to ``k1`` [1/m]."""
-
-    length: float
-    k0: float
-    k1: float
-
-
-Segment = Line | Arc | Clothoid
+#: Queries this far outside ``[0, length]`` (relative to the length) are clipped, not rejected.
+S_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True)
 class PathSamples:
-    """A path sampled on a uniform arc-length grid."""
+    """A path sampled on a uniform arc-length grid (both ends included).
+
+    Attributes
+    ----------
+    s : ndarray, shape (n,)
+        Arc lengths [m], ``s[0] = 0`` and ``s[-1] = length``.
+    xy : ndarray, shape (n, 2)
+        Positions [m].
+    heading : ndarray, shape (n,)
+        Headings [rad], continuous (unwrapped) along the path.
+    curvature : ndarray, shape (n,)
+        Signed curvatures [1/m] (positive: turning left).
+
+    Examples
+    --------
+    >>> from speedplan.geometry import Line, Path
+    >>> smp = Path.from_segments([Line(4.0)]).resample(n=3)
+    >>> smp.s.tolist(), smp.xy[:, 0].tolist(), smp.curvature.tolist()
+    ([0.0, 2.0, 4.0], [0.0, 2.0, 4.0], [0.0, 0.0, 0.0])
+    """
 
     s: FloatArray
     xy: FloatArray
@@ -53,46 +50,22 @@ class PathSamples:
     curvature: FloatArray
 
 
-def _segment(seg: Any, i: int) -> tuple[float, float, float]:
-    """``(length, k0, k1)`` of a segment given as a dataclass or a dict."""
-    if isinstance(seg, dict):
-        kind = seg.get("type")
-        try:
-            if kind == "line":
-                seg = Line(seg["length"])
-            elif kind == "arc":
-                seg = Arc(seg["radius"], seg["angle"])
-            elif kind == "clothoid":
-                seg = Clothoid(seg["length"], seg["k0"], seg["k1"])
-            else:
-                raise InvalidInputError(
-                    f"`segments[{i}]` has type {kind!r}; use 'line', 'arc' or 'clothoid'"
-                )
-        except KeyError as exc:
-            raise InvalidInputError(f"`segments[{i}]` ({kind}) lacks the field {exc}") from exc
-    name = f"segments[{i}]"
-    if isinstance(seg, Line):
-        return as_scalar(f"{name}.length", seg.length, positive=True), 0.0, 0.0
-    if isinstance(seg, Arc):
-        r = as_scalar(f"{name}.radius", seg.radius, positive=True)
-        ang = as_scalar(f"{name}.angle", seg.angle)
-        if ang == 0:
-            raise InvalidInputError(f"`{name}.angle` must be non-zero; use a Line instead")
-        return r * abs(ang), np.sign(ang) / r, np.sign(ang) / r
-    if isinstance(seg, Clothoid):
-        return (as_scalar(f"{name}.length", seg.length, positive=True),
-                as_scalar(f"{name}.k0", seg.k0), as_scalar(f"{name}.k1", seg.k1))
-    raise InvalidInputError(f"`{name}` must be a Line, Arc, Clothoid or a dict; got {seg!r}")
-
-
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class Path:
     """Planar path parametrised by arc length ``s ∈ [0, length]``.
 
     Build it with :meth:`from_segments`, :meth:`from_waypoints`, :meth:`from_nurbs` or
-    :meth:`from_linestring`. Positions in metres, headings in radians (counter-clockwise from
-    +x), curvature in 1/m (positive turning left). Query positions outside ``[0, length]`` are
-    clipped to the ends.
+    :meth:`from_linestring`; it is immutable. Positions in metres, headings in radians
+    (counter-clockwise from +x, continuous along the path), curvature in 1/m (positive turning
+    left). Every query is vectorised over ``s``.
+
+    Query positions within ``1e-9 * length`` outside ``[0, length]`` (rounding) are clipped to
+    the ends; further outside they raise :class:`~speedplan.errors.InvalidInputError`.
+
+    Parameters
+    ----------
+    pieces : tuple of Piece
+        The chain of pieces (internal; use the constructors).
 
     Examples
     --------
@@ -107,128 +80,363 @@ class Path:
     pieces: tuple[Piece, ...]
 
     def __post_init__(self) -> None:
-        if not self.pieces:
-            raise InvalidInputError("a Path needs at least one piece")
-        if not self.length > 0:
+        object.__setattr__(self, "pieces", tuple(self.pieces))
+        if not self.pieces or not all(isinstance(p, Piece) for p in self.pieces):
+            raise InvalidInputError(
+                "`pieces` must be a non-empty sequence of pieces; build paths with "
+                "Path.from_segments, from_waypoints, from_nurbs or from_linestring"
+            )
+        if not (np.isfinite(self.length) and self.length > 0):
             raise InvalidInputError("the path has zero length; pass at least two distinct points")
+
+    def __repr__(self) -> str:
+        return (f"Path(length={self.length:.6g} m, pieces={len(self.pieces)}, "
+                f"closed={self.is_closed})")
 
     @cached_property
     def offsets(self) -> FloatArray:
-        """Arc length at the start of each piece, and the total length last."""
+        """Arc length at the start of each piece, then the total length [m]."""
         return np.concatenate(([0.0], np.cumsum([p.length for p in self.pieces])))
 
     @property
     def length(self) -> float:
-        """Total length [m]."""
+        """Total length [m].
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Line, Path
+        >>> Path.from_segments([Line(1.5), Line(2.5)]).length
+        4.0
+        """
         return float(self.offsets[-1])
 
     @property
     def is_closed(self) -> bool:
-        """Whether the end point coincides with the start point (to 1e-9 of the length)."""
+        """Whether the end point equals the start point (to ``1e-9 * length``).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from speedplan.geometry import Arc, Path
+        >>> Path.from_segments([Arc(1.0, 2 * np.pi)]).is_closed
+        True
+        """
         ends = self.point(np.array([0.0, self.length]))
         return bool(np.linalg.norm(ends[1] - ends[0]) <= 1e-9 * self.length)
 
+    # ---- evaluation -------------------------------------------------------------------------
+    def _locate(self, s: Any) -> tuple[FloatArray, IntArray]:
+        """Checked, clipped ``s`` and the index of the piece holding each value."""
+        q = as_array("s", s)
+        L = self.length
+        tol = S_TOLERANCE * L
+        if q.size and (q.min() < -tol or q.max() > L + tol):
+            bad = q[(q < -tol) | (q > L + tol)][0]
+            raise InvalidInputError(
+                f"`s` must lie in [0, length] = [0, {L:.9g}] m; got {bad!r}"
+            )
+        q = np.clip(q, 0.0, L)
+        idx = np.clip(np.searchsorted(self.offsets, q, side="right") - 1, 0, len(self.pieces) - 1)
+        return q, idx
+
     def _dispatch(self, s: Any, attr: str) -> FloatArray:
-        q = np.clip(as_array("s", s), 0.0, self.length)
-        flat = q.ravel()
-        last = len(self.pieces) - 1
-        idx = np.clip(np.searchsorted(self.offsets, flat, side="right") - 1, 0, last)
+        q, idx = self._locate(s)
+        flat, fidx = q.ravel(), idx.ravel()
         trailing = (2,) if attr == "point" else ()
         out = np.empty(flat.shape + trailing)
-        for k in np.unique(idx):
-            sel = idx == k
+        for k in np.unique(fidx):
+            sel = fidx == k
             out[sel] = getattr(self.pieces[k], attr)(flat[sel] - self.offsets[k])
         return out.reshape(q.shape + trailing)
 
     def point(self, s: Any) -> FloatArray:
-        """Positions ``(x, y)`` at arc lengths ``s``, shape ``s.shape + (2,)`` [m]."""
+        """Positions ``(x, y)`` [m] at arc lengths ``s`` [m], shape ``s.shape + (2,)``.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Line, Path
+        >>> Path.from_segments([Line(4.0)], start=(1, 2)).point([0.0, 4.0]).tolist()
+        [[1.0, 2.0], [5.0, 2.0]]
+        """
         return self._dispatch(s, "point")
 
     def heading(self, s: Any) -> FloatArray:
-        """Heading [rad] at arc lengths ``s``."""
+        """Heading [rad] at arc lengths ``s`` [m], continuous along the path.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from speedplan.geometry import Arc, Path
+        >>> p = Path.from_segments([Arc(1.0, 3 * np.pi)])  # heading grows past π
+        >>> round(float(p.heading(p.length)) / np.pi, 12)
+        3.0
+        """
         return self._dispatch(s, "heading")
 
     def curvature(self, s: Any) -> FloatArray:
-        """Signed curvature [1/m] at arc lengths ``s``."""
+        """Signed curvature [1/m] at arc lengths ``s`` [m] (positive: turning left).
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Arc, Line, Path
+        >>> p = Path.from_segments([Line(1.0), Arc(radius=4.0, angle=-1.0)])
+        >>> p.curvature([0.5, 2.0]).tolist()
+        [0.0, -0.25]
+        """
         return self._dispatch(s, "curvature")
 
+    def evaluate(self, s: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``(point, heading, curvature)`` at arc lengths ``s`` in one pass.
+
+        Cheaper than three calls for spline and NURBS pieces (one arc-length inversion).
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Line, Path
+        >>> xy, theta, kappa = Path.from_segments([Line(2.0)], heading=0.5).evaluate([1.0])
+        >>> xy.shape, theta.tolist(), kappa.tolist()
+        ((1, 2), [0.5], [0.0])
+        """
+        q, idx = self._locate(s)
+        flat, fidx = q.ravel(), idx.ravel()
+        xy, theta, kappa = np.empty((flat.size, 2)), np.empty(flat.size), np.empty(flat.size)
+        for k in np.unique(fidx):
+            sel = fidx == k
+            xy[sel], theta[sel], kappa[sel] = self.pieces[k].evaluate(flat[sel] - self.offsets[k])
+        return xy.reshape((*q.shape, 2)), theta.reshape(q.shape), kappa.reshape(q.shape)
+
     def resample(self, n: int | None = None, ds: float | None = None) -> PathSamples:
-        """Uniform arc-length samples: ``n`` points, or a step of at most ``ds`` [m]."""
+        """Samples on a uniform arc-length grid including both ends.
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of samples (>= 2).
+        ds : float, optional
+            Largest step [m]; the grid has ``ceil(length / ds) + 1`` samples. Pass exactly one
+            of ``n`` and ``ds``.
+
+        Returns
+        -------
+        PathSamples
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Line, Path
+        >>> smp = Path.from_segments([Line(10.0)]).resample(ds=3.0)
+        >>> smp.s.tolist()
+        [0.0, 2.5, 5.0, 7.5, 10.0]
+        """
         if (n is None) == (ds is None):
             raise InvalidInputError("pass exactly one of `n` and `ds`")
         if n is None:
             step = as_scalar("ds", ds, positive=True)
-            n = int(np.ceil(self.length / step)) + 1
-        if isinstance(n, bool) or int(n) != n or n < 2:
-            raise InvalidInputError(f"`n` must be an integer >= 2; got {n!r}")
-        s = np.linspace(0.0, self.length, int(n))
-        return PathSamples(s, self.point(s), self.heading(s), self.curvature(s))
+            count = grid_size("ds", int(np.ceil(self.length / step * (1 - 1e-12))) + 1)
+        else:
+            count = grid_size("n", as_int("n", n, minimum=2))
+        s = np.linspace(0.0, self.length, max(count, 2))
+        xy, theta, kappa = self.evaluate(s)
+        return PathSamples(s, xy, theta, kappa)
 
     def reversed(self) -> Path:
-        """The same path travelled from its end to its start."""
-        return Path(tuple(p.piece if isinstance(p, ReversedPiece) else ReversedPiece(p)
-                          for p in reversed(self.pieces)))
+        """The same path travelled from its end to its start.
+
+        ``point_rev(s) = point(L - s)``, ``heading_rev(s) = heading(L - s) + π`` and
+        ``curvature_rev(s) = -curvature(L - s)``.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Arc, Line, Path
+        >>> p = Path.from_segments([Line(1.0), Arc(radius=2.0, angle=1.0)])
+        >>> r = p.reversed()
+        >>> float(r.curvature(0.5)), r.point(r.length).round(12).tolist()
+        (-0.5, [0.0, 0.0])
+        """
+        return Path(tuple(p.reversed() for p in reversed(self.pieces)))
 
     def to_linestring(self, ds: float | None = None) -> Any:
-        """A shapely ``LineString`` through points every ``ds`` [m] (default length/1000)."""
+        """A shapely ``LineString`` through the path.
+
+        Parameters
+        ----------
+        ds : float, optional
+            Largest spacing of the vertices [m] (default ``length / 1000``). The joins between
+            pieces (e.g. polyline vertices) are always vertices.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Line, Path
+        >>> ls = Path.from_segments([Line(3.0)]).to_linestring(ds=1.0)
+        >>> ls.length, len(ls.coords)
+        (3.0, 4)
+        """
         import shapely
 
-        samples = self.resample(ds=ds if ds is not None else self.length / 1000)
-        return shapely.LineString(samples.xy)
+        step = self.length / 1000 if ds is None else as_scalar("ds", ds, positive=True)
+        count = grid_size("ds", int(np.ceil(self.length / step * (1 - 1e-12))) + 1)
+        s = np.union1d(np.linspace(0.0, self.length, max(count, 2)), self.offsets)
+        return shapely.LineString(self.point(s))
 
     # ---- constructors -----------------------------------------------------------------------
     @classmethod
     def from_segments(
-        cls, segments: Sequence[Any], start: Sequence[float] = (0.0, 0.0), heading: float = 0.0
+        cls,
+        segments: Sequence[Any],
+        start: Sequence[float] = (0.0, 0.0),
+        heading: float = 0.0,
     ) -> Path:
         """Chain of lines, arcs and clothoids, tangent-continuous (G1) by construction.
 
         Parameters
         ----------
         segments : sequence
-            :class:`Line`, :class:`Arc`, :class:`Clothoid` or dicts
-            ``{"type": "line"|"arc"|"clothoid", ...}`` with the same fields.
+            :class:`Line`, :class:`Arc`, :class:`Clothoid`, or dicts ``{"type": "line" |
+            "arc" | "clothoid", ...}`` with the same fields. Arcs take a positive radius and a
+            signed angle (positive turns left).
         start : (x, y)
             Start point [m].
         heading : float
             Initial heading [rad].
+
+        Returns
+        -------
+        Path
+            Each segment starts where the previous one ends, with its end heading.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from speedplan.geometry import Arc, Clothoid, Line, Path
+        >>> p = Path.from_segments([Line(5.0), Clothoid(2.0, 0.0, 0.5), Arc(2.0, 0.5),
+        ...                         {"type": "clothoid", "length": 2.0, "k0": 0.5, "k1": 0.0}])
+        >>> round(p.length, 12), round(float(p.heading(p.length)), 12)
+        (10.0, 1.5)
         """
+        if isinstance(segments, str | bytes) or not isinstance(segments, Sequence):
+            raise InvalidInputError(
+                f"`segments` must be a list of segments; got {type(segments).__name__}"
+            )
         if len(segments) == 0:
             raise InvalidInputError("`segments` is empty; pass at least one segment")
         xy = as_array("start", start, ndim=1, length=2)
         theta = as_scalar("heading", heading)
         pieces: list[Piece] = []
+        point = (float(xy[0]), float(xy[1]))
         for i, seg in enumerate(segments):
-            length, k0, k1 = _segment(seg, i)
-            piece = ClothoidPiece((float(xy[0]), float(xy[1])), theta, length, k0, k1)
+            piece = segment_piece(as_segment(seg, f"segments[{i}]"), point, theta)
             pieces.append(piece)
-            xy = piece.point(np.array(length))
-            theta = float(piece.heading(np.array(length)))
+            end, theta = piece.end
+            point = (float(end[0]), float(end[1]))
         return cls(tuple(pieces))
 
     @classmethod
-    def from_waypoints(cls, xy: Any, kind: str = "clothoid", **options: Any) -> Path:
-        """Path through waypoints; see :func:`speedplan.geometry.fitting.fit_waypoints`."""
+    def from_waypoints(
+        cls,
+        xy: Any,
+        kind: str = "clothoid",
+        *,
+        headings: Any = None,
+        corner_radius: float | None = None,
+        max_deviation: float | None = None,
+    ) -> Path:
+        """Path through waypoints.
+
+        Parameters
+        ----------
+        xy : array_like, shape (n, 2)
+            Waypoints [m]; n >= 2, finite, no repeated consecutive points.
+        kind : {"clothoid", "spline", "polyline"}
+            ``"clothoid"`` (default): one clothoid per leg, through every waypoint, tangent
+            continuous (G1); see :func:`~speedplan.geometry.fitting.clothoid_chain`.
+            ``"spline"``: chord-length cubic spline reparametrised by true arc length (C²).
+            ``"polyline"``: straight legs with corners rounded by tangent circular arcs; see
+            :func:`~speedplan.geometry.fitting.rounded_polyline` for the default rounding.
+        headings : array_like, shape (n,), optional
+            Headings at the waypoints [rad] (``"clothoid"`` only; default: estimated).
+        corner_radius : float, optional
+            ``"polyline"`` only: radius of the corner arcs [m] (reduced where the legs are too
+            short).
+        max_deviation : float, optional
+            ``"polyline"`` only: largest distance between a corner and its arc [m].
+
+        Examples
+        --------
+        >>> from speedplan import Path
+        >>> pts = [[0, 0], [10, 0], [10, 10]]
+        >>> p = Path.from_waypoints(pts)                      # G1 clothoid chain
+        >>> p.point(p.offsets).round(9).tolist() == [[0, 0], [10, 0], [10, 10]]
+        True
+        >>> q = Path.from_waypoints(pts, kind="polyline", corner_radius=2.0)
+        >>> round(float(q.curvature(10.0)), 12), round(q.length, 6)
+        (0.5, 19.141593)
+        """
         from .fitting import fit_waypoints
 
-        return cls(fit_waypoints(xy, kind, **options))
+        return cls(fit_waypoints(xy, kind, headings=headings, corner_radius=corner_radius,
+                                 max_deviation=max_deviation))
 
     @classmethod
     def from_nurbs(
         cls, degree: int, knots: Any, control_points: Any, weights: Any = None
     ) -> Path:
-        """NURBS curve as in a VDA 5050 edge ``trajectory``; see :mod:`speedplan.geometry.nurbs`."""
+        """NURBS curve, as in a VDA 5050 edge ``trajectory``, reparametrised by arc length.
+
+        Parameters
+        ----------
+        degree : int
+            Degree (>= 1).
+        knots : array_like
+            Non-decreasing knot vector, length ``len(control_points) + degree + 1``
+            (VDA 5050 ``knotVector``).
+        control_points : array_like, shape (m, 2)
+            Control points [m].
+        weights : array_like, shape (m,), optional
+            Positive weights (default 1: a plain B-spline).
+
+        Examples
+        --------
+        >>> from speedplan import Path
+        >>> p = Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[0, 0], [1, 1], [2, 0]])
+        >>> p.point([0.0, p.length]).round(12).tolist(), round(p.length, 9)
+        ([[0.0, 0.0], [2.0, 0.0]], 2.295587149)
+        """
         from .nurbs import nurbs_piece
 
         return cls((nurbs_piece(degree, knots, control_points, weights),))
 
     @classmethod
-    def from_linestring(cls, line: Any, kind: str = "polyline", **options: Any) -> Path:
-        """Path through the vertices of a shapely ``LineString``."""
+    def from_linestring(
+        cls,
+        ls: Any,
+        kind: str = "polyline",
+        *,
+        headings: Any = None,
+        corner_radius: float | None = None,
+        max_deviation: float | None = None,
+    ) -> Path:
+        """Path through the vertices of a shapely ``LineString`` (z ignored).
+
+        ``kind`` and the keyword options are those of :meth:`from_waypoints`; the default
+        ``"polyline"`` keeps the straight legs of the LineString and rounds its corners.
+
+        Examples
+        --------
+        >>> import shapely
+        >>> from speedplan import Path
+        >>> p = Path.from_linestring(shapely.LineString([(0, 0), (4, 0)]))
+        >>> p.length
+        4.0
+        """
         import shapely
 
-        if not isinstance(line, shapely.LineString):
+        if not isinstance(ls, shapely.LineString):
             raise InvalidInputError(
-                f"`line` must be a shapely LineString; got {type(line).__name__}"
+                f"`ls` must be a shapely LineString; got {type(ls).__name__}"
             )
-        return cls.from_waypoints(np.asarray(line.coords)[:, :2], kind, **options)
+        if ls.is_empty:
+            raise InvalidInputError("`ls` is empty")
+        from .fitting import fit_waypoints
+
+        return cls(fit_waypoints(np.asarray(ls.coords)[:, :2], kind, headings=headings,
+                                 corner_radius=corner_radius, max_deviation=max_deviation,
+                                 name="ls"))

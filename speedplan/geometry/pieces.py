@@ -1,32 +1,37 @@
 """Path pieces, each parametrised by its own arc length ``u ∈ [0, length]``.
 
-Two kinds cover every constructor:
+One mechanism serves every constructor: a :class:`~speedplan.geometry.path.Path` is a chain of
+pieces with ``length`` and vectorised ``point(u)``, ``heading(u)``, ``curvature(u)``.
 
-* :class:`ClothoidPiece` — heading quadratic in ``u`` (curvature linear): a clothoid, and with
-  constant curvature an arc or a line. Positions are integrals of ``(cos θ, sin θ)``, computed by
-  Gauss–Legendre quadrature from a table of knots spaced so that the heading turns by at most
-  0.25 rad between them: accurate to rounding.
+* :class:`~speedplan.geometry.primitives.ClothoidPiece` — curvature linear in ``u``: clothoid,
+  arc (constant curvature) or line (zero curvature), evaluated to rounding.
 * :class:`CurvePiece` — a parametric curve ``r(τ)`` with derivatives (cubic spline, NURBS),
-  reparametrised by arc length through a quadrature table inverted by Newton's method.
+  reparametrised by arc length: a Gauss–Legendre table of ``∫|r'|`` inverted by Newton's method.
+* :class:`ReversedPiece` — any piece travelled backwards.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
-from .._checks import FloatArray
+from .._checks import FloatArray, IntArray
 
-__all__ = ["ClothoidPiece", "CurvePiece", "Piece", "ReversedPiece"]
+__all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "CurvePiece", "ParametricCurve", "Piece",
+           "ReversedPiece"]
 
-_GX, _GW = np.polynomial.legendre.leggauss(16)
-_GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW
+#: 16-point Gauss–Legendre rule on [0, 1]: exact for polynomials of degree 31.
+GAUSS_NODES, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(16)
+GAUSS_NODES, GAUSS_WEIGHTS = 0.5 * (GAUSS_NODES + 1.0), 0.5 * GAUSS_WEIGHTS
+
+#: Sub-intervals per polynomial piece in the arc-length table of a :class:`CurvePiece`.
+_TABLE_SPLIT = 8
 
 
 class Piece:
-    """Interface: ``length`` and vectorised ``point(u)``, ``heading(u)``, ``curvature(u)``."""
+    """Interface of a path piece; ``u`` is the local arc length in ``[0, length]`` [m]."""
 
     length: float
 
@@ -35,134 +40,134 @@ class Piece:
         raise NotImplementedError
 
     def heading(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
-        """Headings at local arc lengths ``u`` [rad]."""
+        """Headings at local arc lengths ``u`` [rad], continuous along the piece."""
         raise NotImplementedError
 
     def curvature(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
-        """Signed curvatures at local arc lengths ``u`` [1/m]."""
+        """Signed curvatures at local arc lengths ``u`` [1/m] (positive: turning left)."""
         raise NotImplementedError
 
+    def evaluate(self, u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``(point, heading, curvature)`` at once (pieces share work where they can)."""
+        return self.point(u), self.heading(u), self.curvature(u)
 
-@dataclass(frozen=True)
-class ClothoidPiece(Piece):
-    """Curvature ``k0 + (k1 - k0) u / length`` from ``start`` with heading ``theta0``."""
-
-    start: tuple[float, float]
-    theta0: float
-    length: float
-    k0: float
-    k1: float
-    _knots: FloatArray = field(init=False, repr=False, compare=False)
-    _knot_xy: FloatArray = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        turn = abs(self.k0) * self.length + 0.5 * abs(self.k1 - self.k0) * self.length
-        m = int(np.clip(np.ceil(turn / 0.25), 1, 100_000))
-        knots = np.linspace(0.0, self.length, m + 1)
-        steps = self._integrate(knots[:-1], knots[1:])
-        xy = np.asarray(self.start, dtype=np.float64) + np.vstack(
-            (np.zeros((1, 2)), np.cumsum(steps, axis=0))
-        )
-        object.__setattr__(self, "_knots", knots)
-        object.__setattr__(self, "_knot_xy", xy)
-
-    def heading(self, u: FloatArray) -> FloatArray:
-        """Heading ``θ0 + k0 u + (k1 - k0) u² / (2 length)`` [rad]."""
-        u = np.asarray(u, dtype=np.float64)
-        sharpness = (self.k1 - self.k0) / self.length
-        out: FloatArray = self.theta0 + self.k0 * u + 0.5 * sharpness * u * u
-        return out
-
-    def curvature(self, u: FloatArray) -> FloatArray:
-        """Curvature, linear from ``k0`` to ``k1`` [1/m]."""
-        u = np.asarray(u, dtype=np.float64)
-        out: FloatArray = self.k0 + (self.k1 - self.k0) * u / self.length
-        return out
-
-    def _integrate(self, a: FloatArray, b: FloatArray) -> FloatArray:
-        width = (b - a)[:, None]
-        th = self.heading(a[:, None] + width * _GX[None, :])
-        return np.column_stack(((np.cos(th) * width) @ _GW, (np.sin(th) * width) @ _GW))
-
-    def point(self, u: FloatArray) -> FloatArray:
-        """Positions: the nearest knot's position plus a 16-point quadrature from it [m]."""
-        u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
-        flat = u.ravel()
-        j = np.clip(np.searchsorted(self._knots, flat, side="right") - 1, 0, self._knots.size - 2)
-        out = self._knot_xy[j] + self._integrate(self._knots[j], flat)
-        return out.reshape(*u.shape, 2)
+    def reversed(self) -> Piece:
+        """The piece travelled from its end to its start."""
+        return ReversedPiece(self)
 
 
-@dataclass(frozen=True)
+class ParametricCurve(Protocol):
+    """A picklable curve ``r(τ)``: ``curve(tau, nu)`` is the ``nu``-th derivative, shape (m, 2).
+
+    ``breaks`` are the parameters where its polynomial pieces join (quadrature never straddles
+    them), from the first to the last parameter of the curve.
+    """
+
+    @property
+    def breaks(self) -> FloatArray:  # pragma: no cover - protocol
+        """Parameters of the joins, increasing, first and last included."""
+        ...
+
+    def __call__(self, tau: FloatArray, nu: int) -> FloatArray:  # pragma: no cover - protocol
+        """``nu``-th derivative (0, 1 or 2) at parameters ``tau`` (1-D), shape (m, 2)."""
+        ...
+
+
+@dataclass(frozen=True, eq=False)
 class CurvePiece(Piece):
     """A parametric curve reparametrised by arc length.
 
-    ``curve(tau, nu)`` returns the ``nu``-th derivative of ``r`` at parameters ``tau``, shape
-    ``(..., 2)``, for ``tau ∈ [tau0, tau1]``; ``breaks`` are parameter values where the curve's
-    polynomial pieces join (quadrature never straddles them).
+    The arc length ``σ(τ) = ∫|r'|`` is tabulated on 8 sub-intervals per polynomial piece with a
+    16-point Gauss–Legendre rule (accurate to rounding for smooth ``|r'|``); ``τ(u)`` solves
+    ``σ(τ) = u`` by Newton's method inside the bracketing table cell, so ``point(u)`` moves at
+    unit speed.
     """
 
-    curve: Callable[[FloatArray, int], FloatArray]
-    breaks: FloatArray
+    curve: ParametricCurve
     length: float = field(init=False)
-    _tau: FloatArray = field(init=False, repr=False, compare=False)
-    _arc: FloatArray = field(init=False, repr=False, compare=False)
+    _tau: FloatArray = field(init=False, repr=False)
+    _arc: FloatArray = field(init=False, repr=False)
+    _theta: FloatArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        # Table: 8 sub-intervals per polynomial piece, 16-point Gauss–Legendre on each.
-        b = np.asarray(self.breaks, dtype=np.float64)
-        tau = np.unique(np.concatenate([np.linspace(b[i], b[i + 1], 9) for i in range(b.size - 1)]))
-        seg = self._speed_integral(tau[:-1], tau[1:])
-        arc = np.concatenate(([0.0], np.cumsum(seg)))
-        object.__setattr__(self, "_tau", tau)
-        object.__setattr__(self, "_arc", arc)
-        object.__setattr__(self, "length", float(arc[-1]))
+        b = np.asarray(self.curve.breaks, dtype=np.float64)
+        frac = np.linspace(0.0, 1.0, _TABLE_SPLIT + 1)[:-1]
+        tau = np.append((b[:-1, None] + np.diff(b)[:, None] * frac[None, :]).ravel(), b[-1])
+        arc = np.concatenate(([0.0], np.cumsum(self._speed_integral(tau[:-1], tau[1:]))))
+        d1 = self.curve(tau, 1)
+        # Unwrapped headings at the table nodes anchor a continuous heading(u).
+        theta = np.unwrap(np.arctan2(d1[:, 1], d1[:, 0]))
+        set_ = object.__setattr__
+        set_(self, "_tau", tau)
+        set_(self, "_arc", arc)
+        set_(self, "_theta", theta)
+        set_(self, "length", float(arc[-1]))
 
     def _speed_integral(self, a: FloatArray, b: FloatArray) -> FloatArray:
+        """``∫_a^b |r'(τ)| dτ`` elementwise (one 16-point rule per interval)."""
         width = (b - a)[:, None]
-        d1 = self.curve((a[:, None] + width * _GX[None, :]).ravel(), 1).reshape(-1, _GX.size, 2)
-        return np.asarray((np.linalg.norm(d1, axis=-1) * width) @ _GW, dtype=np.float64)
+        nodes = (a[:, None] + width * GAUSS_NODES[None, :]).ravel()
+        speed = np.linalg.norm(self.curve(nodes, 1), axis=-1).reshape(-1, GAUSS_NODES.size)
+        out: FloatArray = (speed * width) @ GAUSS_WEIGHTS
+        return out
+
+    def _cell(self, u: FloatArray) -> tuple[FloatArray, IntArray]:
+        """Flattened, clipped ``u`` and the index of its table cell."""
+        flat = np.clip(np.asarray(u, dtype=np.float64).ravel(), 0.0, self.length)
+        j = np.clip(np.searchsorted(self._arc, flat, side="right") - 1, 0, self._tau.size - 2)
+        return flat, j
 
     def parameter(self, u: FloatArray) -> FloatArray:
-        """Curve parameter ``tau`` at arc length ``u`` (Newton from the table, safeguarded)."""
-        u = np.clip(np.asarray(u, dtype=np.float64).ravel(), 0.0, self.length)
-        j = np.clip(np.searchsorted(self._arc, u, side="right") - 1, 0, self._tau.size - 2)
+        """Curve parameter ``τ`` at local arc lengths ``u`` (flattened)."""
+        flat, j = self._cell(u)
+        return self._parameter(flat, j)
+
+    def _parameter(self, flat: FloatArray, j: IntArray) -> FloatArray:
         lo, hi = self._tau[j], self._tau[j + 1]
         span = np.maximum(self._arc[j + 1] - self._arc[j], 1e-300)
-        tau = lo + (hi - lo) * (u - self._arc[j]) / span
-        for _ in range(50):
-            f = self._arc[j] + self._speed_integral(lo, tau) - u
-            speed = np.linalg.norm(self.curve(tau, 1), axis=-1)
-            step = f / np.maximum(speed, 1e-300)
-            tau = np.clip(tau - step, lo, hi)
-            if np.all(np.abs(f) <= 1e-13 * max(self.length, 1.0)):
+        tau = lo + (hi - lo) * (flat - self._arc[j]) / span
+        tol = 1e-14 * max(self.length, 1.0)
+        for _ in range(30):
+            f = self._arc[j] + self._speed_integral(lo, tau) - flat
+            if np.all(np.abs(f) <= tol):
                 break
-        return tau
+            speed = np.linalg.norm(self.curve(tau, 1), axis=-1)
+            # Clipping to the cell keeps Newton inside the bracket where σ is monotone.
+            tau = np.clip(tau - f / np.maximum(speed, 1e-300), lo, hi)
+        out: FloatArray = tau
+        return out
+
+    def evaluate(self, u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``(point, heading, curvature)`` from one arc-length inversion."""
+        shape = np.shape(u)
+        flat, j = self._cell(u)
+        tau = self._parameter(flat, j)
+        r, d1, d2 = self.curve(tau, 0), self.curve(tau, 1), self.curve(tau, 2)
+        raw = np.arctan2(d1[:, 1], d1[:, 0])
+        # Nearest 2π-branch to the heading interpolated in the table cell.
+        w = (flat - self._arc[j]) / np.maximum(self._arc[j + 1] - self._arc[j], 1e-300)
+        ref = (1.0 - w) * self._theta[j] + w * self._theta[j + 1]
+        theta = raw + 2.0 * np.pi * np.round((ref - raw) / (2.0 * np.pi))
+        cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+        kappa = cross / np.linalg.norm(d1, axis=-1) ** 3
+        return r.reshape(*shape, 2), theta.reshape(shape), kappa.reshape(shape)
 
     def point(self, u: FloatArray) -> FloatArray:
-        """Positions at arc lengths ``u`` [m]."""
-        u = np.asarray(u, dtype=np.float64)
-        return self.curve(self.parameter(u), 0).reshape(*u.shape, 2)
+        """Positions at local arc lengths ``u`` [m]."""
+        return self.curve(self.parameter(u), 0).reshape(*np.shape(u), 2)
 
     def heading(self, u: FloatArray) -> FloatArray:
-        """Direction of ``r'(τ)`` [rad]."""
-        u = np.asarray(u, dtype=np.float64)
-        d1 = self.curve(self.parameter(u), 1)
-        return np.arctan2(d1[:, 1], d1[:, 0]).reshape(u.shape)
+        """Direction of ``r'(τ)`` [rad], continuous along the piece."""
+        return self.evaluate(u)[1]
 
     def curvature(self, u: FloatArray) -> FloatArray:
         """``(x'y'' - y'x'') / |r'|³`` [1/m]."""
-        u = np.asarray(u, dtype=np.float64)
-        tau = self.parameter(u)
-        d1, d2 = self.curve(tau, 1), self.curve(tau, 2)
-        cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
-        out: FloatArray = (cross / np.linalg.norm(d1, axis=-1) ** 3).reshape(u.shape)
-        return out
+        return self.evaluate(u)[2]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ReversedPiece(Piece):
-    """``piece`` travelled backwards: heading + π, curvature negated."""
+    """``piece`` travelled backwards: heading turned by π, curvature negated."""
 
     piece: Piece
 
@@ -174,6 +179,11 @@ class ReversedPiece(Piece):
     def _mirror(self, u: FloatArray) -> FloatArray:
         out: FloatArray = self.piece.length - np.asarray(u, dtype=np.float64)
         return out
+
+    def evaluate(self, u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``(point, heading, curvature)`` travelled backwards."""
+        xy, theta, kappa = self.piece.evaluate(self._mirror(u))
+        return xy, theta + np.pi, -kappa
 
     def point(self, u: FloatArray) -> FloatArray:
         """Positions, travelled backwards [m]."""
@@ -188,3 +198,7 @@ class ReversedPiece(Piece):
         """Curvatures with the opposite sign [1/m]."""
         out: FloatArray = -self.piece.curvature(self._mirror(u))
         return out
+
+    def reversed(self) -> Piece:
+        """The original piece."""
+        return self.piece

@@ -26,6 +26,7 @@ __all__ = ["RelaxationResult", "solve_relaxation"]
 _SOLVED = {"Solved"}
 _ALMOST = {"AlmostSolved"}
 _INFEASIBLE = {"PrimalInfeasible", "AlmostPrimalInfeasible"}
+_STALLED = {"InsufficientProgress", "MaxIterations", "NumericalError"}
 
 
 @dataclass(frozen=True)
@@ -141,6 +142,22 @@ def default_settings() -> clarabel.DefaultSettings:
     return settings
 
 
+def retry_settings() -> clarabel.DefaultSettings:
+    """Settings of the second attempt after a stall: no equilibration, more iterations."""
+    settings = default_settings()
+    settings.equilibrate_enable = False
+    settings.max_iter = 400
+    return settings
+
+
+def _run(P: sp.csc_matrix, q: FloatArray, A: sp.csc_matrix, b: FloatArray, cones: list[Any],
+         settings: clarabel.DefaultSettings) -> Any:
+    try:
+        return clarabel.DefaultSolver(P, q, A, b, cones, settings).solve()
+    except Exception as exc:  # the Rust core raises plain exceptions on bad data
+        raise SolverError(f"Clarabel failed: {exc}", backend="clarabel") from exc
+
+
 def solve_relaxation(
     problem: DiscreteProblem, settings: clarabel.DefaultSettings | None = None
 ) -> RelaxationResult:
@@ -149,13 +166,15 @@ def solve_relaxation(
     A, b, q, cones = build_socp(problem)
     P = sp.csc_matrix((q.size, q.size))
     t1 = time.perf_counter()
-    try:
-        solver = clarabel.DefaultSolver(P, q, A, b, cones, settings or default_settings())
-        sol = solver.solve()
-    except Exception as exc:  # the Rust core raises plain exceptions on bad data
-        raise SolverError(f"Clarabel failed: {exc}", backend="clarabel") from exc
-    t2 = time.perf_counter()
+    first = settings or default_settings()
+    sol = _run(P, q, A, b, cones, first)
     status = str(sol.status)
+    if status in _STALLED and settings is None:
+        # Measured on fuzzed instances (long graded grids with lower bounds): Clarabel's
+        # equilibration can stall the iteration; without it the same problem solves.
+        sol = _run(P, q, A, b, cones, retry_settings())
+        status = str(sol.status)
+    t2 = time.perf_counter()
     if status in _INFEASIBLE:
         raise InfeasibleError(
             "the relaxation is infeasible: no speed law meets the boundary values together "

@@ -1,0 +1,52 @@
+"""Input checks of the geometry layer (waypoints, integers, angles)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .._checks import FloatArray, as_array
+from ..errors import InvalidInputError
+
+__all__ = ["as_int", "check_waypoints", "wrap_angle"]
+
+
+def wrap_angle(a: Any) -> FloatArray:
+    """Angles wrapped into ``[-π, π)`` [rad]."""
+    out: FloatArray = (np.asarray(a, dtype=np.float64) + np.pi) % (2.0 * np.pi) - np.pi
+    return out
+
+
+def as_int(name: str, value: Any, *, minimum: int) -> int:
+    """``value`` as an ``int`` >= ``minimum`` (bools and non-integral numbers rejected)."""
+    ok = not isinstance(value, bool | str)
+    try:
+        ok = ok and int(value) == value
+    except (TypeError, ValueError):
+        ok = False
+    if not ok or int(value) < minimum:
+        raise InvalidInputError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
+    return int(value)
+
+
+def check_waypoints(xy: Any, name: str = "xy") -> FloatArray:
+    """Validate waypoints: shape (n, 2) with n >= 2, finite, no repeated consecutive points.
+
+    Two points closer than ``1e-12`` times the extent of the point set count as repeated.
+    """
+    pts = as_array(name, xy)
+    if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 2:
+        raise InvalidInputError(f"`{name}` must have shape (n, 2) with n >= 2; got {pts.shape}")
+    extent = float(np.ptp(pts, axis=0).max())
+    if not extent > 0:
+        raise InvalidInputError(f"`{name}` needs at least two distinct points; all are equal")
+    legs = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    short = np.flatnonzero(legs <= 1e-12 * extent)
+    if short.size:
+        i = int(short[0])
+        raise InvalidInputError(
+            f"`{name}` repeats a point at consecutive rows {i} and {i + 1} ({pts[i].tolist()}); "
+            "remove the duplicate"
+        )
+    return pts

@@ -1,0 +1,229 @@
+"""Line, arc and clothoid segments, and the piece that evaluates them exactly.
+
+A clothoid has curvature linear in arc length, so its heading is quadratic and its position
+is ``∫ (cos θ, sin θ)``, a (generalised) Fresnel integral. :class:`ClothoidPiece` evaluates it
+by Gauss–Legendre quadrature on cells over which the heading turns by at most 0.25 rad: 16
+nodes integrate ``cos``/``sin`` of a quadratic over such a cell to rounding, for any
+curvature and sharpness (no separate ``k1 ≈ k0`` branch is needed, unlike the Fresnel-function
+formula). Arcs and lines are the constant-curvature cases of the same piece.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .._checks import FloatArray, as_scalar
+from ..errors import InvalidInputError
+from .pieces import GAUSS_NODES, GAUSS_WEIGHTS, Piece
+
+__all__ = ["Arc", "Clothoid", "ClothoidPiece", "Line", "Segment", "as_segment", "segment_piece"]
+
+#: Largest heading change over one quadrature cell of a clothoid [rad].
+_CELL_TURN = 0.25
+
+
+@dataclass(frozen=True)
+class Line:
+    """Straight segment.
+
+    Parameters
+    ----------
+    length : float
+        Length [m], > 0.
+
+    Examples
+    --------
+    >>> from speedplan.geometry import Line, Path
+    >>> Path.from_segments([Line(3.0)]).point(3.0).tolist()
+    [3.0, 0.0]
+    """
+
+    length: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "length", as_scalar("length", self.length, positive=True))
+
+
+@dataclass(frozen=True)
+class Arc:
+    """Circular arc: positive ``radius``, signed ``angle`` (positive turns left).
+
+    Parameters
+    ----------
+    radius : float
+        Radius [m], > 0.
+    angle : float
+        Angle turned [rad], non-zero; its sign gives the direction (left positive). The arc
+        length is ``radius * |angle|`` and the curvature ``sign(angle) / radius``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry import Arc, Path
+    >>> p = Path.from_segments([Arc(radius=2.0, angle=-np.pi / 2)])
+    >>> round(p.length, 12), float(p.curvature(1.0)), p.point(p.length).round(12).tolist()
+    (3.14159265359, -0.5, [2.0, -2.0])
+    """
+
+    radius: float
+    angle: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "radius", as_scalar("radius", self.radius, positive=True))
+        angle = as_scalar("angle", self.angle)
+        if angle == 0.0:
+            raise InvalidInputError("`angle` of an Arc must be non-zero; use a Line instead")
+        object.__setattr__(self, "angle", angle)
+
+
+@dataclass(frozen=True)
+class Clothoid:
+    """Clothoid (Euler spiral): curvature linear in arc length from ``k0`` to ``k1``.
+
+    Parameters
+    ----------
+    length : float
+        Length [m], > 0.
+    k0, k1 : float
+        Signed curvature at the start and at the end [1/m] (positive: turning left).
+
+    Examples
+    --------
+    >>> from speedplan.geometry import Clothoid, Path
+    >>> p = Path.from_segments([Clothoid(length=2.0, k0=0.0, k1=0.5)])
+    >>> p.curvature([0.0, 1.0, 2.0]).tolist(), float(p.heading(2.0))
+    ([0.0, 0.25, 0.5], 0.5)
+    """
+
+    length: float
+    k0: float
+    k1: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "length", as_scalar("length", self.length, positive=True))
+        object.__setattr__(self, "k0", as_scalar("k0", self.k0))
+        object.__setattr__(self, "k1", as_scalar("k1", self.k1))
+
+
+Segment = Line | Arc | Clothoid
+
+_FIELDS: dict[str, tuple[type[Line] | type[Arc] | type[Clothoid], tuple[str, ...]]] = {
+    "line": (Line, ("length",)),
+    "arc": (Arc, ("radius", "angle")),
+    "clothoid": (Clothoid, ("length", "k0", "k1")),
+}
+
+
+def as_segment(seg: Any, name: str) -> Segment:
+    """A :class:`Line`, :class:`Arc` or :class:`Clothoid` from itself or from a dict.
+
+    Dicts carry ``"type"`` (``"line"``, ``"arc"`` or ``"clothoid"``) and the fields of that
+    class. Errors name the argument, e.g. ``segments[2].radius``.
+    """
+    if isinstance(seg, Line | Arc | Clothoid):
+        return seg
+    if not isinstance(seg, Mapping):
+        raise InvalidInputError(
+            f"`{name}` must be a Line, Arc, Clothoid or a dict with a 'type'; got {seg!r}"
+        )
+    kind = seg.get("type")
+    if kind not in _FIELDS:
+        raise InvalidInputError(
+            f"`{name}` has type {kind!r}; use 'line', 'arc' or 'clothoid'"
+        )
+    cls, names = _FIELDS[kind]
+    missing = [f for f in names if f not in seg]
+    if missing:
+        raise InvalidInputError(f"`{name}` ({kind}) lacks the field(s) {missing}")
+    unknown = sorted(set(seg) - set(names) - {"type"})
+    if unknown:
+        raise InvalidInputError(f"`{name}` ({kind}) has unknown field(s) {unknown}")
+    try:
+        return cls(*(seg[f] for f in names))
+    except InvalidInputError as exc:
+        # Prefix the field name with the segment's position: `length` -> `segments[0].length`.
+        raise InvalidInputError(str(exc).replace("`", f"`{name}.", 1)) from exc
+
+
+@dataclass(frozen=True, eq=False)
+class ClothoidPiece(Piece):
+    """Curvature ``k0 + (k1 - k0) u / length`` from ``start`` with heading ``theta0``.
+
+    Positions are tabulated at cell boundaries (heading turn <= 0.25 rad per cell); a query
+    adds a 16-point Gauss–Legendre integral from its cell's start, accurate to rounding.
+    """
+
+    start: tuple[float, float]
+    theta0: float
+    length: float
+    k0: float
+    k1: float
+    _knots: FloatArray = field(init=False, repr=False)
+    _knot_xy: FloatArray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        turn = max(abs(self.k0), abs(self.k1)) * self.length
+        m = int(np.clip(np.ceil(turn / _CELL_TURN), 1, 1_000_000))
+        knots = np.linspace(0.0, self.length, m + 1)
+        steps = self._integrate(knots[:-1], knots[1:])
+        xy = np.asarray(self.start, dtype=np.float64) + np.vstack(
+            (np.zeros((1, 2)), np.cumsum(steps, axis=0))
+        )
+        object.__setattr__(self, "_knots", knots)
+        object.__setattr__(self, "_knot_xy", xy)
+
+    @property
+    def end(self) -> tuple[FloatArray, float]:
+        """End point [m] and end heading [rad]."""
+        return self._knot_xy[-1].copy(), float(self.heading(np.array(self.length)))
+
+    def heading(self, u: FloatArray) -> FloatArray:
+        """Heading ``θ0 + k0 u + (k1 - k0) u² / (2 length)`` [rad]."""
+        u = np.asarray(u, dtype=np.float64)
+        sharpness = (self.k1 - self.k0) / self.length
+        out: FloatArray = self.theta0 + u * (self.k0 + 0.5 * sharpness * u)
+        return out
+
+    def curvature(self, u: FloatArray) -> FloatArray:
+        """Curvature, linear from ``k0`` to ``k1`` [1/m]."""
+        u = np.asarray(u, dtype=np.float64)
+        out: FloatArray = self.k0 + (self.k1 - self.k0) * (u / self.length)
+        return out
+
+    def _integrate(self, a: FloatArray, b: FloatArray) -> FloatArray:
+        width = (b - a)[:, None]
+        th = self.heading(a[:, None] + width * GAUSS_NODES[None, :])
+        return np.column_stack(((np.cos(th) * width) @ GAUSS_WEIGHTS,
+                                (np.sin(th) * width) @ GAUSS_WEIGHTS))
+
+    def point(self, u: FloatArray) -> FloatArray:
+        """Positions: the cell start's position plus a quadrature from it [m]."""
+        u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
+        if self.k0 == 0.0 and self.k1 == 0.0:  # a line: exact, no quadrature rounding
+            direction = np.array([np.cos(self.theta0), np.sin(self.theta0)])
+            line: FloatArray = np.asarray(self.start) + u[..., None] * direction
+            return line
+        flat = u.ravel()
+        j = np.clip(np.searchsorted(self._knots, flat, side="right") - 1, 0, self._knots.size - 2)
+        out = self._knot_xy[j] + self._integrate(self._knots[j], flat)
+        return out.reshape(*u.shape, 2)
+
+    def reversed(self) -> ClothoidPiece:
+        """The same clothoid from its end: heading + π, curvature from ``-k1`` to ``-k0``."""
+        end, theta = self.end
+        return ClothoidPiece((float(end[0]), float(end[1])), theta + np.pi, self.length,
+                             -self.k1, -self.k0)
+
+
+def segment_piece(seg: Segment, start: tuple[float, float], theta0: float) -> ClothoidPiece:
+    """The piece of ``seg`` starting at ``start`` with heading ``theta0`` [rad]."""
+    if isinstance(seg, Line):
+        return ClothoidPiece(start, theta0, seg.length, 0.0, 0.0)
+    if isinstance(seg, Arc):
+        k = float(np.sign(seg.angle)) / seg.radius
+        return ClothoidPiece(start, theta0, seg.radius * abs(seg.angle), k, k)
+    return ClothoidPiece(start, theta0, seg.length, seg.k0, seg.k1)

@@ -1,0 +1,107 @@
+"""NURBS paths (VDA 5050 trajectories) against an independent de Boor evaluation."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from speedplan import InvalidInputError, Path
+
+K = 3
+KNOTS = np.array([0, 0, 0, 0, 0.4, 0.7, 1, 1, 1, 1], dtype=float)
+CTRL = np.array([[0, 0], [3, 0], [6, 0.5], [8, 2.5], [9, 5], [9, 8]], dtype=float)
+W = np.array([1, 1, 1.2, 0.7, 1, 1.0])
+
+
+def de_boor(k, t, c, x):
+    """Independent de Boor evaluation of a B-spline with coefficients ``c`` at ``x``."""
+    n = len(c)
+    j = int(np.searchsorted(t, x, side="right") - 1)
+    j = min(max(j, k), n - 1)
+    d = [np.array(c[j + r - k], dtype=float) for r in range(k + 1)]
+    for r in range(1, k + 1):
+        for i in range(k, r - 1, -1):
+            denom = t[i + 1 + j - r] - t[i + j - k]
+            alpha = 0.0 if denom == 0 else (x - t[i + j - k]) / denom
+            d[i] = (1 - alpha) * d[i - 1] + alpha * d[i]
+    return d[k]
+
+
+def nurbs_point(k, t, ctrl, w, x):
+    h = de_boor(k, t, np.column_stack((ctrl * w[:, None], w)), x)
+    return h[:2] / h[2]
+
+
+def test_nurbs_points_equal_independent_de_boor_at_their_arc_length():
+    p = Path.from_nurbs(K, KNOTS, CTRL, W)
+
+    def speed(x, h=1e-6):
+        lo, hi = max(x - h, 0.0), min(x + h, 1.0)
+        return np.linalg.norm(nurbs_point(K, KNOTS, CTRL, W, hi)
+                              - nurbs_point(K, KNOTS, CTRL, W, lo)) / (hi - lo)
+
+    def arc(a, b):
+        pts = [x for x in (0.4, 0.7) if a < x < b]
+        return quad(speed, a, b, points=pts or None, epsabs=1e-11, epsrel=1e-11, limit=200)[0]
+
+    assert p.length == pytest.approx(arc(0.0, 1.0), abs=1e-7)
+    for x in np.linspace(0, 1, 17)[1:-1]:
+        s = arc(0.0, x)  # independent arc length to parameter x
+        np.testing.assert_allclose(p.point(s), nurbs_point(K, KNOTS, CTRL, W, x), atol=1e-7)
+    np.testing.assert_allclose(p.point(0.0), CTRL[0], atol=1e-14)
+    np.testing.assert_allclose(p.point(p.length), CTRL[-1], atol=1e-12)
+
+
+def test_nurbs_path_points_match_de_boor_at_the_inverted_parameter():
+    p = Path.from_nurbs(K, KNOTS, CTRL, W)
+    piece = p.pieces[0]
+    s = np.linspace(0, p.length, 31)
+    tau = piece.parameter(s)
+    assert (np.diff(tau) > 0).all()
+    for si, ti in zip(s, tau, strict=True):
+        np.testing.assert_allclose(p.point(si), nurbs_point(K, KNOTS, CTRL, W, ti), atol=1e-12)
+
+
+def test_rational_quarter_circle_is_exact():
+    c = np.sqrt(0.5)
+    p = Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[1, 0], [1, 1], [0, 1]], [1, c, 1])
+    assert p.length == pytest.approx(np.pi / 2, rel=1e-12)
+    s = np.linspace(0, p.length, 50)
+    np.testing.assert_allclose(np.linalg.norm(p.point(s), axis=1), 1.0, rtol=1e-12)
+    np.testing.assert_allclose(p.curvature(s), 1.0, rtol=1e-9)
+    np.testing.assert_allclose(p.heading(s), np.pi / 2 + s, atol=1e-9)
+    # Unit speed: the point at s is at angle s on the unit circle.
+    np.testing.assert_allclose(p.point(s), np.column_stack((np.cos(s), np.sin(s))), atol=1e-12)
+
+
+def test_full_circle_with_double_knots_is_smooth_not_a_corner():
+    c = np.sqrt(0.5)
+    ctrl = [[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1], [1, 0]]
+    w = [1, c, 1, c, 1, c, 1, c, 1]
+    knots = [0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1]
+    p = Path.from_nurbs(2, knots, np.array(ctrl, float) * 2.0, w)
+    assert p.length == pytest.approx(4 * np.pi, rel=1e-12)
+    assert p.is_closed
+    s = np.linspace(0, p.length, 101)
+    np.testing.assert_allclose(p.curvature(s), 0.5, rtol=1e-9)
+    assert p.heading(p.length) - p.heading(0.0) == pytest.approx(2 * np.pi, abs=1e-9)
+
+
+def test_nurbs_with_a_corner_is_refused():
+    with pytest.raises(InvalidInputError, match=r"`knots`.*corner"):
+        Path.from_nurbs(1, [0, 0, 0.5, 1, 1], [[0, 0], [1, 0], [1, 1]])
+
+
+def test_plain_bspline_default_weights_and_vda5050_unclamped_domain():
+    p = Path.from_nurbs(K, KNOTS, CTRL)
+    q = Path.from_nurbs(K, KNOTS, CTRL, np.ones(6))
+    s = np.linspace(0, p.length, 7)
+    np.testing.assert_array_equal(p.point(s), q.point(s))
+    # Unclamped uniform knots: the curve lives on [t_k, t_m].
+    t = np.arange(10, dtype=float)
+    u = Path.from_nurbs(K, t, CTRL)
+    np.testing.assert_allclose(u.point(0.0), nurbs_point(K, t, CTRL, np.ones(6), 3.0),
+                               atol=1e-12)
+    np.testing.assert_allclose(u.point(u.length), nurbs_point(K, t, CTRL, np.ones(6), 6.0 - 1e-15),
+                               atol=1e-9)
