@@ -18,6 +18,7 @@ from typing import Protocol
 import numpy as np
 
 from .._checks import FloatArray, IntArray
+from ..errors import InvalidInputError
 
 __all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "CurvePiece", "ParametricCurve", "Piece",
            "ReversedPiece"]
@@ -95,6 +96,16 @@ class CurvePiece(Piece):
         tau = np.append((b[:-1, None] + np.diff(b)[:, None] * frac[None, :]).ravel(), b[-1])
         arc = np.concatenate(([0.0], np.cumsum(self._speed_integral(tau[:-1], tau[1:]))))
         d1 = self.curve(tau, 1)
+        speed = np.linalg.norm(d1, axis=1)
+        mean_speed = arc[-1] / max(float(b[-1] - b[0]), 1e-300)
+        if not mean_speed > 0 or speed.min() <= 1e-6 * mean_speed:
+            # |r'| = 0: the curve stops and turns back (a cusp); heading and curvature are
+            # undefined there and a vehicle would have to reverse.
+            i = int(np.argmin(speed))
+            raise InvalidInputError(
+                f"the curve reverses direction (a cusp, |r'| = 0) near parameter {tau[i]:.6g}; "
+                "the waypoints or control points double back — split the path there"
+            )
         # Unwrapped headings at the table nodes anchor a continuous heading(u).
         theta = np.unwrap(np.arctan2(d1[:, 1], d1[:, 0]))
         set_ = object.__setattr__

@@ -163,12 +163,14 @@ class SpeedProfile:
                                                                                 np.inf, 0.0))
 
         def ratio(value: float, limit: float) -> float:
+            if not np.isfinite(value):
+                return float("inf")  # a NaN or infinite sample is a violation, never ignored
             return float(value / limit) if np.isfinite(limit) else 0.0
 
-        max_accel = float(max(traj.a.max(), 0.0))
-        max_decel = float(max(-traj.a.min(), 0.0))
-        max_jerk = float(np.abs(traj.j).max())
-        max_lat = float(np.abs(traj.a_lat).max())
+        max_accel = float(np.max(np.append(traj.a, 0.0)))
+        max_decel = float(np.max(np.append(-traj.a, 0.0)))
+        max_jerk = float(np.max(np.abs(traj.j)))
+        max_lat = float(np.max(np.abs(traj.a_lat)))
         return Verification(
             max_speed=float(traj.v.max()),
             max_accel=max_accel,
@@ -176,7 +178,7 @@ class SpeedProfile:
             max_jerk=max_jerk,
             max_lateral=max_lat,
             ratios={
-                "speed": float(speed_ratio.max()),
+                "speed": ratio(float(speed_ratio.max()), 1.0),
                 "accel": ratio(max_accel, lim.a_max),
                 "decel": ratio(max_decel, lim.a_decel),
                 "lateral": ratio(max_lat, lim.a_lat_max),
