@@ -222,3 +222,8 @@ def test_path_is_immutable_and_has_a_short_repr():
     with pytest.raises(AttributeError):
         p.pieces = ()  # type: ignore[misc]
     assert repr(p) == "Path(length=2 m, pieces=1, closed=False)"
+
+
+def test_spline_that_doubles_back_is_rejected_as_a_cusp():
+    with pytest.raises(InvalidInputError, match=r"`xy`.*cusp"):
+        Path.from_waypoints([[1.0, 0.0], [0.0, 0.0], [1.0, 0.0]], kind="spline")

@@ -196,7 +196,10 @@ def spline_piece(pts: FloatArray) -> CurvePiece:
     >>> round(spline_piece(np.array([[0.0, 0.0], [3.0, 4.0]])).length, 12)
     5.0
     """
-    return CurvePiece(SplineCurve(_chord_spline(pts)))
+    try:
+        return CurvePiece(SplineCurve(_chord_spline(pts)))
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"`xy`: {exc}") from exc
 
 
 def rounded_polyline(

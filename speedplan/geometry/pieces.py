@@ -98,7 +98,7 @@ class CurvePiece(Piece):
         d1 = self.curve(tau, 1)
         speed = np.linalg.norm(d1, axis=1)
         mean_speed = arc[-1] / max(float(b[-1] - b[0]), 1e-300)
-        if not mean_speed > 0 or speed.min() <= 1e-6 * mean_speed:
+        if mean_speed > 0 and speed.min() <= 1e-6 * mean_speed:  # zero length: callers say
             # |r'| = 0: the curve stops and turns back (a cusp); heading and curvature are
             # undefined there and a vehicle would have to reverse.
             i = int(np.argmin(speed))
