@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._checks import FloatArray, as_array, as_scalar
+from ..errors import InvalidInputError
 from ..limits import Limits
 from ..solve.solution import DiscreteSolution
 from .law import TimeLaw
@@ -134,8 +135,6 @@ class SpeedProfile:
         step = as_scalar("dt", dt, positive=True)
         n = int(np.floor(self.duration / step + 1e-9)) + 1
         if n > 50_000_000:
-            from ..errors import InvalidInputError
-
             raise InvalidInputError(
                 f"`dt`={step!r} gives {n} samples for a {self.duration:.6g} s trajectory; "
                 "use a larger dt"
