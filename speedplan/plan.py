@@ -264,7 +264,7 @@ def _calibrate_standstill_rows(jerk: FloatArray, s: FloatArray, v0: float, a0: f
     ):
         if not at_rest:
             continue
-        env = max_jerk_envelope(dist, 0.0, 0.0, j_max)
+        env = max_jerk_envelope(dist, j_max)
         sub = DiscreteProblem(s=s[idx], w_max=env, accel=np.ones(k + 1), decel=np.ones(k + 1),
                               jerk=np.full(k, np.inf))
         load = np.abs(sub.second_difference @ env) * np.sqrt(env[1:-1]) / (2.0 * j_max)

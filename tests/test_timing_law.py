@@ -37,7 +37,7 @@ def test_max_jerk_start_reproduced_exactly(j, length):
     # From rest with jerk j: s = j t³/6, v = j t²/2, a = j t. u = w^(3/4) is linear in s,
     # so the interpolant reproduces it exactly on any grid.
     s = np.sort(np.concatenate(([0.0, length], np.random.default_rng(0).uniform(0, length, 7))))
-    law = TimeLaw(s, max_jerk_envelope(s, 0.0, 0.0, j))
+    law = TimeLaw(s, max_jerk_envelope(s, j))
     t_end = (6 * length / j) ** (1 / 3)
     assert law.duration == pytest.approx(t_end, rel=1e-10)
     tt = np.linspace(0, t_end, 11)
@@ -61,7 +61,7 @@ def test_prescribed_end_accelerations_are_met_exactly():
 
 def test_time_and_position_are_inverse_near_standstill():
     s = np.linspace(0, 3, 31)
-    w = np.minimum(max_jerk_envelope(s, 0, 0, 0.5), max_jerk_envelope(3 - s, 0, 0, 0.5))
+    w = np.minimum(max_jerk_envelope(s, 0.5), max_jerk_envelope(3 - s, 0.5))
     law = TimeLaw(s, w)
     tt = np.linspace(0, law.duration, 2001)
     q = law.position_at(tt)

@@ -15,7 +15,7 @@ import numpy as np
 from .._checks import FloatArray
 from ..errors import InfeasibleError
 
-__all__ = ["check_boundary_state", "max_jerk_envelope"]
+__all__ = ["check_boundary_state", "jerk_motion_w", "max_jerk_envelope"]
 
 
 def check_boundary_state(v: float, a: float, j_max: float, *, end: bool) -> None:
@@ -36,8 +36,11 @@ def check_boundary_state(v: float, a: float, j_max: float, *, end: bool) -> None
         )
 
 
-def max_jerk_envelope(d: FloatArray, v: float, a: float, j_max: float) -> FloatArray:
-    """Largest ``w = v²`` reachable at distance ``d >= 0`` from state ``(v, a)`` under ``j_max``.
+def max_jerk_envelope(d: FloatArray, j_max: float) -> FloatArray:
+    """Largest ``w = v²`` at distance ``d >= 0`` from rest (zero speed and acceleration).
+
+    The closed form ``(j²/4) (6 d / j)^{4/3}`` of the maximum-jerk start; moving states use
+    :func:`jerk_motion_w`.
 
     Examples
     --------
@@ -45,29 +48,14 @@ def max_jerk_envelope(d: FloatArray, v: float, a: float, j_max: float) -> FloatA
     ``v = j t²/2 = 1`` m/s.
 
     >>> import numpy as np
-    >>> w = max_jerk_envelope(np.array([0.0, 2.0 / 3.0]), v=0.0, a=0.0, j_max=0.5)
+    >>> w = max_jerk_envelope(np.array([0.0, 2.0 / 3.0]), j_max=0.5)
     >>> np.round(w, 12).tolist()
     [0.0, 1.0]
     """
     d = np.maximum(np.asarray(d, dtype=np.float64), 0.0)
     if not np.isfinite(j_max):
         return np.full(d.shape, np.inf)
-    j = j_max
-    if v == 0.0 and a == 0.0:
-        return np.asarray((j * j / 4.0) * (6.0 * d / j) ** (4.0 / 3.0), dtype=np.float64)
-    # Solve s(t) = d for t by Newton from a safe start; s is increasing while v(t) > 0.
-    t = np.cbrt(6.0 * d / j)
-    if v > 0:
-        t = np.minimum(t, d / v)
-    for _ in range(60):
-        s = v * t + 0.5 * a * t * t + j * t**3 / 6.0
-        vt = v + a * t + 0.5 * j * t * t
-        step = (s - d) / np.maximum(vt, 1e-300)
-        t = np.maximum(t - step, 0.5 * t)
-        if np.all(np.abs(step) <= 1e-15 * np.maximum(t, 1e-300)):
-            break
-    vt = v + a * t + 0.5 * j * t * t
-    return np.asarray(vt * vt, dtype=np.float64)
+    return np.asarray((j_max * j_max / 4.0) * (6.0 * d / j_max) ** (4.0 / 3.0), dtype=np.float64)
 
 
 def jerk_motion_w(d: FloatArray, v: float, a: float, jerk: float, a_limit: float) -> FloatArray:
