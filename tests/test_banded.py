@@ -15,7 +15,7 @@ N = 200
 EXACT_TOL = 1e-5  # the paper's exactness threshold on a jerk row
 
 
-def _problem(w_max, A, J, s=None, w_start=0.0, w_end=0.0):
+def _problem(w_max, A, J, s=None, w_start=0.0, w_end=0.0, w_min=None):
     n = w_max.size
     s = np.arange(n, dtype=float) if s is None else s
     return DiscreteProblem(
@@ -26,6 +26,7 @@ def _problem(w_max, A, J, s=None, w_start=0.0, w_end=0.0):
         jerk=np.broadcast_to(np.asarray(J, float), (n - 2,)).copy(),
         w_start=w_start,
         w_end=w_end,
+        w_min=w_min,
     )
 
 
@@ -95,6 +96,33 @@ def test_positive_boundary_values():
     w_max = inst.w_max.copy()
     w_start, w_end = 0.5 * w_max[0], 0.3 * w_max[-1]
     _check_against_clarabel(_problem(w_max, inst.A, inst.J, w_start=w_start, w_end=w_end))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_lower_bounds_match_clarabel(seed):
+    # Moving starts are planned with lower jerk-limited envelopes (w_min rows): a floor on
+    # the first nodes that forces the optimum to brake no faster than allowed, plus floors
+    # inside that bind.
+    from speedplan.solve.nojerk import max_feasible_w
+
+    inst = paper_instance("rnd", "cnst", "cnst", n=N, seed=seed)
+    w_max = inst.w_max.copy()
+    # A start speed the braking bound can still bring down to every w_max ahead.
+    w_start = 0.8 * min(w_max[0], float(np.min(w_max[1:] + np.cumsum(inst.A))))
+    # Floors under the fastest feasible profile: feasible by construction, and binding.
+    fastest = max_feasible_w(_problem(w_max, inst.A, inst.J, w_start=w_start))
+    w_min = np.zeros(N)
+    w_min[:20] = 0.9 * fastest[:20]
+    w_min[0] = w_start
+    mid = slice(N // 2 - 5, N // 2 + 5)
+    w_min[mid] = 0.8 * fastest[mid]
+    p = _problem(w_max, inst.A, inst.J, w_start=w_start, w_min=w_min)
+    _check_against_clarabel(p)
+    res = solve_relaxation_banded(p)
+    assert np.all(res.w >= w_min - 1e-9)
+    # The floors bind somewhere: without them the optimum is different.
+    free = solve_relaxation_banded(_problem(w_max, inst.A, inst.J, w_start=w_start))
+    assert np.any(free.w < w_min - 1e-6)
 
 
 def test_infinite_jerk_rows_are_skipped():

@@ -249,7 +249,7 @@ class Path:
         >>> from speedplan.geometry import Arc, Line, Path
         >>> p = Path.from_segments([Line(1.0), Arc(radius=2.0, angle=1.0)])
         >>> r = p.reversed()
-        >>> float(r.curvature(0.5)), r.point(r.length).round(12).tolist()
+        >>> float(r.curvature(0.5)), (r.point(r.length).round(12) + 0.0).tolist()
         (-0.5, [0.0, 0.0])
         """
         return Path(tuple(p.reversed() for p in reversed(self.pieces)))
