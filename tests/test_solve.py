@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import cvxpy as cp
 import numpy as np
 import pytest
@@ -262,3 +264,34 @@ def test_banded_backend_gives_the_same_certified_answer(family):
     assert (fast.exact, fast.status) == (ref.exact, ref.status)
     assert fast.lower_bound == pytest.approx(ref.lower_bound, rel=1e-6)
     assert fast.objective == pytest.approx(ref.objective, rel=1e-5)
+
+
+def test_a_failing_backend_falls_back_to_the_other(monkeypatch):
+    from speedplan.errors import SolverError
+    from speedplan.solve import discrete
+
+    def jammed(problem):
+        raise SolverError("stopped with status NoProgress", backend="banded", status="NoProgress")
+
+    monkeypatch.setitem(discrete.RELAXATION_BACKENDS, "banded", jammed)
+    inst = paper_instance("rnd", "cnst", "cnst", n=N_CI, seed=7)
+    sol = solve_discrete(inst.w_max, inst.A, inst.J, backend="banded")
+    ref = solve_discrete(inst.w_max, inst.A, inst.J, backend="clarabel")
+    assert sol.extras["backend"] == "clarabel"
+    assert sol.extras["backend_fallback"] == "banded: stopped with status NoProgress"
+    assert sol.objective == pytest.approx(ref.objective, rel=1e-12)
+
+
+def test_fine_uniform_grid_gets_the_same_answer_from_auto_and_clarabel():
+    # Grid steps of a few millimetres make the relaxation hard (docs/performance.md): the
+    # banded method may give up there; whichever backend answers, the answer is Clarabel's.
+    import speedplan as sp
+    from speedplan.io import read_path
+
+    path = read_path(str(Path(__file__).parents[1] / "paths" / "u_turn.json"))
+    limits = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    auto = sp.plan(path, limits, n=5000, refine="never")
+    ref = sp.plan(path, limits, n=5000, refine="never", backend="clarabel")
+    assert auto.status == ref.status == "optimal"
+    assert auto.duration == pytest.approx(ref.duration, rel=1e-6)
+    assert auto.lower_bound == pytest.approx(ref.lower_bound, rel=1e-6)
