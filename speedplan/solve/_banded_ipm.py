@@ -66,13 +66,15 @@ class Data(NamedTuple):
 
 
 class Scaling(NamedTuple):
-    """Nesterov–Todd scaling ``W`` at the current ``(s, y)``."""
+    """Nesterov–Todd scaling ``W`` of the cones at the current ``(s, y)``.
 
-    wl: FloatArray  # linear: W = diag(sqrt(s / y))
-    lam_l: FloatArray  # scaled point λ = W y = W⁻¹ s, linear part
+    The linear rows' scaling ``W = diag(sqrt(s / y))`` is never formed: only ``W² = s / y``
+    and ``λ² = s y`` enter the Newton system.
+    """
+
     beta: FloatArray  # cones: W = β (2 v v' - J)
     v: FloatArray
-    lam_s: FloatArray  # λ, cone part
+    lam_s: FloatArray  # scaled point λ = W y = W⁻¹ s
 
 
 class Factor(NamedTuple):
@@ -326,12 +328,8 @@ def _step_into_cones(u: FloatArray, alpha: float, du: FloatArray, out: FloatArra
 
 
 @njit(cache=True, error_model="numpy")
-def scaling_into(sl: FloatArray, yl: FloatArray, ss: FloatArray, ys: FloatArray,
-                 sc: Scaling) -> None:
+def scaling_into(ss: FloatArray, ys: FloatArray, sc: Scaling) -> None:
     """Nesterov–Todd scaling of every cone (formulas of CVXOPT's ``misc.compute_scaling``)."""
-    for j in range(sl.size):
-        sc.wl[j] = math.sqrt(sl[j] / yl[j])
-        sc.lam_l[j] = math.sqrt(sl[j] * yl[j])
     for c in range(ss.shape[1]):
         sn = math.sqrt(_jnorm2(ss[0, c], ss[1, c], ss[2, c]))
         yn = math.sqrt(_jnorm2(ys[0, c], ys[1, c], ys[2, c]))
@@ -503,15 +501,18 @@ def _dy_into(
 @njit(cache=True, error_model="numpy")
 def newton_into(
     d: Data, sc: Scaling, fac: Factor, nw: Work,
-    bw: FloatArray, bt: FloatArray, bz: FloatArray, byl: FloatArray, bys: FloatArray,
-    bsl: FloatArray, bss: FloatArray, refine: int,
+    sl: FloatArray, bw: FloatArray, bt: FloatArray, bz: FloatArray, byl: FloatArray,
+    bys: FloatArray, bsl: FloatArray, bss: FloatArray, refine: int,
     dw: FloatArray, dt: FloatArray, dz: FloatArray,
     dsl: FloatArray, dss: FloatArray, dyl: FloatArray, dys: FloatArray,
 ) -> None:
-    """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs``."""
+    """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs``.
+
+    ``sl`` is the linear slack (``λ W = s`` on the linear rows).
+    """
     # v = H by - W⁻¹ u with λ ∘ u = bs; then (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
     for j in range(bsl.size):
-        nw.vl[j] = fac.hl[j] * byl[j] - bsl[j] / (sc.lam_l[j] * sc.wl[j])
+        nw.vl[j] = fac.hl[j] * byl[j] - bsl[j] / sl[j]
     for c in range(bys.shape[1]):
         u0, u1, u2 = _jordan_solve(sc.lam_s[0, c], sc.lam_s[1, c], sc.lam_s[2, c],
                                    bss[0, c], bss[1, c], bss[2, c])
@@ -608,15 +609,14 @@ def iterate(
     def cone() -> FloatArray:
         return np.zeros((3, nc))
 
-    sc = Scaling(lin(), lin(), np.ones(nc), cone(), cone())
-    sc.wl[:] = 1.0
+    sc = Scaling(np.ones(nc), cone(), cone())
     sc.v[0] = 1.0  # W = I for the starting point
     fac = Factor(node(), node(), node(), lin(), node(), node(), node(), node(), node(), node(),
                  node(), node(), node(), node(), node(), node())
     nw = Work(lin(), lin(), cone(), node(), node(), node(), node(), node(), node(), node())
     w, t, z, gw, gt, gz = node(), node(), node(), node(), node(), node()
-    sl, yl, ryl, lam_sq_l, bsl, dsl, dyl = lin(), lin(), lin(), lin(), lin(), lin(), lin()
-    ss, ys, rys, lam_sq_s, bss, dss, dys = cone(), cone(), cone(), cone(), cone(), cone(), cone()
+    sl, yl, ryl, bsl, dsl, dyl = lin(), lin(), lin(), lin(), lin(), lin()
+    ss, ys, rys, bss, dss, dys = cone(), cone(), cone(), cone(), cone(), cone()
     ss_new, ys_new = cone(), cone()
     dw, dt, dz = node(), node(), node()
 
@@ -651,9 +651,15 @@ def iterate(
             ryl[j] = b_lin[j] - ryl[j] - sl[j]
         for c in range(nc):
             for r in range(3):
-                rys[r, c] = b_soc[r, c] - rys[r, c] - ss[r, c]
+                rys[r, c] = -rys[r, c] - ss[r, c]
+        ys_b = 0.0  # ys · b_soc with the constant part of the cone rows spelled out
+        for i in range(m):
+            rys[0, i] += 1.0
+            rys[2, i] -= 1.0
+            rys[2, m + i] += 2.0
+            ys_b += ys[0, i] - ys[2, i] + 2.0 * ys[2, m + i]
         pcost = _dot(d.ct, t)
-        dcost = -_dot(yl, b_lin) - _dot(ys, b_soc)
+        dcost = -_dot(yl, b_lin) - ys_b
         gap = _dot(sl, yl) + _dot(ss, ys)
         pres = math.sqrt(_dot(ryl, ryl) + _dot(rys, rys)) / res_y0
         dres = math.sqrt(_dot(gw, gw) + _dot(gt, gt) + _dot(gz, gz)) / res_x0
@@ -678,39 +684,37 @@ def iterate(
         if not (math.isfinite(pres) and math.isfinite(dres) and math.isfinite(gap)):
             status = NUMERICAL_ERROR
             break
-        scaling_into(sl, yl, ss, ys, sc)
+        scaling_into(ss, ys, sc)
         if not factor_into(d, sc, yl, sl, fac):
             status = NUMERICAL_ERROR
             break
         mu = gap / nu
         # Refinement only pays once the scaling is ill-conditioned, close to the optimum.
         refine = 1 if relgap < REFINE_BELOW else 0
+        # Right-hand side -λ∘λ (λ∘λ = s y on the linear rows).
         for j in range(n_lin):
-            lam_sq_l[j] = sc.lam_l[j] * sc.lam_l[j]
-            bsl[j] = -lam_sq_l[j]
+            bsl[j] = -sl[j] * yl[j]
         lam = sc.lam_s
         for c in range(nc):
-            lam_sq_s[0, c] = lam[0, c] ** 2 + lam[1, c] ** 2 + lam[2, c] ** 2
-            lam_sq_s[1, c] = 2.0 * lam[0, c] * lam[1, c]
-            lam_sq_s[2, c] = 2.0 * lam[0, c] * lam[2, c]
-            for r in range(3):
-                bss[r, c] = -lam_sq_s[r, c]
+            bss[0, c] = -(lam[0, c] ** 2 + lam[1, c] ** 2 + lam[2, c] ** 2)
+            bss[1, c] = -2.0 * lam[0, c] * lam[1, c]
+            bss[2, c] = -2.0 * lam[0, c] * lam[2, c]
         # Predictor (affine-scaling) direction.
-        newton_into(d, sc, fac, nw, gw, gt, gz, ryl, rys, bsl, bss, refine,
+        newton_into(d, sc, fac, nw, sl, gw, gt, gz, ryl, rys, bsl, bss, refine,
                     dw, dt, dz, dsl, dss, dyl, dys)
         alpha = min(max_step_lin(sl, dsl), max_step_lin(yl, dyl),
                     max_step_soc(ss, dss), max_step_soc(ys, dys))
         sigma = (1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT
         # Corrector: second-order term and centring, same factorisation.
         for j in range(n_lin):
-            bsl[j] = -lam_sq_l[j] - dsl[j] * dyl[j] + sigma * mu
+            bsl[j] = -sl[j] * yl[j] - dsl[j] * dyl[j] + sigma * mu
         for c in range(nc):
             a0, a1, a2 = _apply_winv(sc, dss[0, c], dss[1, c], dss[2, c], c)
             b0, b1, b2 = _apply_w(sc, dys[0, c], dys[1, c], dys[2, c], c)
-            bss[0, c] = -lam_sq_s[0, c] - (a0 * b0 + a1 * b1 + a2 * b2) + sigma * mu
-            bss[1, c] = -lam_sq_s[1, c] - (a0 * b1 + b0 * a1)
-            bss[2, c] = -lam_sq_s[2, c] - (a0 * b2 + b0 * a2)
-        newton_into(d, sc, fac, nw, gw, gt, gz, ryl, rys, bsl, bss, refine,
+            bss[0, c] += -(a0 * b0 + a1 * b1 + a2 * b2) + sigma * mu
+            bss[1, c] += -(a0 * b1 + b0 * a1)
+            bss[2, c] += -(a0 * b2 + b0 * a2)
+        newton_into(d, sc, fac, nw, sl, gw, gt, gz, ryl, rys, bsl, bss, refine,
                     dw, dt, dz, dsl, dss, dyl, dys)
         alpha_p = min(1.0, STEP * min(
             max_step_lin(sl, dsl), max_step_lin(yl, dyl),
