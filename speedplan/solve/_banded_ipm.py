@@ -61,7 +61,6 @@ class Data(NamedTuple):
     lk: IntArray  # interior nodes with a positive lower bound
     ct: FloatArray  # objective coefficients of t
     cw: FloatArray  # coefficients of w in the acceleration rows
-    row: FloatArray  # scale of each linear row
     b_lin: FloatArray  # right-hand side of the linear rows
 
 
@@ -198,23 +197,22 @@ def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
     """Linear rows of ``G x`` (no constants)."""
     m, k, kl = w.size, d.jk.size, d.lk.size
     nl = m + 1
-    row = d.row
     for j in range(nl):
         right = d.cw[j] * w[j] if j < m else 0.0
         left = d.cw[j - 1] * w[j - 1] if j > 0 else 0.0
-        out[j] = row[j] * (right - left)
-        out[nl + j] = row[nl + j] * (left - right)
+        out[j] = right - left
+        out[nl + j] = left - right
     for i in range(m):
-        out[2 * nl + i] = row[2 * nl + i] * w[i]
+        out[2 * nl + i] = w[i]
     base = 2 * nl + m
     for r in range(kl):
-        out[base + r] = -row[base + r] * w[d.lk[r]]
+        out[base + r] = -w[d.lk[r]]
     base += kl
     for r in range(k):
         i = d.jk[r]
         jw = d.cj[r] * _second_diff(d, w, i)
-        out[base + r] = row[base + r] * (jw - t[i])
-        out[base + k + r] = row[base + k + r] * (-jw - t[i])
+        out[base + r] = jw - t[i]
+        out[base + k + r] = -jw - t[i]
 
 
 @njit(cache=True, error_model="numpy")
@@ -251,7 +249,6 @@ def g_adjoint_into(
     """``G' y`` split into its ``w``, ``t`` and ``z`` parts (``u`` is scratch)."""
     m, k, kl = d.cw.size, d.jk.size, d.lk.size
     nl = m + 1
-    row = d.row
     base_j = 2 * nl + m + kl
     for i in range(m):
         u[i] = 0.0
@@ -259,17 +256,17 @@ def g_adjoint_into(
         gz[i] = -2.0 * ys[1, i] - ys[0, m + i] + ys[1, m + i]
     for r in range(k):
         i = d.jk[r]
-        jp, jm = yl[base_j + r] * row[base_j + r], yl[base_j + k + r] * row[base_j + k + r]
+        jp, jm = yl[base_j + r], yl[base_j + k + r]
         u[i] = d.cj[r] * (jp - jm)
         gt[i] -= jp + jm
     _second_diff_t_into(d, u, gw)
     for i in range(m):
-        acc_i = yl[i] * row[i] - yl[nl + i] * row[nl + i]
-        acc_n = yl[i + 1] * row[i + 1] - yl[nl + i + 1] * row[nl + i + 1]
-        gw[i] += (d.cw[i] * (acc_i - acc_n) + yl[2 * nl + i] * row[2 * nl + i]
+        acc_i = yl[i] - yl[nl + i]
+        acc_n = yl[i + 1] - yl[nl + i + 1]
+        gw[i] += (d.cw[i] * (acc_i - acc_n) + yl[2 * nl + i]
                   - ys[0, i] - ys[2, i])
     for r in range(kl):
-        gw[d.lk[r]] -= yl[2 * nl + m + r] * row[2 * nl + m + r]
+        gw[d.lk[r]] -= yl[2 * nl + m + r]
 
 
 # --- cones: steps, interiority, scaling --------------------------------------------------------
@@ -364,7 +361,6 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
     hl = fac.hl
     for j in range(hl.size):
         hl[j] = yl[j] / sl[j]
-    row = d.row
     base_j = 2 * nl + m + kl
     mtt, mzz, mtz, dg, e, a = fac.mtt, fac.mzz, fac.mtz, fac.dg, fac.e, fac.a
     for i in range(m):
@@ -374,16 +370,16 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
         mzz[i] = 4.0 * h11 + g00 - 2.0 * g01 + g11
         mtz[i] = g00 - g11
         fac.bwz[i] = 2.0 * (h01 + h12)
-        dg[i] = hl[2 * nl + i] * row[2 * nl + i] ** 2 + (h00 + 2.0 * h02 + h22)
+        dg[i] = hl[2 * nl + i] + (h00 + 2.0 * h02 + h22)
         a[i] = 0.0
         e[i] = 0.0
     for r in range(kl):
         j = 2 * nl + m + r
-        dg[d.lk[r]] += hl[j] * row[j] ** 2
+        dg[d.lk[r]] += hl[j]
     for r in range(k):
         i = d.jk[r]
-        hp = hl[base_j + r] * row[base_j + r] ** 2
-        hm = hl[base_j + k + r] * row[base_j + k + r] ** 2
+        hp = hl[base_j + r]
+        hm = hl[base_j + k + r]
         # Jerk weight after eliminating t: c²(H⁺ + H⁻) - p a², written without cancellation
         # as c² (4 H⁺H⁻ + κ (H⁺ + H⁻)) / (H⁺ + H⁻ + κ) with κ the cones' own weight of t.
         kappa = mtt[i] - mtz[i] * mtz[i] / mzz[i]
@@ -398,8 +394,8 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
     off1, off2, l1, l2, dd = fac.off1, fac.off2, fac.l1, fac.l2, fac.dd
     ok = True
     for i in range(m):
-        gacc_i = hl[i] * row[i] ** 2 + hl[nl + i] * row[nl + i] ** 2
-        gacc_n = hl[i + 1] * row[i + 1] ** 2 + hl[nl + i + 1] * row[nl + i + 1] ** 2
+        gacc_i = hl[i] + hl[nl + i]
+        gacc_n = hl[i + 1] + hl[nl + i + 1]
         f_i = -fac.q[i] * a[i] * fac.bwz[i]
         di = (e[i] * d.d1[i] ** 2 + 2.0 * f_i * d.d1[i] + dg[i] - fac.r[i] * fac.bwz[i] ** 2
               + d.cw[i] ** 2 * (gacc_i + gacc_n))
@@ -592,7 +588,7 @@ def iterate(
     """
     m = d.cw.size
     nc = 2 * m
-    n_lin = d.row.size
+    n_lin = d.b_lin.size
     b_lin = d.b_lin
     b_soc = np.zeros((3, nc))  # constant part of the cone rows: (1, 0, -1) and (0, 0, 2)
     b_soc[0, :m] = 1.0

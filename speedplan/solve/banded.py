@@ -26,7 +26,7 @@ memory with no per-operation interpreter overhead.
 The problem is solved in internal units (``w`` scaled to at most 1, ``s`` to unit mean step),
 with every variable further scaled per node from the O(n) no-jerk profile ``w_ref``
 (``w = w_ref ŵ``, ``z = sqrt(w_ref) ẑ``, ``t = τ / sqrt(w_ref) t̂``) so that every node's cones
-become the same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``, and jerk rows are normalised. The
+become the same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``. The
 primal start is the midpoint of the slowest and fastest feasible profiles (see
 :func:`_start`), the dual start CVXOPT's default (least-norm, shifted into the cones);
 each Newton solve gets one round of iterative refinement once the gap is small.
@@ -70,8 +70,10 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
     Variables are scaled per node, ``w = cw ŵ``, ``z = sqrt(cw) ẑ``, ``t = ct t̂`` with
     ``cw = w_ref`` and ``ct = τ / sqrt(cw)``, which turns both cones of every node into the
     same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``; the acceleration rows get the coefficients
-    ``cw`` and the jerk rows are divided by ``ct``. Jerk rows are normalised to unit norm,
-    which balances the starting point and the stopping tests.
+    ``cw`` and the jerk rows are divided by ``ct``. The rows are not normalised further:
+    normalising the jerk rows to unit norm (as an earlier version did) made the method jam on
+    grids finer than about 7 mm, e.g. ``paths/u_turn.json`` at ``n = 5000`` (NoProgress after
+    36 iterations; without it, a certified gap below 1e-6 after 34), with no gain elsewhere.
     """
     n = p.n
     m = n - 2
@@ -101,12 +103,8 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
             jconst,
         )
     )
-    dh0, dh1, dh2 = d0 * cwp[:-2], d1 * cw, d2 * cwp[2:]
-    row = np.ones(b_lin.size)
-    jnorm = 1.0 / np.sqrt(cj**2 * (dh0[jk] ** 2 + dh1[jk] ** 2 + dh2[jk] ** 2) + 1.0)
-    row[b_lin.size - 2 * jk.size :] = np.concatenate((jnorm, jnorm))
-    return ipm.Data(d0=dh0, d1=dh1, d2=dh2, jk=jk.astype(np.intp), cj=cj,
-                    lk=lk.astype(np.intp), ct=ct, cw=cw, row=row, b_lin=b_lin * row)
+    return ipm.Data(d0=d0 * cwp[:-2], d1=d1 * cw, d2=d2 * cwp[2:], jk=jk.astype(np.intp), cj=cj,
+                    lk=lk.astype(np.intp), ct=ct, cw=cw, b_lin=b_lin)
 
 
 # --- certificates -------------------------------------------------------------------------
@@ -183,7 +181,7 @@ def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, Flo
     padded = np.concatenate(([0.0], w_hat, [0.0]))
     second = d.d0 * padded[:-2] + d.d1 * padded[1:-1] + d.d2 * padded[2:]
     k = d.jk.size
-    end_terms = d.b_lin[d.b_lin.size - k :] / d.row[d.row.size - k :]  # fixed ends' share
+    end_terms = d.b_lin[d.b_lin.size - k :]  # the fixed ends' share of the jerk rows
     jerk = np.zeros(w_hat.size)
     jerk[d.jk] = np.abs(d.cj * second[d.jk] + end_terms)
     t_hat = 2.0 * np.maximum(1.0 / z_hat, jerk) + 1.0
@@ -194,7 +192,7 @@ def _row_multipliers(d: ipm.Data, yl: FloatArray) -> tuple[FloatArray, ...]:
     """Multipliers of the scaled problem's own rows from those of the internal rows."""
     m, k = d.cw.size, d.jk.size
     nl = m + 1
-    y = yl * d.row
+    y = yl
     base = y.size - 2 * k
     nu_p, nu_m = np.zeros(m), np.zeros(m)
     nu_p[d.jk] = y[base : base + k] / d.ct[d.jk]
