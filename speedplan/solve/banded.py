@@ -58,7 +58,7 @@ from .._checks import FloatArray
 from ..errors import InfeasibleError, SolverError
 from . import _banded_ipm as ipm
 from .clarabel_ import RelaxationResult
-from .nojerk import check_reachable, max_feasible_w
+from .nojerk import check_reachable, max_feasible_w, min_feasible_w
 from .problem import DiscreteProblem
 
 __all__ = ["solve_relaxation_banded"]
@@ -163,41 +163,36 @@ def _lagrangian_bound(
 def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Primal starting point ``(ŵ, t̂, ẑ)`` in the middle of the linear rows' feasible set.
 
-    ``w`` is the mean of the fastest feasible profile ``w_ref`` and the slowest one (braking
-    from ``w_start`` and accelerating into ``w_end`` as hard as allowed, floored at 0); both
-    meet every acceleration row, so their mean does too, strictly inside the speed bounds
-    wherever they differ. ``z`` and ``t`` are then strictly inside their cones and above the
-    jerk rows. Measured on ``plan()`` grids this halves the iterations of CVXOPT's
-    least-squares start (55 -> 20 on ``paths/u_turn.json``), whose point ignores the chain of
-    acceleration rows and spends iterations propagating it along the path.
+    ``w`` is the mean of the fastest feasible profile ``w_ref`` and the slowest one
+    (:func:`~speedplan.solve.nojerk.min_feasible_w`); both meet every acceleration row, so
+    their mean does too, strictly inside the speed bounds wherever they differ. ``z`` and
+    ``t`` are then strictly inside their cones and above the jerk rows. Measured on ``plan()``
+    grids (with the jerk-row normalisation of the time) this more than halved the iterations of
+    CVXOPT's least-squares start (55 -> 20 on ``paths/u_turn.json``), whose point ignores the
+    chain of acceleration rows and spends iterations propagating it along the path.
     """
-    accel = np.concatenate(([0.0], np.cumsum(p.accel * p.h)))
-    decel = np.concatenate(([0.0], np.cumsum(p.decel * p.h)))
-    slowest = np.maximum(np.maximum(p.w_start - decel, p.w_end - (accel[-1] - accel)), 0.0)
-    if p.w_min is not None:
-        slowest = np.maximum(slowest, p.w_min)
-    w_hat = 0.5 * (slowest[1:-1] / d.cw + 1.0)
+    w_hat = 0.5 * (min_feasible_w(p)[1:-1] / d.cw + 1.0)
     z_hat = 0.5 * np.sqrt(w_hat)
-    padded = np.concatenate(([0.0], w_hat, [0.0]))
-    second = d.d0 * padded[:-2] + d.d1 * padded[1:-1] + d.d2 * padded[2:]
+    # Jerk rows at t = 0: G x - b gives cj D̂ŵ plus the fixed ends' share.
+    rows = np.empty(d.b_lin.size)
+    ipm.g_lin_into(d, w_hat, np.zeros(w_hat.size), rows)
     k = d.jk.size
-    end_terms = d.b_lin[d.b_lin.size - k :]  # the fixed ends' share of the jerk rows
     jerk = np.zeros(w_hat.size)
-    jerk[d.jk] = np.abs(d.cj * second[d.jk] + end_terms)
+    positive = slice(d.b_lin.size - 2 * k, d.b_lin.size - k)
+    jerk[d.jk] = np.abs(rows[positive] - d.b_lin[positive])
     t_hat = 2.0 * np.maximum(1.0 / z_hat, jerk) + 1.0
     return w_hat, t_hat, z_hat
 
 
 def _row_multipliers(d: ipm.Data, yl: FloatArray) -> tuple[FloatArray, ...]:
-    """Multipliers of the scaled problem's own rows from those of the internal rows."""
+    """Multipliers of the scaled problem's own rows (``t`` rescaled by ``ct``)."""
     m, k = d.cw.size, d.jk.size
     nl = m + 1
-    y = yl
-    base = y.size - 2 * k
+    base = yl.size - 2 * k
     nu_p, nu_m = np.zeros(m), np.zeros(m)
-    nu_p[d.jk] = y[base : base + k] / d.ct[d.jk]
-    nu_m[d.jk] = y[base + k :] / d.ct[d.jk]
-    return y[:nl], y[nl : 2 * nl], nu_p, nu_m
+    nu_p[d.jk] = yl[base : base + k] / d.ct[d.jk]
+    nu_m[d.jk] = yl[base + k :] / d.ct[d.jk]
+    return yl[:nl], yl[nl : 2 * nl], nu_p, nu_m
 
 
 # --- driver --------------------------------------------------------------------------------

@@ -14,11 +14,17 @@ from .._checks import FloatArray
 from ..errors import InfeasibleError
 from .problem import DiscreteProblem
 
-__all__ = ["check_reachable", "max_feasible_w"]
+__all__ = ["check_reachable", "max_feasible_w", "min_feasible_w"]
+
+
+def _cumulative(rate_h: FloatArray) -> FloatArray:
+    """``c_i = Σ_{k<i} rate_h_k`` (n values for n - 1 segments): the bound on ``w_i - w_0``."""
+    out: FloatArray = np.concatenate(([0.0], np.cumsum(rate_h)))
+    return out
 
 
 def _forward(bound: FloatArray, rate_h: FloatArray) -> FloatArray:
-    c = np.concatenate(([0.0], np.cumsum(rate_h)))
+    c = _cumulative(rate_h)
     out: FloatArray = c + np.minimum.accumulate(bound - c)
     return np.minimum(out, bound)
 
@@ -47,6 +53,32 @@ def max_feasible_w(problem: DiscreteProblem, *, pin_ends: bool = True) -> FloatA
     return np.maximum(w, 0.0)
 
 
+def min_feasible_w(problem: DiscreteProblem) -> FloatArray:
+    """Smallest ``w`` meeting the acceleration/braking rows from ``w_start`` and into ``w_end``.
+
+    Braking from ``w_start`` and accelerating into ``w_end`` as hard as allowed, floored at 0
+    and at ``w_min`` (the floor may break an acceleration row where ``w_min`` rises faster
+    than the acceleration bound). Every ``w`` meeting the rows and the fixed ends lies above
+    it; with the speed bounds ignored it is itself feasible when ``w_min`` is not given.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.solve.problem import DiscreteProblem
+    >>> p = DiscreteProblem(s=np.arange(5.0), w_max=np.full(5, 10.0), accel=np.ones(4),
+    ...                     decel=np.ones(4), jerk=np.full(3, np.inf), w_start=3.0)
+    >>> min_feasible_w(p).tolist()
+    [3.0, 2.0, 1.0, 0.0, 0.0]
+    """
+    braking = problem.w_start - _cumulative(problem.decel * problem.h)
+    accel = _cumulative(problem.accel * problem.h)
+    accelerating = problem.w_end - (accel[-1] - accel)
+    w: FloatArray = np.maximum(np.maximum(braking, accelerating), 0.0)
+    if problem.w_min is not None:
+        w = np.maximum(w, problem.w_min)
+    return w
+
+
 def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
     """Raise :class:`InfeasibleError` if ``w_start`` / ``w_end`` cannot be met.
 
@@ -66,8 +98,7 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
                 s=float(where),
             )
     # Braking from w_start: the backward pass alone says how fast each node may be.
-    dec_h = problem.decel * problem.h
-    c = np.concatenate(([0.0], np.cumsum(dec_h)))
+    c = _cumulative(problem.decel * problem.h)
     reach_back = problem.w_max.copy()
     reach_back[-1] = min(reach_back[-1], problem.w_end)
     limit_from = reach_back + c  # w_0 <= w_max_j + c_j - c_0
@@ -85,7 +116,7 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
         if (short > tol).any():
             j = int(np.argmax(short > tol))
             # The bound ahead that the braking from node j cannot reach in time.
-            c = np.concatenate(([0.0], np.cumsum(problem.decel * problem.h)))
+            c = _cumulative(problem.decel * problem.h)
             k = j + int(np.argmin(problem.w_max[j:] + c[j:]))
             raise InfeasibleError(
                 f"cannot slow down in time for the bound w_max={problem.w_max[k]:.6g} at "
@@ -94,8 +125,7 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
                 constraint="jerk",
                 s=float(s[k]),
             )
-    acc_h = problem.accel * problem.h
-    c = np.concatenate(([0.0], np.cumsum(acc_h)))
+    c = _cumulative(problem.accel * problem.h)
     reach_fwd = problem.w_max.copy()
     reach_fwd[0] = min(reach_fwd[0], problem.w_start)
     limit_to = reach_fwd + (c[-1] - c)  # w_end <= w_max_j + (c_end - c_j)
