@@ -24,6 +24,9 @@ __all__ = ["STANDSTILL_MODES", "SpeedBound", "plan"]
 #: ``"smooth"``: acceleration is 0 at a standstill and jerk-limited from the first instant.
 #: ``"free"``: the paper's model, where acceleration may jump at a standstill.
 STANDSTILL_MODES = ("smooth", "free")
+#: Shortest path planned [m]. Far below any vehicle's resolution; much shorter paths (from
+#: nearly coincident waypoints) made the solvers fail with misleading messages.
+MIN_PATH_LENGTH = 1e-9
 _NO_JERK_NODES = 1001
 
 
@@ -116,7 +119,8 @@ def plan(
     Raises
     ------
     InvalidInputError
-        Malformed arguments, or boundary states beyond the limits.
+        Malformed arguments, a path shorter than ``MIN_PATH_LENGTH`` (1 nm), or boundary states
+        beyond the limits.
     InfeasibleError
         No speed law meets the boundary states (the message says which constraint, where).
 
@@ -154,6 +158,11 @@ def plan(
     af = as_scalar("af", af)
     _check_boundary(limits, v0, a0, vf, af, standstill)
     L = float(path.length)
+    if not L >= MIN_PATH_LENGTH:
+        raise InvalidInputError(
+            f"`path` is {L:.3g} m long, shorter than {MIN_PATH_LENGTH:g} m: there is no motion "
+            "to plan (nearly coincident waypoints?); skip the move or check the path"
+        )
     zone_list = list(zones) if zones is not None else None
     bound = SpeedBound(path, limits, zone_list, v_limit)
 

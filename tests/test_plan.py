@@ -156,6 +156,22 @@ def test_impossible_boundary_states():
     assert info.value.s == pytest.approx(1.0, abs=0.05)
 
 
+@pytest.mark.parametrize("length", [4e-156, 1e-40, 1e-12])
+def test_path_shorter_than_a_nanometre_is_rejected_by_name(length):
+    # Nearly coincident waypoints: the solvers used to fail here with misleading messages
+    # (an InfeasibleError "at s=1" at 1e-40 m, a SolverError at 4e-156 m).
+    tiny = Path.from_waypoints([[0.0, 0.0], [length, 0.0]], kind="polyline")
+    with pytest.raises(InvalidInputError, match="`path` is .* shorter than 1e-09 m"):
+        plan(tiny, LGV)
+
+
+def test_two_nanometre_move_matches_the_jerk_limited_closed_form():
+    # Rest to rest where only the jerk limit binds: T = (32 L / J)^(1/3).
+    prof = plan(Path.from_waypoints([[0.0, 0.0], [2e-9, 0.0]], kind="polyline"), LGV)
+    assert prof.duration == pytest.approx((32 * 2e-9 / LGV.j_max) ** (1 / 3), rel=1e-4)
+    assert prof.verify().ok
+
+
 def test_millimetres_and_metres_give_the_same_trajectory():
     pts = np.array([[0, 0], [8, 0], [12, 3], [12, 9]], dtype=float)
     m = plan(Path.from_waypoints(pts), LGV)

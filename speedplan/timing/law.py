@@ -27,12 +27,10 @@ from functools import cached_property
 import numpy as np
 
 from .._checks import FloatArray, IntArray
+from ._quadrature import GL_W, GL_X, piece_integrals
 
 __all__ = ["TimeLaw"]
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
-_GL_X = 0.5 * (_GL_X + 1.0)  # nodes on [0, 1]
-_GL_W = 0.5 * _GL_W
 
 
 @dataclass(frozen=True)
@@ -149,26 +147,17 @@ class TimeLaw:
 
         ``singular_at`` is -1 when the piece starts at standstill (then ``lo = 0``), +1 when it
         ends there (then ``hi`` is the piece width) and 0 otherwise. Offsets are measured from
-        the singular end, so the integrand is evaluated without cancellation.
+        the singular end, so the integrand is evaluated without cancellation; the substitution
+        ``σ = y³`` removes the ``1/v`` singularity (compiled loop:
+        :func:`speedplan.timing._quadrature.piece_integrals`).
         """
-        x = self._knots[0]
-        width = (x[j + 1] - x[j])[:, None]
-        lo, hi, jj = lo[:, None], hi[:, None], j[:, None]
-        y = _GL_X[None, :]
-        left = singular_at[:, None] < 0
-        right = singular_at[:, None] > 0
-        span = hi - lo
-        # σ = y³ substitution removes the 1/v singularity at a standstill end.
-        dx = np.where(left, span * y**3, lo + span * y)
-        dr = np.where(right, span * y**3, width - dx)
-        dx = np.where(right, width - dr, dx)
-        jac = np.where(left | right, 3 * span * y**2, span)
-        jb = np.broadcast_to(jj, dx.shape)
-        u, _, _ = self._u_piece(jb.ravel(), dx.ravel(), dr.ravel())
-        speed = (u ** (0.5 / self.p)).reshape(dx.shape)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f = np.where(jac == 0, 0.0, jac / speed)
-        return np.asarray(f @ _GL_W, dtype=np.float64)
+        x, gk, uc, c = self._knots
+        return piece_integrals(
+            np.ascontiguousarray(j, dtype=np.intp), np.ascontiguousarray(lo, dtype=np.float64),
+            np.ascontiguousarray(hi, dtype=np.float64),
+            np.ascontiguousarray(singular_at, dtype=np.float64), x, gk, uc, float(c),
+            float(self.s[0]), self.length, float(self.p), GL_X, GL_W,
+        )
 
     def _speed(self, q: FloatArray) -> FloatArray:
         u, _, _ = self._u(q)

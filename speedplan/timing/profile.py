@@ -114,15 +114,19 @@ class SpeedProfile:
         """
         times = as_array("t", t)
         tt = np.clip(np.atleast_1d(times), 0.0, self.duration)
-        q = self.law.position_at(tt)
-        _, v, a, jerk = self.law.kinematics(q)
+        q, v, a, jerk, kappa = self._motion(tt)
         xy = np.asarray(self.path.point(q)).reshape(-1, 2)
-        kappa = np.asarray(self.path.curvature(q), dtype=np.float64)
         return Trajectory(
             t=tt, s=q, x=xy[:, 0], y=xy[:, 1],
             heading=np.asarray(self.path.heading(q), dtype=np.float64),
             curvature=kappa, v=v, a=a, j=jerk, a_lat=kappa * v * v,
         )
+
+    def _motion(self, tt: FloatArray) -> tuple[FloatArray, ...]:
+        """``s, v, a, j`` and the curvature at times ``tt`` (within ``[0, duration]``)."""
+        q = self.law.position_at(tt)
+        _, v, a, jerk = self.law.kinematics(q)
+        return q, v, a, jerk, np.asarray(self.path.curvature(q), dtype=np.float64)
 
     def sample(self, dt: float = 0.01) -> Trajectory:
         """Trajectory sampled every ``dt`` seconds from 0; the last sample is at ``duration``.
@@ -132,6 +136,10 @@ class SpeedProfile:
         dt : float
             Sampling period [s], > 0.
         """
+        return self.at(self._sample_times(dt))
+
+    def _sample_times(self, dt: float) -> FloatArray:
+        """``0, dt, 2 dt, ...`` up to the duration, which is always the last sample."""
         step = as_scalar("dt", dt, positive=True)
         n = int(np.floor(self.duration / step + 1e-9)) + 1
         if n > 50_000_000:
@@ -139,10 +147,10 @@ class SpeedProfile:
                 f"`dt`={step!r} gives {n} samples for a {self.duration:.6g} s trajectory; "
                 "use a larger dt"
             )
-        times = np.arange(n) * step
+        times: FloatArray = np.arange(n, dtype=np.float64) * step
         if times[-1] < self.duration - 1e-12 * max(1.0, self.duration):
             times = np.append(times, self.duration)
-        return self.at(times)
+        return times
 
     # ---- checks ---------------------------------------------------------------------------
     def verify(self, dt: float | None = None) -> Verification:
@@ -154,24 +162,26 @@ class SpeedProfile:
             Sampling period [s]; default 1 ms, or ``duration / 200 000`` if that is longer.
         """
         step = dt if dt is not None else max(1e-3, self.duration / 200_000)
-        traj = self.sample(step)
+        # The states of sample(step) that the limits involve: positions and headings are not
+        # needed, and on clothoid paths they cost as much as the time law.
+        q, v, a, jerk, kappa = self._motion(self._sample_times(step))
+        a_lat = kappa * v * v
         lim = self.limits
-        bound = self.speed_bound(traj.s)
+        bound = self.speed_bound(q)
         with np.errstate(divide="ignore", invalid="ignore"):
-            speed_ratio = np.where(bound > 0, traj.v / np.sqrt(bound), np.where(traj.v > 0,
-                                                                                np.inf, 0.0))
+            speed_ratio = np.where(bound > 0, v / np.sqrt(bound), np.where(v > 0, np.inf, 0.0))
 
         def ratio(value: float, limit: float) -> float:
             if not np.isfinite(value):
                 return float("inf")  # a NaN or infinite sample is a violation, never ignored
             return float(value / limit) if np.isfinite(limit) else 0.0
 
-        max_accel = float(np.max(np.append(traj.a, 0.0)))
-        max_decel = float(np.max(np.append(-traj.a, 0.0)))
-        max_jerk = float(np.max(np.abs(traj.j)))
-        max_lat = float(np.max(np.abs(traj.a_lat)))
+        max_accel = float(np.max(np.append(a, 0.0)))
+        max_decel = float(np.max(np.append(-a, 0.0)))
+        max_jerk = float(np.max(np.abs(jerk)))
+        max_lat = float(np.max(np.abs(a_lat)))
         return Verification(
-            max_speed=float(traj.v.max()),
+            max_speed=float(v.max()),
             max_accel=max_accel,
             max_decel=max_decel,
             max_jerk=max_jerk,
