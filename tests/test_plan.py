@@ -161,7 +161,7 @@ def test_path_shorter_than_a_nanometre_is_rejected_by_name(length):
     # Nearly coincident waypoints: the solvers used to fail here with misleading messages
     # (an InfeasibleError "at s=1" at 1e-40 m, a SolverError at 4e-156 m).
     tiny = Path.from_waypoints([[0.0, 0.0], [length, 0.0]], kind="polyline")
-    with pytest.raises(InvalidInputError, match="`path` is .* shorter than 1e-09 m"):
+    with pytest.raises(InvalidInputError, match=r"`path` is .* shorter than 1e-09 m"):
         plan(tiny, LGV)
 
 
