@@ -298,3 +298,25 @@ def test_fine_uniform_grid_gets_the_same_answer_from_auto_and_clarabel():
     # on this grid with its reduced tolerances, its bound then 1.3e-6 below (measured).
     assert auto.solution.objective - auto.lower_bound <= 1e-6 * auto.solution.objective
     assert auto.lower_bound == pytest.approx(ref.lower_bound, rel=1e-5)
+
+
+@pytest.mark.parametrize("name", ["slow_zone.json", "u_turn.json"])
+def test_very_fine_grid_is_answered_by_the_banded_method_on_its_certificate(name):
+    # At n = 20 000 (steps of 1-2 mm) the banded iterates' dual residual stalls near 1e-5
+    # while the certified gap reaches 1e-11 (slow_zone; the rounded gap went negative and the
+    # method used to run to max_iter), or the Newton matrix stops factoring one step after a
+    # certified gap of 1e-7 (u_turn). Such answers are accepted on their certificate, so
+    # "auto" no longer hands these grids to Clarabel (4-6 s there, against under 1 s).
+    import speedplan as sp
+    from speedplan.io import read_path
+
+    path = read_path(str(Path(__file__).parents[1] / "paths" / name))
+    limits = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    prof = sp.plan(path, limits, n=20000, refine="never")
+    sol = prof.solution
+    assert sol.extras["backend"] == "banded"
+    assert sol.extras.get("backend_fallback") is None
+    assert sol.extras["relaxation_status"] in ("Solved", "AlmostSolved")
+    assert prof.status == "optimal"
+    assert sol.objective - sol.lower_bound <= 1e-6 * sol.objective
+    assert prof.verify().ok

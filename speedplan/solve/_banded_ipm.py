@@ -664,9 +664,12 @@ def iterate(
             status = SOLVED
             break
         # Near the optimum the NT scaling becomes ill-conditioned and rounding may stop
-        # progress short of ``tol``; detect that instead of spinning to ``max_iter``.
-        if relgap < 0.5 * best_gap:
-            best_gap, stalled = relgap, 0
+        # progress short of ``tol``; detect that instead of spinning to ``max_iter``. The gap
+        # s'y may round to a tiny negative number once it has converged; clamped at 0, it
+        # then counts as no further progress (unclamped, every negative value "halved" the
+        # previous one and the method ran to max_iter, seen on a 20 000-node grid).
+        if max(relgap, 0.0) < 0.5 * best_gap:
+            best_gap, stalled = max(relgap, 0.0), 0
         else:
             stalled += 1
         if stalled >= STALL_ITERATIONS and best_gap < ALMOST_GAP:
