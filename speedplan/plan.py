@@ -24,9 +24,11 @@ __all__ = ["STANDSTILL_MODES", "SpeedBound", "plan"]
 #: ``"smooth"``: acceleration is 0 at a standstill and jerk-limited from the first instant.
 #: ``"free"``: the paper's model, where acceleration may jump at a standstill.
 STANDSTILL_MODES = ("smooth", "free")
-#: Shortest path planned [m]. Far below any vehicle's resolution; much shorter paths (from
-#: nearly coincident waypoints) made the solvers fail with misleading messages.
-MIN_PATH_LENGTH = 1e-9
+#: Shortest path planned, relative to ``v_max² / a_max`` (4e-9 m for v_max = 2 m/s, a_max = 1
+#: m/s²; relative, so that millimetres and metres agree). Far below any vehicle's resolution;
+#: much shorter paths (nearly coincident waypoints) made the solvers fail with misleading
+#: messages.
+MIN_RELATIVE_LENGTH = 1e-9
 _NO_JERK_NODES = 1001
 
 
@@ -119,8 +121,8 @@ def plan(
     Raises
     ------
     InvalidInputError
-        Malformed arguments, a path shorter than ``MIN_PATH_LENGTH`` (1 nm), or boundary states
-        beyond the limits.
+        Malformed arguments, a path shorter than ``1e-9 v_max² / a_max`` (nearly coincident
+        waypoints), or boundary states beyond the limits.
     InfeasibleError
         No speed law meets the boundary states (the message says which constraint, where).
 
@@ -158,10 +160,12 @@ def plan(
     af = as_scalar("af", af)
     _check_boundary(limits, v0, a0, vf, af, standstill)
     L = float(path.length)
-    if not L >= MIN_PATH_LENGTH:
+    min_length = MIN_RELATIVE_LENGTH * limits.v_max**2 / limits.a_max
+    if not L >= min_length:
         raise InvalidInputError(
-            f"`path` is {L:.3g} m long, shorter than {MIN_PATH_LENGTH:g} m: there is no motion "
-            "to plan (nearly coincident waypoints?); skip the move or check the path"
+            f"`path` is {L:.3g} m long, shorter than {min_length:.3g} m (1e-9 v_max²/a_max): "
+            "there is no motion to plan (nearly coincident waypoints?); skip the move or "
+            "check the path"
         )
     zone_list = list(zones) if zones is not None else None
     bound = SpeedBound(path, limits, zone_list, v_limit)

@@ -163,3 +163,28 @@ def test_zero_speed_bound_inside_is_infeasible():
     w_max[7] = 0.0
     with pytest.raises(InfeasibleError):
         solve_relaxation_banded(_problem(w_max, 1.0, 1.0))
+
+
+@pytest.mark.parametrize("code", ["NUMERICAL_ERROR", "MAX_ITERATIONS", "NO_PROGRESS"])
+def test_banded_stop_is_accepted_on_its_certificate_whatever_stopped_it(monkeypatch, code):
+    # The kernel's stop reason does not decide: a feasible w with a certified gap <= 1e-6 is
+    # "AlmostSolved" (here a converged iterate reported as a failure); a poor one raises.
+    from speedplan.solve import _banded_ipm as ipm
+
+    inst = paper_instance("rnd", "cnst", "cnst", n=200, seed=7)
+    problem = _problem(inst.w_max, inst.A, inst.J)
+    ref = solve_relaxation_banded(problem)
+    assert ref.status == "Solved"
+    real = ipm.iterate
+
+    def relabelled(d, w0, t0, z0, tol, max_iter):
+        w, yl, it, _ = real(d, w0, t0, z0, tol, max_iter)
+        return w, yl, it, getattr(ipm, code)
+
+    monkeypatch.setattr(ipm, "iterate", relabelled)
+    res = solve_relaxation_banded(problem)
+    assert res.status == "AlmostSolved"
+    assert res.primal_objective == ref.primal_objective
+    assert res.primal_objective - res.dual_objective <= 1e-6 * res.primal_objective
+    with pytest.raises(SolverError, match=ipm.STATUS_NAMES[getattr(ipm, code)]):
+        solve_relaxation_banded(problem, max_iter=2)

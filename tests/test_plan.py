@@ -156,19 +156,24 @@ def test_impossible_boundary_states():
     assert info.value.s == pytest.approx(1.0, abs=0.05)
 
 
+@pytest.mark.parametrize("scale", [1.0, 1e3])
 @pytest.mark.parametrize("length", [4e-156, 1e-40, 1e-12])
-def test_path_shorter_than_a_nanometre_is_rejected_by_name(length):
+def test_nearly_zero_length_path_is_rejected_by_name_in_any_unit(length, scale):
     # Nearly coincident waypoints: the solvers used to fail here with misleading messages
-    # (an InfeasibleError "at s=1" at 1e-40 m, a SolverError at 4e-156 m).
-    tiny = Path.from_waypoints([[0.0, 0.0], [length, 0.0]], kind="polyline")
-    with pytest.raises(InvalidInputError, match=r"`path` is .* shorter than 1e-09 m"):
-        plan(tiny, LGV)
+    # (an InfeasibleError "at s=1" at 1e-40 m, a SolverError at 4e-156 m). The threshold is
+    # 1e-9 v_max²/a_max: 4e-9 m for these limits, the same length in millimetres.
+    tiny = Path.from_waypoints([[0.0, 0.0], [length * scale, 0.0]], kind="polyline")
+    lim = Limits(v_max=2.0 * scale, a_max=1.0 * scale, a_lat_max=1.0 * scale,
+                 j_max=0.5 * scale)
+    with pytest.raises(InvalidInputError, match=r"`path` is .* shorter than"):
+        plan(tiny, lim)
 
 
-def test_two_nanometre_move_matches_the_jerk_limited_closed_form():
-    # Rest to rest where only the jerk limit binds: T = (32 L / J)^(1/3).
-    prof = plan(Path.from_waypoints([[0.0, 0.0], [2e-9, 0.0]], kind="polyline"), LGV)
-    assert prof.duration == pytest.approx((32 * 2e-9 / LGV.j_max) ** (1 / 3), rel=1e-4)
+def test_ten_nanometre_move_matches_the_jerk_limited_closed_form():
+    # Just above the threshold, rest to rest where only the jerk limit binds:
+    # T = (32 L / J)^(1/3).
+    prof = plan(Path.from_waypoints([[0.0, 0.0], [1e-8, 0.0]], kind="polyline"), LGV)
+    assert prof.duration == pytest.approx((32 * 1e-8 / LGV.j_max) ** (1 / 3), rel=1e-4)
     assert prof.verify().ok
 
 

@@ -316,7 +316,7 @@ def test_very_fine_grid_is_answered_by_the_banded_method_on_its_certificate(name
     sol = prof.solution
     assert sol.extras["backend"] == "banded"
     assert sol.extras.get("backend_fallback") is None
-    assert sol.extras["relaxation_status"] in ("Solved", "AlmostSolved")
+    assert sol.extras["iterations"] < 50  # 32 and 25 measured; 100 (max_iter) before
     assert prof.status == "optimal"
     assert sol.objective - sol.lower_bound <= 1e-6 * sol.objective
     assert prof.verify().ok

@@ -138,8 +138,8 @@ class CurvePiece(Piece):
     def _parameter(self, flat: FloatArray, j: IntArray) -> FloatArray:
         lo, hi = self._tau[j], self._tau[j + 1]
         span = np.maximum(self._arc[j + 1] - self._arc[j], 1e-300)
-        # Cubic Hermite start from τ and dτ/du = 1/|r'| at the cell's ends: one or two Newton
-        # steps fewer than a linear start, each a 16-point integral per position.
+        # Cubic Hermite start from τ and dτ/du = 1/|r'| at the cell's ends: one Newton step
+        # (a 16-point integral per position) fewer than a linear start on nurbs_edge.json.
         x = (flat - self._arc[j]) / span
         x2, x3 = x * x, x * x * x
         tau = ((2 * x3 - 3 * x2 + 1) * lo + (-2 * x3 + 3 * x2) * hi

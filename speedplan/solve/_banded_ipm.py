@@ -38,7 +38,8 @@ SIGMA_EXPONENT = 3.0
 REFINE_BELOW = 1e-3
 #: Iterations without halving the relative gap after which the method is declared stalled.
 STALL_ITERATIONS = 5
-#: Certified relative gap accepted (as status "AlmostSolved") when the method stalls.
+#: Relative gap below which a stalled method reports STALLED; also the certified relative gap
+#: with which :mod:`~speedplan.solve.banded` accepts any stop short of ``tol`` ("AlmostSolved").
 ALMOST_GAP = 1e-6
 #: Iterations without halving the relative gap after which the method gives up at any gap
 #: (seen on a few long, strongly graded grids, where it jams near a gap of 1e-2; the caller

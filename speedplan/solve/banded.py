@@ -131,13 +131,16 @@ def _lagrangian_bound(
     zero where ``J = inf``) on ``±τ w'' / J - t <= 0``, the multiplier ``λ = 1 - ν⁺ - ν⁻ >= 0``
     of ``t >= τ / sqrt(w)`` makes the Lagrangian free of ``t``; its minimum over the box
     ``w_min <= w <= w_max`` is separable and closed-form (the minimiser of the convex
-    ``g w + c / sqrt(w)`` clipped to the box). Any such multipliers give a valid bound.
+    ``g w + c / sqrt(w)`` clipped to the box). Any such multipliers give a valid bound;
+    non-finite ones (an iterate that broke down) give none, ``-inf``.
     """
+    if not all(np.all(np.isfinite(x)) for x in (mu_acc, mu_dec, nu_p, nu_m)):
+        return -np.inf
     mu_acc, mu_dec = np.maximum(mu_acc, 0.0), np.maximum(mu_dec, 0.0)
     nu_p, nu_m = np.maximum(nu_p, 0.0), np.maximum(nu_m, 0.0)
     excess = np.maximum(nu_p + nu_m, 1.0)  # λ >= 0 needs ν⁺ + ν⁻ <= 1
     nu_p, nu_m = nu_p / excess, nu_m / excess
-    lam = 1.0 - nu_p - nu_m
+    lam = np.maximum(1.0 - nu_p - nu_m, 0.0)  # >= 0 up to rounding; c / g below stays >= 0
     finite = np.isfinite(p.jerk)
     coef = np.where(finite, (nu_p - nu_m) * p.tau / np.where(finite, p.jerk, 1.0), 0.0)
     # Linear coefficient of the full w in the Lagrangian.
@@ -257,8 +260,9 @@ def solve_relaxation_banded(
     InfeasibleError
         If no ``w`` with positive interior values meets the bounds and acceleration rows.
     SolverError
-        If the method does not converge within ``max_iter`` iterations or breaks down
-        numerically (``backend="banded"``; ``status`` says which).
+        If the method stops short of ``tol`` (iteration limit, stall, numerical breakdown or
+        no progress) without a certified relative gap <= 1e-6 and a feasible ``w``
+        (``backend="banded"``; ``status`` says why it stopped).
 
     Examples
     --------
@@ -298,8 +302,8 @@ def solve_relaxation_banded(
         # Like Clarabel's AlmostSolved: accepted only with a certified gap and feasible w,
         # whatever stopped the iteration. Both are checked here, independently of the
         # iterates' residuals: on fine grids the dual residual can stall at 1e-5 while the
-        # certified gap is 1e-11 (paths/slow_zone.json, n = 20 000), or the next Newton
-        # matrix fails to factor one step after a certified gap of 1e-7 (u_turn.json).
+        # certified gap is 3.6e-11 (paths/slow_zone.json, n = 20 000), or the next Newton
+        # matrix fails to factor one step after a certified gap of 9.9e-8 (u_turn.json).
         cert_gap = (primal - dual) / max(abs(primal), 1e-300)
         feasible = problem.linear_violation(w) <= ipm.ALMOST_GAP * max(1.0, w_scale)
         if not (cert_gap <= ipm.ALMOST_GAP and feasible):

@@ -14,11 +14,10 @@ import numpy as np
 from numba import njit
 
 from .._checks import FloatArray, IntArray
+from ..geometry.pieces import GAUSS_NODES as GL_X
+from ..geometry.pieces import GAUSS_WEIGHTS as GL_W
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(16)
-#: Gauss–Legendre nodes and weights on ``[0, 1]``.
-GL_X = 0.5 * (_GL_X + 1.0)
-GL_W = 0.5 * _GL_W
+__all__ = ["GL_W", "GL_X", "piece_integrals"]
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -32,7 +32,6 @@ from ._quadrature import GL_W, GL_X, piece_integrals
 __all__ = ["TimeLaw"]
 
 
-
 @dataclass(frozen=True)
 class TimeLaw:
     """C¹ interpolant ``u(s) = w(s)^p`` and the exact time law it implies.

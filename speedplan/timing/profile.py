@@ -122,7 +122,9 @@ class SpeedProfile:
             curvature=kappa, v=v, a=a, j=jerk, a_lat=kappa * v * v,
         )
 
-    def _motion(self, tt: FloatArray) -> tuple[FloatArray, ...]:
+    def _motion(
+        self, tt: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
         """``s, v, a, j`` and the curvature at times ``tt`` (within ``[0, duration]``)."""
         q = self.law.position_at(tt)
         _, v, a, jerk = self.law.kinematics(q)
