@@ -171,7 +171,7 @@ def test_banded_stop_is_accepted_on_its_certificate_whatever_stopped_it(monkeypa
     # "AlmostSolved" (here a converged iterate reported as a failure); a poor one raises.
     from speedplan.solve import _banded_ipm as ipm
 
-    inst = paper_instance("rnd", "cnst", "cnst", n=200, seed=7)
+    inst = paper_instance("rnd", "cnst", "cnst", n=N, seed=7)
     problem = _problem(inst.w_max, inst.A, inst.J)
     ref = solve_relaxation_banded(problem)
     assert ref.status == "Solved"

@@ -14,10 +14,9 @@ import numpy as np
 from numba import njit
 
 from .._checks import FloatArray, IntArray
-from ..geometry.pieces import GAUSS_NODES as GL_X
-from ..geometry.pieces import GAUSS_WEIGHTS as GL_W
+from ..geometry.pieces import GAUSS_NODES, GAUSS_WEIGHTS
 
-__all__ = ["GL_W", "GL_X", "piece_integrals"]
+__all__ = ["piece_integrals"]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -30,7 +29,7 @@ def _smoothstep(q: float, s0: float, length: float) -> float:
 def piece_integrals(
     j: IntArray, lo: FloatArray, hi: FloatArray, singular_at: FloatArray,
     x: FloatArray, gk: FloatArray, uc: FloatArray, c: float, s0: float, length: float,
-    p: float, gl_x: FloatArray, gl_w: FloatArray,
+    p: float,
 ) -> FloatArray:
     """``∫ ds / v`` over offsets ``[lo_i, hi_i]`` of piece ``j_i``, for every sample ``i``.
 
@@ -49,8 +48,8 @@ def piece_integrals(
         span = hi[i] - lo[i]
         left, right = singular_at[i] < 0.0, singular_at[i] > 0.0
         acc = 0.0
-        for g in range(gl_x.size):
-            y = gl_x[g]
+        for g in range(GAUSS_NODES.size):  # the geometry's 16-point rule on [0, 1]
+            y = GAUSS_NODES[g]
             if left:
                 dx = span * y**3
                 dr = width - dx
@@ -73,6 +72,6 @@ def piece_integrals(
                 anchor = x[k + 1] if nearer_right else x[k]
                 u = u + c * (_smoothstep(x[k] + dx, s0, length)
                              - _smoothstep(anchor, s0, length))
-            acc += gl_w[g] * (jac / max(u, 0.0) ** exponent)
+            acc += GAUSS_WEIGHTS[g] * (jac / max(u, 0.0) ** exponent)
         out[i] = acc
     return out

@@ -27,7 +27,7 @@ from functools import cached_property
 import numpy as np
 
 from .._checks import FloatArray, IntArray
-from ._quadrature import GL_W, GL_X, piece_integrals
+from ._quadrature import piece_integrals
 
 __all__ = ["TimeLaw"]
 
@@ -155,7 +155,7 @@ class TimeLaw:
             np.ascontiguousarray(j, dtype=np.intp), np.ascontiguousarray(lo, dtype=np.float64),
             np.ascontiguousarray(hi, dtype=np.float64),
             np.ascontiguousarray(singular_at, dtype=np.float64), x, gk, uc, float(c),
-            float(self.s[0]), self.length, float(self.p), GL_X, GL_W,
+            float(self.s[0]), self.length, float(self.p),
         )
 
     def _speed(self, q: FloatArray) -> FloatArray:
