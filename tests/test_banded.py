@@ -188,3 +188,60 @@ def test_banded_stop_is_accepted_on_its_certificate_whatever_stopped_it(monkeypa
     assert res.primal_objective - res.dual_objective <= 1e-6 * res.primal_objective
     with pytest.raises(SolverError, match=ipm.STATUS_NAMES[getattr(ipm, code)]):
         solve_relaxation_banded(problem, max_iter=2)
+
+
+def _newton_state(seed: int):
+    """A Newton system of the kernel at a random interior point (sizes of an n=60 problem)."""
+    from speedplan.solve import _banded_ipm as ipm
+    from speedplan.solve.banded import _check_feasible, _prepare, _scales
+
+    inst = paper_instance("rnd", "cnst", "cnst", n=60, seed=seed)
+    p = _problem(inst.w_max, inst.A, inst.J)
+    wmf = _check_feasible(p)
+    s_scale, w_scale = _scales(p, wmf[1:-1])
+    d = _prepare(p.scaled(s_scale, w_scale), wmf[1:-1] / w_scale)
+    m, n_lin = d.cw.size, d.b_lin.size
+    rng = np.random.default_rng(seed)
+
+    def cone_interior():
+        u = rng.normal(size=(3, 2 * m))
+        u[0] = np.hypot(u[1], u[2]) * (1.0 + 10.0 ** rng.uniform(-2, 0, 2 * m))
+        return u
+
+    sl, yl = 10.0 ** rng.uniform(-2, 2, n_lin), 10.0 ** rng.uniform(-2, 2, n_lin)
+    sc = ipm.Scaling(np.ones(2 * m), np.zeros((3, 2 * m)), np.zeros((3, 2 * m)))
+    ipm.scaling_into(cone_interior(), cone_interior(), sc)
+    fac = ipm.Factor(*(np.zeros(n_lin) if f == "hl" else np.zeros(m) for f in ipm.Factor._fields))
+    assert ipm.factor_into(d, sc, yl, sl, fac)
+    rhs = (*rng.normal(size=(3, m)), rng.normal(size=n_lin), rng.normal(size=(3, 2 * m)),
+           rng.normal(size=n_lin), rng.normal(size=(3, 2 * m)))
+    return ipm, d, sc, fac, sl, rhs
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_newton_refines_only_above_its_residual_threshold(seed):
+    # One round of iterative refinement runs iff the residual of G'Δy = bx exceeds
+    # refine_above; below the threshold the unrefined direction is returned as it is.
+    ipm, d, sc, fac, sl, rhs = _newton_state(seed)
+    m, n_lin, nc = d.cw.size, d.b_lin.size, 2 * d.cw.size
+
+    def direction(refine_above):
+        nw = ipm.Work(np.zeros(n_lin), np.zeros(n_lin), np.zeros((3, nc)),
+                      *(np.zeros(m) for _ in range(7)))
+        out = (np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(n_lin), np.zeros((3, nc)),
+               np.zeros(n_lin), np.zeros((3, nc)))
+        ipm.newton_into(d, sc, fac, nw, sl, *rhs, refine_above, *out)
+        gx = (np.zeros(m), np.zeros(m), np.zeros(m))
+        ipm.g_adjoint_into(d, out[5], out[6], *gx, np.zeros(m))
+        residual = np.sqrt(sum(float(np.sum((b - g) ** 2))
+                               for b, g in zip(rhs[:3], gx, strict=True)))
+        return out, residual
+
+    plain, residual = direction(np.inf)
+    refined, _ = direction(0.0)
+    assert residual > 0.0
+    assert any(not np.array_equal(a, b) for a, b in zip(plain, refined, strict=True))
+    for a, b in zip(direction(2.0 * residual)[0], plain, strict=True):
+        np.testing.assert_array_equal(a, b)
+    for a, b in zip(direction(0.5 * residual)[0], refined, strict=True):
+        np.testing.assert_array_equal(a, b)

@@ -34,8 +34,12 @@ from .._checks import FloatArray, IntArray
 STEP = 0.99
 #: Exponent of Mehrotra's centring heuristic ``σ = (1 - α_affine)^3``.
 SIGMA_EXPONENT = 3.0
-#: Relative gap below which each Newton solve gets one round of iterative refinement.
+#: Relative gap below which each Newton solve is checked for iterative refinement.
 REFINE_BELOW = 1e-3
+#: The check refines when the solve's residual in ``G'Δy = bx``, relative like the dual
+#: residual, exceeds this fraction of ``tol``: there it can matter for convergence (fine grids,
+#: strongly varying ``J``); on most instances it is far smaller and a round would be wasted.
+REFINE_RESIDUAL = 0.01
 #: Iterations without halving the relative gap after which the method is declared stalled.
 STALL_ITERATIONS = 5
 #: Relative gap below which a stalled method reports STALLED; also the certified relative gap
@@ -499,13 +503,15 @@ def _dy_into(
 def newton_into(
     d: Data, sc: Scaling, fac: Factor, nw: Work,
     sl: FloatArray, bw: FloatArray, bt: FloatArray, bz: FloatArray, byl: FloatArray,
-    bys: FloatArray, bsl: FloatArray, bss: FloatArray, refine: int,
+    bys: FloatArray, bsl: FloatArray, bss: FloatArray, refine_above: float,
     dw: FloatArray, dt: FloatArray, dz: FloatArray,
     dsl: FloatArray, dss: FloatArray, dyl: FloatArray, dys: FloatArray,
 ) -> None:
     """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs``.
 
-    ``sl`` is the linear slack (``λ W = s`` on the linear rows).
+    ``sl`` is the linear slack (``λ W = s`` on the linear rows). One round of iterative
+    refinement follows if the 2-norm of the residual ``bx - G'Δy`` exceeds ``refine_above``
+    (``inf``: no refinement, and the residual is not computed).
     """
     # v = H by - W⁻¹ u with λ ∘ u = bs; then (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
     for j in range(bsl.size):
@@ -527,12 +533,16 @@ def newton_into(
     # The last two equations hold by construction; only G'Δy = bx inherits the rounding of
     # the reduced solve, which grows as H becomes ill-conditioned near the optimum. A round
     # of iterative refinement with the same factor restores it.
-    for _ in range(refine):
+    if refine_above < np.inf:
         g_adjoint_into(d, dyl, dys, rw, rt, rz, nw.u)
+        res2 = 0.0
         for i in range(rw.size):
             rw[i] = bw[i] - rw[i]
             rt[i] = bt[i] - rt[i]
             rz[i] = bz[i] - rz[i]
+            res2 += rw[i] * rw[i] + rt[i] * rt[i] + rz[i] * rz[i]
+        if not math.sqrt(res2) > refine_above:
+            return
         solve_normal_into(d, fac, rw, rt, rz, nw.cw, nw.ct, nw.cz, nw.u)
         for i in range(rw.size):
             dw[i] += nw.cw[i]
@@ -689,8 +699,9 @@ def iterate(
             status = NUMERICAL_ERROR
             break
         mu = gap / nu
-        # Refinement only pays once the scaling is ill-conditioned, close to the optimum.
-        refine = 1 if relgap < REFINE_BELOW else 0
+        # Refinement only pays once the scaling is ill-conditioned, close to the optimum, and
+        # only where the solve's own residual could show in the dual residual's test.
+        refine_above = REFINE_RESIDUAL * tol * res_x0 if relgap < REFINE_BELOW else np.inf
         # Right-hand side -λ∘λ (λ∘λ = s y on the linear rows).
         for j in range(n_lin):
             bsl[j] = -sl[j] * yl[j]
@@ -700,7 +711,7 @@ def iterate(
             bss[1, c] = -2.0 * lam[0, c] * lam[1, c]
             bss[2, c] = -2.0 * lam[0, c] * lam[2, c]
         # Predictor (affine-scaling) direction.
-        newton_into(d, sc, fac, nw, sl, gw, gt, gz, ryl, rys, bsl, bss, refine,
+        newton_into(d, sc, fac, nw, sl, gw, gt, gz, ryl, rys, bsl, bss, refine_above,
                     dw, dt, dz, dsl, dss, dyl, dys)
         alpha = min(max_step_lin(sl, dsl), max_step_lin(yl, dyl),
                     max_step_soc(ss, dss), max_step_soc(ys, dys))
@@ -714,7 +725,7 @@ def iterate(
             bss[0, c] += -(a0 * b0 + a1 * b1 + a2 * b2) + sigma * mu
             bss[1, c] += -(a0 * b1 + b0 * a1)
             bss[2, c] += -(a0 * b2 + b0 * a2)
-        newton_into(d, sc, fac, nw, sl, gw, gt, gz, ryl, rys, bsl, bss, refine,
+        newton_into(d, sc, fac, nw, sl, gw, gt, gz, ryl, rys, bsl, bss, refine_above,
                     dw, dt, dz, dsl, dss, dyl, dys)
         alpha_p = min(1.0, STEP * min(
             max_step_lin(sl, dsl), max_step_lin(yl, dyl),
