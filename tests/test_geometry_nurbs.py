@@ -63,6 +63,31 @@ def test_nurbs_path_points_match_de_boor_at_the_inverted_parameter():
         np.testing.assert_allclose(p.point(si), nurbs_point(K, KNOTS, CTRL, W, ti), atol=1e-12)
 
 
+@pytest.mark.parametrize("weights", [[1, 200, 0.01, 100, 0.01, 1], [1, 1e3, 1e-3, 1e3, 1e-3, 1]])
+def test_extreme_weights_arc_length_is_resolved(weights):
+    # |r'| varies by orders of magnitude inside one table cell: the table is refined until
+    # each cell's arc length is resolved (one 16-point rule was off by up to 0.86 m here), and
+    # the inversion still lands on σ(τ) = s.
+    w = np.asarray(weights, dtype=float)
+    p = Path.from_nurbs(K, KNOTS, CTRL, w)
+    piece = p.pieces[0]
+
+    def speed(x):
+        return float(np.linalg.norm(piece.curve(np.array([x]), 1)[0]))
+
+    def arc(a, b):
+        pts = [x for x in (0.4, 0.7) if a < x < b]
+        return quad(speed, a, b, points=pts or None, epsabs=1e-13, epsrel=1e-13, limit=500)[0]
+
+    assert p.length == pytest.approx(arc(0.0, 1.0), rel=1e-10)
+    s = np.linspace(0.0, p.length, 41)
+    tau = piece.parameter(s)
+    assert (np.diff(tau) > 0).all()
+    for si, ti in zip(s[1:-1], tau[1:-1], strict=True):
+        assert arc(0.0, ti) == pytest.approx(si, abs=1e-9)
+        np.testing.assert_allclose(p.point(si), nurbs_point(K, KNOTS, CTRL, w, ti), atol=1e-12)
+
+
 def test_rational_quarter_circle_is_exact():
     c = np.sqrt(0.5)
     p = Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[1, 0], [1, 1], [0, 1]], [1, c, 1])

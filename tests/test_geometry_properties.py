@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import os
 
 import numpy as np
@@ -109,3 +110,40 @@ def test_waypoint_paths(case, n):
 @given(p=nurbs_paths(), n=st.integers(2, 400))
 def test_nurbs_paths(p, n):
     check_invariants(p, unit_tol=1e-6, n=n)
+
+
+@SETTINGS
+@given(k=st.integers(1, 3), data=st.data())
+def test_nurbs_arc_length_with_weights_over_five_decades(k, data):
+    # |r'| may vary by orders of magnitude inside a polynomial piece; length and arc-length
+    # inversion must still be exact (scipy's adaptive quadrature is the reference).
+    from scipy.integrate import quad
+
+    from speedplan import InvalidInputError
+
+    m = data.draw(st.integers(k + 1, 7))
+    steps = np.array(data.draw(st.lists(st.tuples(st.floats(1, 5), st.floats(-2, 2)),
+                                        min_size=m - 1, max_size=m - 1)))
+    ctrl = np.vstack(([0.0, 0.0], np.cumsum(steps, axis=0)))
+    w = 10.0 ** np.array(data.draw(st.lists(st.floats(-2.5, 2.5), min_size=m, max_size=m)))
+    knots = np.concatenate((np.zeros(k + 1), np.linspace(0, 1, m - k + 1)[1:-1], np.ones(k + 1)))
+    try:
+        p = Path.from_nurbs(k, knots, ctrl, w)
+    except InvalidInputError:  # a cusp (|r'| = 0): refused, as it should be
+        assume(False)
+    assert len(p.pieces) == 1
+    piece = p.pieces[0]
+    breaks = np.asarray(piece.curve.breaks)
+
+    def arc(t):
+        def speed(x):
+            return float(np.linalg.norm(piece.curve(np.array([x]), 1)[0]))
+
+        ends = np.append(breaks[breaks < t], t)
+        return sum(quad(speed, a, b, epsabs=1e-13, epsrel=1e-13, limit=500)[0]
+                   for a, b in itertools.pairwise(ends))
+
+    assert p.length == pytest.approx(arc(breaks[-1]), rel=1e-9)
+    s = np.linspace(0.0, p.length, 9)[1:-1]
+    for si, ti in zip(s, piece.parameter(s), strict=True):
+        assert arc(ti) == pytest.approx(si, abs=1e-9 * p.length)

@@ -29,6 +29,17 @@ GAUSS_NODES, GAUSS_WEIGHTS = 0.5 * (GAUSS_NODES + 1.0), 0.5 * GAUSS_WEIGHTS
 
 #: Sub-intervals per polynomial piece in the arc-length table of a :class:`CurvePiece`.
 _TABLE_SPLIT = 8
+#: At most this many rounds of halving the table cells where the arc length is not resolved.
+_TABLE_HALVINGS = 40
+#: At most this many safeguarded Newton steps per arc-length inversion (2-3 in practice; 60
+#: bisections would shrink a cell's bracket to rounding).
+_INVERSION_STEPS = 60
+#: 4-point Gauss–Legendre rule on [0, 1] for the arc length over a Newton step of the
+#: inversion; used for steps of at most ``_SHORT_STEP`` of a table cell, where it is exact to
+#: rounding (a cell takes the 16-point rule).
+_SHORT_NODES, _SHORT_WEIGHTS = np.polynomial.legendre.leggauss(4)
+_SHORT_NODES, _SHORT_WEIGHTS = 0.5 * (_SHORT_NODES + 1.0), 0.5 * _SHORT_WEIGHTS
+_SHORT_STEP = 1e-3
 
 
 class Piece:
@@ -93,9 +104,8 @@ class CurvePiece(Piece):
 
     def __post_init__(self) -> None:
         b = np.asarray(self.curve.breaks, dtype=np.float64)
-        frac = np.linspace(0.0, 1.0, _TABLE_SPLIT + 1)[:-1]
-        tau = np.append((b[:-1, None] + np.diff(b)[:, None] * frac[None, :]).ravel(), b[-1])
-        arc = np.concatenate(([0.0], np.cumsum(self._speed_integral(tau[:-1], tau[1:]))))
+        tau, cells = self._arc_table(b)
+        arc = np.concatenate(([0.0], np.cumsum(cells)))
         d1 = self.curve(tau, 1)
         speed = np.linalg.norm(d1, axis=1)
         mean_speed = arc[-1] / max(float(b[-1] - b[0]), 1e-300)
@@ -116,12 +126,44 @@ class CurvePiece(Piece):
         set_(self, "_dtau", 1.0 / np.maximum(speed, 1e-300))  # dτ/du at the table nodes
         set_(self, "length", float(arc[-1]))
 
-    def _speed_integral(self, a: FloatArray, b: FloatArray) -> FloatArray:
-        """``∫_a^b |r'(τ)| dτ`` elementwise (one 16-point rule per interval)."""
+    def _arc_table(self, breaks: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Table nodes ``τ`` and the arc length of each cell between them.
+
+        ``_TABLE_SPLIT`` cells per polynomial piece, halved until one rule over the cell and
+        one over each half agree to ``1e-15`` of the curve's length: where ``|r'|`` varies by
+        orders of magnitude within a cell (a NURBS with weights 200 and 0.01), a single rule
+        is off by metres and the inversion would not converge.
+        """
+        frac = np.linspace(0.0, 1.0, _TABLE_SPLIT + 1)[:-1]
+        tau = np.append((breaks[:-1, None] + np.diff(breaks)[:, None] * frac[None, :]).ravel(),
+                        breaks[-1])
+        cells = self._speed_integral(tau[:-1], tau[1:])
+        for _ in range(_TABLE_HALVINGS):
+            mid = 0.5 * (tau[:-1] + tau[1:])
+            left, right = self._speed_integral(tau[:-1], mid), self._speed_integral(mid, tau[1:])
+            tol = 1e-15 * max(float(np.sum(left + right)), 1.0)
+            split = (np.abs(left + right - cells) > tol) & (mid > tau[:-1]) & (mid < tau[1:])
+            if not split.any():
+                break
+            first = np.cumsum(np.where(split, 2, 1)) - np.where(split, 2, 1)
+            new_tau = np.empty(first[-1] + (2 if split[-1] else 1) + 1)
+            new_cells = np.empty(new_tau.size - 1)
+            new_tau[first], new_tau[-1] = tau[:-1], tau[-1]
+            new_cells[first] = np.where(split, left, cells)
+            new_tau[first[split] + 1], new_cells[first[split] + 1] = mid[split], right[split]
+            tau, cells = new_tau, new_cells
+        return tau, cells
+
+    def _speed_integral(
+        self, a: FloatArray, b: FloatArray, rule: tuple[FloatArray, FloatArray] = (
+            GAUSS_NODES, GAUSS_WEIGHTS)
+    ) -> FloatArray:
+        """``∫_a^b |r'(τ)| dτ`` elementwise (one Gauss–Legendre ``rule`` per interval)."""
+        x, weights = rule
         width = (b - a)[:, None]
-        nodes = (a[:, None] + width * GAUSS_NODES[None, :]).ravel()
-        speed = np.linalg.norm(self.curve(nodes, 1), axis=-1).reshape(-1, GAUSS_NODES.size)
-        out: FloatArray = (speed * width) @ GAUSS_WEIGHTS
+        nodes = (a[:, None] + width * x[None, :]).ravel()
+        speed = np.linalg.norm(self.curve(nodes, 1), axis=-1).reshape(-1, x.size)
+        out: FloatArray = (speed * width) @ weights
         return out
 
     def _cell(self, u: FloatArray) -> tuple[FloatArray, IntArray]:
@@ -146,13 +188,25 @@ class CurvePiece(Piece):
                + span * ((x3 - 2 * x2 + x) * self._dtau[j] + (x3 - x2) * self._dtau[j + 1]))
         tau = np.clip(tau, lo, hi)
         tol = 1e-14 * max(self.length, 1.0)
-        for _ in range(30):
-            f = self._arc[j] + self._speed_integral(lo, tau) - flat
+        f = self._arc[j] + self._speed_integral(lo, tau) - flat  # σ(τ) - u
+        a, b = lo, hi  # σ(a) <= u <= σ(b)
+        for _ in range(_INVERSION_STEPS):
             if np.all(np.abs(f) <= tol):
                 break
+            a, b = np.where(f < 0, tau, a), np.where(f < 0, b, tau)
             speed = np.linalg.norm(self.curve(tau, 1), axis=-1)
-            # Clipping to the cell keeps Newton inside the bracket where σ is monotone.
-            tau = np.clip(tau - f / np.maximum(speed, 1e-300), lo, hi)
+            # Newton inside the bracket, bisection otherwise: converges however |r'| varies.
+            new = tau - f / np.maximum(speed, 1e-300)
+            new = np.where((new >= a) & (new <= b), new, 0.5 * (a + b))
+            if np.array_equal(new, tau):
+                break  # where |r'| is huge, a step below τ's rounding still moves σ by > tol
+            # σ(new) - u = f + ∫_τ^new |r'|: over a short step 4 points do what 16 do over
+            # the cell from its start (half the time of the inversion on nurbs_edge.json).
+            f = f + self._speed_integral(tau, new, (_SHORT_NODES, _SHORT_WEIGHTS))
+            far = np.abs(new - tau) > _SHORT_STEP * (hi - lo)
+            if np.any(far):
+                f[far] = self._arc[j[far]] + self._speed_integral(lo[far], new[far]) - flat[far]
+            tau = new
         out: FloatArray = tau
         return out
 
