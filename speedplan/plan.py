@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ._checks import FloatArray, as_scalar, choice
 from .errors import InfeasibleError, InvalidInputError, LimitWarning
-from .geometry import Path, SpeedZone, speed_bounds
+from .geometry import Path, SpeedBound, SpeedZone
 from .limits import Limits
 from .solve import DiscreteProblem, solve_problem
 from .solve.boundary import check_boundary_state, jerk_motion_w, max_jerk_envelope
@@ -30,23 +29,6 @@ STANDSTILL_MODES = ("smooth", "free")
 #: messages.
 MIN_RELATIVE_LENGTH = 1e-9
 _NO_JERK_NODES = 1001
-
-
-@dataclass(frozen=True)
-class SpeedBound:
-    """``s -> mu+(s)`` for one path, limits and zones: a picklable callable [m²/s²]."""
-
-    path: Path
-    limits: Limits
-    zones: list[SpeedZone] | None = None
-    v_limit: Any = None
-
-    def __call__(self, s: FloatArray) -> FloatArray:
-        """Bound at arc lengths ``s`` [m²/s²]."""
-        return np.asarray(
-            speed_bounds(self.path, self.limits, s, zones=self.zones, v_limit=self.v_limit),
-            dtype=np.float64,
-        )
 
 
 def _check_boundary(limits: Limits, v0: float, a0: float, vf: float, af: float,

@@ -107,3 +107,18 @@ def test_speed_zone_validation():
         speed_bounds(p, LIM, [2.0])
     with pytest.raises(InvalidInputError, match="`limits`"):
         speed_bounds(p, {"v_max": 1}, [0.5])
+
+
+def test_speed_bound_given_curvature_is_the_same_bound():
+    # SpeedProfile.verify passes the curvature it already has; the bound must not change.
+    from speedplan.geometry import SpeedBound
+
+    p = Path.from_segments([Line(5.0), Arc(2.0, 1.5), Clothoid(4.0, 0.5, -0.3)])
+    zone = SpeedZone([(1, -1), (3, -1), (3, 1), (1, 1)], v_max=0.5)
+    bound = SpeedBound(p, LIM, [zone], v_limit=([0.0, p.length], [2.0, 0.8]))
+    s = np.linspace(0, p.length, 301)
+    np.testing.assert_array_equal(bound.given_curvature(s, p.curvature(s)), bound(s))
+    np.testing.assert_array_equal(bound(s), speed_bounds(p, LIM, s, zones=[zone],
+                                                        v_limit=([0.0, p.length], [2.0, 0.8])))
+    with pytest.raises(InvalidInputError, match="curvature"):
+        bound.given_curvature(s, p.curvature(s)[:-1])

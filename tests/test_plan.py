@@ -217,3 +217,14 @@ def test_moving_start_that_must_brake_is_jerk_limited_from_its_first_instant():
     with pytest.raises(InfeasibleError, match="j_max") as info:
         plan(near, LGV, v0=2.0, zones=[close_zone])
     assert info.value.constraint == "jerk" and info.value.s == pytest.approx(2.0, abs=0.05)
+
+
+def test_verify_with_plans_bound_equals_verify_with_any_callable():
+    # verify() hands plan()'s SpeedBound the curvature it already has; a plain callable
+    # (which gets only s) must measure exactly the same on a zone path and a NURBS path.
+    import dataclasses
+
+    for name in ("slow_zone.json", "nurbs_edge.json"):
+        prof = plan(read_path(f"paths/{name}"), LGV, zones=read_zones(f"paths/{name}"))
+        generic = dataclasses.replace(prof, speed_bound=lambda s, b=prof.speed_bound: b(s))
+        assert prof.verify() == generic.verify()

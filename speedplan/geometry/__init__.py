@@ -10,13 +10,13 @@ Modules, one job each:
   parametric curves;
 * :mod:`~speedplan.geometry.fitting` — waypoints to G1 clothoid chain, spline or polyline;
 * :mod:`~speedplan.geometry.nurbs` — NURBS (VDA 5050 ``trajectory``);
-* :mod:`~speedplan.geometry.bounds` — :func:`speed_bounds` ``mu+(s)``, :class:`SpeedZone`,
-  :func:`zone_intervals`.
+* :mod:`~speedplan.geometry.bounds` — :func:`speed_bounds` ``mu+(s)``, :class:`SpeedBound`,
+  :class:`SpeedZone`, :func:`zone_intervals`.
 
 This layer imports only ``errors``, ``_checks`` and ``limits``.
 """
 
-from .bounds import SpeedZone, speed_bounds, zone_intervals
+from .bounds import SpeedBound, SpeedZone, speed_bounds, zone_intervals
 from .path import Arc, Clothoid, Line, Path, PathSamples
 
 __all__ = [
@@ -25,6 +25,7 @@ __all__ = [
     "Line",
     "Path",
     "PathSamples",
+    "SpeedBound",
     "SpeedZone",
     "speed_bounds",
     "zone_intervals",

@@ -14,7 +14,7 @@ from ..errors import InvalidInputError
 from ..limits import Limits
 from .path import Path
 
-__all__ = ["SpeedZone", "speed_bounds", "zone_intervals"]
+__all__ = ["SpeedBound", "SpeedZone", "speed_bounds", "zone_intervals"]
 
 
 @dataclass(frozen=True)
@@ -113,8 +113,17 @@ def speed_bounds(
         raise InvalidInputError(f"`limits` must be a speedplan.Limits; got {type(limits).__name__}")
     zone_list = _check_zones(zones)
     q = as_array("s", s)
+    # path.curvature also checks that s lies on the path.
+    return _bounds(path, limits, q, path.curvature(q), zone_list, v_limit)
+
+
+def _bounds(
+    path: Path, limits: Limits, q: FloatArray, curvature: FloatArray,
+    zone_list: list[SpeedZone], v_limit: Any,
+) -> FloatArray:
+    """:func:`speed_bounds` at ``q`` once the path's curvature there is known."""
     w = np.full(q.shape, limits.v_max**2)
-    kappa = np.abs(path.curvature(q))  # also checks that s lies on the path
+    kappa = np.abs(curvature)
     if np.isfinite(limits.a_lat_max):
         with np.errstate(divide="ignore"):
             w = np.minimum(w, np.where(kappa > 0, limits.a_lat_max / kappa, np.inf))
@@ -128,6 +137,47 @@ def speed_bounds(
         v = np.interp(q, sk, vk)
         w = np.minimum(w, np.where(np.isnan(v), np.inf, v) ** 2)  # inf knots may give inf*0
     return w
+
+
+@dataclass(frozen=True)
+class SpeedBound:
+    """``s -> mu+(s)`` for one path, limits and zones: a picklable callable [m²/s²].
+
+    Calling it is :func:`speed_bounds` with the stored arguments.
+
+    Examples
+    --------
+    >>> from speedplan import Limits, Path
+    >>> from speedplan.geometry import Arc, Line, SpeedBound
+    >>> p = Path.from_segments([Line(5.0), Arc(radius=2.0, angle=1.0)])
+    >>> bound = SpeedBound(p, Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    >>> bound([1.0, 6.0]).tolist(), bound.given_curvature([6.0], [0.5]).tolist()
+    ([4.0, 2.0], [2.0])
+    """
+
+    path: Path
+    limits: Limits
+    zones: list[SpeedZone] | None = None
+    v_limit: Any = None
+
+    def __call__(self, s: FloatArray) -> FloatArray:
+        """Bound at arc lengths ``s`` [m²/s²]."""
+        return speed_bounds(self.path, self.limits, s, zones=self.zones, v_limit=self.v_limit)
+
+    def given_curvature(self, s: Any, curvature: Any) -> FloatArray:
+        """Bound at arc lengths ``s`` [m] where the path's ``curvature`` [1/m] is known.
+
+        Saves evaluating the curvature again, which on spline and NURBS paths is an
+        arc-length inversion (``SpeedProfile.verify`` has it already). Neither ``s`` nor
+        ``curvature`` is checked against the path.
+        """
+        q = as_array("s", s)
+        kappa = as_array("curvature", curvature, allow_inf=True)
+        if kappa.shape != q.shape:
+            raise InvalidInputError(
+                f"`curvature` must have the shape of `s` {q.shape}; got {kappa.shape}"
+            )
+        return _bounds(self.path, self.limits, q, kappa, _check_zones(self.zones), self.v_limit)
 
 
 def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:

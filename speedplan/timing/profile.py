@@ -11,6 +11,7 @@ import numpy as np
 
 from .._checks import FloatArray, as_array, as_scalar
 from ..errors import InvalidInputError
+from ..geometry.bounds import SpeedBound
 from ..limits import Limits
 from ..solve.solution import DiscreteSolution
 from .law import TimeLaw
@@ -169,7 +170,10 @@ class SpeedProfile:
         q, v, a, jerk, kappa = self._motion(self._sample_times(step))
         a_lat = kappa * v * v
         lim = self.limits
-        bound = self.speed_bound(q)
+        if isinstance(self.speed_bound, SpeedBound):  # plan()'s: reuse the curvature
+            bound = self.speed_bound.given_curvature(q, kappa)
+        else:
+            bound = self.speed_bound(q)
         with np.errstate(divide="ignore", invalid="ignore"):
             speed_ratio = np.where(bound > 0, v / np.sqrt(bound), np.where(v > 0, np.inf, 0.0))
 
