@@ -138,19 +138,25 @@ class CurvePiece(Piece):
         tau = np.append((breaks[:-1, None] + np.diff(breaks)[:, None] * frac[None, :]).ravel(),
                         breaks[-1])
         cells = self._speed_integral(tau[:-1], tau[1:])
+        tol = 1e-15 * max(float(np.sum(cells)), 1.0)
+        pending = np.ones(cells.size, dtype=bool)  # cells not yet compared with their halves
         for _ in range(_TABLE_HALVINGS):
-            mid = 0.5 * (tau[:-1] + tau[1:])
-            left, right = self._speed_integral(tau[:-1], mid), self._speed_integral(mid, tau[1:])
-            tol = 1e-15 * max(float(np.sum(left + right)), 1.0)
-            split = (np.abs(left + right - cells) > tol) & (mid > tau[:-1]) & (mid < tau[1:])
-            if not split.any():
+            lo, hi = tau[:-1][pending], tau[1:][pending]
+            mid = 0.5 * (lo + hi)
+            left, right = self._speed_integral(lo, mid), self._speed_integral(mid, hi)
+            bad = (np.abs(left + right - cells[pending]) > tol) & (mid > lo) & (mid < hi)
+            if not bad.any():
                 break
-            first = np.cumsum(np.where(split, 2, 1)) - np.where(split, 2, 1)
-            new_tau = np.empty(first[-1] + (2 if split[-1] else 1) + 1)
-            new_cells = np.empty(new_tau.size - 1)
-            new_tau[first], new_tau[-1] = tau[:-1], tau[-1]
-            new_cells[first] = np.where(split, left, cells)
-            new_tau[first[split] + 1], new_cells[first[split] + 1] = mid[split], right[split]
+            idx = np.flatnonzero(pending)[bad]
+            count = np.ones(cells.size, dtype=np.intp)
+            count[idx] = 2
+            first = np.cumsum(count) - count  # where each old cell starts in the new table
+            new_tau, new_cells = np.empty(count.sum() + 1), np.empty(count.sum())
+            new_tau[first], new_tau[-1], new_cells[first] = tau[:-1], tau[-1], cells
+            new_cells[first[idx]] = left[bad]
+            new_tau[first[idx] + 1], new_cells[first[idx] + 1] = mid[bad], right[bad]
+            pending = np.zeros(new_cells.size, dtype=bool)
+            pending[first[idx]] = pending[first[idx] + 1] = True
             tau, cells = new_tau, new_cells
         return tau, cells
 
