@@ -7,8 +7,8 @@ Clarabel (``benchmarks/plain_clarabel.py``); times include building the problem.
 settings worth knowing are measured as separate rows: ``clarabel-noir`` (iterative refinement
 off) and ``clarabel-tol6`` (gap and feasibility tolerances 1e-6 instead of 1e-8). A second
 table times the exact no-jerk pass (``solve_discrete`` with ``J = inf``) up to n = 10^6.
-The last column, time per node and iteration, shows where the working set (about 1.3 kB per
-node for the banded method) leaves the CPU caches.
+The last column, wall time (building included, as in the time column) per node and iteration,
+shows where the banded method's working set (about 1.3 kB per node) leaves the CPU caches.
 
     cd benchmarks && python bench_relaxation.py --sizes 1000 10000 100000 --repeats 5
 """

@@ -113,7 +113,7 @@ def test_nurbs_paths(p, n):
 
 
 @SETTINGS
-@given(k=st.integers(1, 3), data=st.data())
+@given(k=st.integers(2, 3), data=st.data())
 def test_nurbs_arc_length_with_weights_over_five_decades(k, data):
     # |r'| may vary by orders of magnitude inside a polynomial piece; length and arc-length
     # inversion must still be exact (scipy's adaptive quadrature is the reference).
@@ -129,7 +129,8 @@ def test_nurbs_arc_length_with_weights_over_five_decades(k, data):
     knots = np.concatenate((np.zeros(k + 1), np.linspace(0, 1, m - k + 1)[1:-1], np.ones(k + 1)))
     try:
         p = Path.from_nurbs(k, knots, ctrl, w)
-    except InvalidInputError:  # a cusp (|r'| = 0): refused, as it should be
+    except InvalidInputError as exc:  # only a (near-)cusp may be refused
+        assert "reverses direction" in str(exc)
         assume(False)
     assert len(p.pieces) == 1
     piece = p.pieces[0]

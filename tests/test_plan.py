@@ -224,7 +224,21 @@ def test_verify_with_plans_bound_equals_verify_with_any_callable():
     # (which gets only s) must measure exactly the same on a zone path and a NURBS path.
     import dataclasses
 
+    from speedplan.geometry import SpeedBound
+
     for name in ("slow_zone.json", "nurbs_edge.json"):
         prof = plan(read_path(f"paths/{name}"), LGV, zones=read_zones(f"paths/{name}"))
+        assert isinstance(prof.speed_bound, SpeedBound)  # so verify() takes the shortcut
         generic = dataclasses.replace(prof, speed_bound=lambda s, b=prof.speed_bound: b(s))
         assert prof.verify() == generic.verify()
+
+
+def test_verify_uses_the_bounds_own_path_when_the_profile_has_another():
+    # The curvature shortcut is only right when bound and profile share the path.
+    import dataclasses
+
+    short = plan(Path.from_segments([Line(3.0), Arc(1.0, 1.0)]), LGV)
+    other = Path.from_segments([Line(3.0), Arc(4.0, 0.25)])
+    moved = dataclasses.replace(short, path=other)
+    generic = dataclasses.replace(moved, speed_bound=lambda s, b=short.speed_bound: b(s))
+    assert moved.verify() == generic.verify()

@@ -172,7 +172,7 @@ class SpeedBound:
         ``curvature`` is checked against the path.
         """
         q = as_array("s", s)
-        kappa = as_array("curvature", curvature, allow_inf=True)
+        kappa = np.asarray(curvature, dtype=np.float64)  # NaN passes: verify() reports it
         if kappa.shape != q.shape:
             raise InvalidInputError(
                 f"`curvature` must have the shape of `s` {q.shape}; got {kappa.shape}"

@@ -89,10 +89,10 @@ class ParametricCurve(Protocol):
 class CurvePiece(Piece):
     """A parametric curve reparametrised by arc length.
 
-    The arc length ``σ(τ) = ∫|r'|`` is tabulated on 8 sub-intervals per polynomial piece with a
-    16-point Gauss–Legendre rule (accurate to rounding for smooth ``|r'|``); ``τ(u)`` solves
-    ``σ(τ) = u`` by Newton's method inside the bracketing table cell, so ``point(u)`` moves at
-    unit speed.
+    The arc length ``σ(τ) = ∫|r'|`` is tabulated with a 16-point Gauss–Legendre rule on 8
+    cells per polynomial piece, each halved until the rule resolves it (see
+    :meth:`_arc_table`); ``τ(u)`` solves ``σ(τ) = u`` by Newton's method kept inside the
+    bracketing table cell, so ``point(u)`` moves at unit speed.
     """
 
     curve: ParametricCurve
@@ -104,18 +104,24 @@ class CurvePiece(Piece):
 
     def __post_init__(self) -> None:
         b = np.asarray(self.curve.breaks, dtype=np.float64)
-        tau, cells = self._arc_table(b)
+        frac = np.linspace(0.0, 1.0, _TABLE_SPLIT + 1)[:-1]
+        coarse = np.append((b[:-1, None] + np.diff(b)[:, None] * frac[None, :]).ravel(), b[-1])
+        tau, cells = self._arc_table(coarse)
         arc = np.concatenate(([0.0], np.cumsum(cells)))
         d1 = self.curve(tau, 1)
         speed = np.linalg.norm(d1, axis=1)
         mean_speed = arc[-1] / max(float(b[-1] - b[0]), 1e-300)
-        if mean_speed > 0 and speed.min() <= 1e-6 * mean_speed:  # zero length: callers say
+        # Tested on the unrefined nodes: the refinement puts nodes into slow stretches of
+        # curves that do not turn back, and would refuse them.
+        coarse_speed = np.linalg.norm(self.curve(coarse, 1), axis=1)
+        if mean_speed > 0 and coarse_speed.min() <= 1e-6 * mean_speed:  # zero length: callers
             # |r'| = 0: the curve stops and turns back (a cusp); heading and curvature are
             # undefined there and a vehicle would have to reverse.
-            i = int(np.argmin(speed))
+            i = int(np.argmin(coarse_speed))
             raise InvalidInputError(
-                f"the curve reverses direction (a cusp, |r'| = 0) near parameter {tau[i]:.6g}; "
-                "the waypoints or control points double back — split the path there"
+                f"the curve reverses direction (a cusp, |r'| = 0) near parameter "
+                f"{coarse[i]:.6g}; the waypoints or control points double back — split the "
+                "path there"
             )
         # Unwrapped headings at the table nodes anchor a continuous heading(u).
         theta = np.unwrap(np.arctan2(d1[:, 1], d1[:, 0]))
@@ -126,17 +132,15 @@ class CurvePiece(Piece):
         set_(self, "_dtau", 1.0 / np.maximum(speed, 1e-300))  # dτ/du at the table nodes
         set_(self, "length", float(arc[-1]))
 
-    def _arc_table(self, breaks: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Table nodes ``τ`` and the arc length of each cell between them.
+    def _arc_table(self, nodes: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Table nodes ``τ`` (``nodes``, refined) and the arc length of each cell between them.
 
-        ``_TABLE_SPLIT`` cells per polynomial piece, halved until one rule over the cell and
-        one over each half agree to ``1e-15`` of the curve's length: where ``|r'|`` varies by
-        orders of magnitude within a cell (a NURBS with weights 200 and 0.01), a single rule
-        is off by metres and the inversion would not converge.
+        Cells are halved until one rule over the cell and one over each half agree to 1e-15
+        of the curve's length (of 1 m if shorter): where ``|r'|`` varies by orders of
+        magnitude within a cell (a NURBS with weights 200 and 0.01), a single rule is off by
+        metres and the inversion would not converge.
         """
-        frac = np.linspace(0.0, 1.0, _TABLE_SPLIT + 1)[:-1]
-        tau = np.append((breaks[:-1, None] + np.diff(breaks)[:, None] * frac[None, :]).ravel(),
-                        breaks[-1])
+        tau = nodes
         cells = self._speed_integral(tau[:-1], tau[1:])
         tol = 1e-15 * max(float(np.sum(cells)), 1.0)
         pending = np.ones(cells.size, dtype=bool)  # cells not yet compared with their halves
@@ -158,6 +162,12 @@ class CurvePiece(Piece):
             pending = np.zeros(new_cells.size, dtype=bool)
             pending[first[idx]] = pending[first[idx] + 1] = True
             tau, cells = new_tau, new_cells
+        else:
+            raise InvalidInputError(
+                f"the curve's arc length is not resolved after {_TABLE_HALVINGS} halvings of "
+                f"its cells near parameter {tau[int(np.argmax(pending))]:.6g} (its speed |r'| "
+                "varies too strongly there); check the weights and control points"
+            )
         return tau, cells
 
     def _speed_integral(

@@ -170,10 +170,11 @@ class SpeedProfile:
         q, v, a, jerk, kappa = self._motion(self._sample_times(step))
         a_lat = kappa * v * v
         lim = self.limits
-        if isinstance(self.speed_bound, SpeedBound):  # plan()'s: reuse the curvature
-            bound = self.speed_bound.given_curvature(q, kappa)
+        bound_fn = self.speed_bound
+        if isinstance(bound_fn, SpeedBound) and bound_fn.path is self.path:  # reuse curvature
+            bound = bound_fn.given_curvature(q, kappa)
         else:
-            bound = self.speed_bound(q)
+            bound = bound_fn(q)
         with np.errstate(divide="ignore", invalid="ignore"):
             speed_ratio = np.where(bound > 0, v / np.sqrt(bound), np.where(v > 0, np.inf, 0.0))
 
