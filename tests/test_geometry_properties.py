@@ -116,7 +116,8 @@ def test_nurbs_paths(p, n):
 @given(k=st.integers(2, 3), data=st.data())
 def test_nurbs_arc_length_with_weights_over_five_decades(k, data):
     # |r'| may vary by orders of magnitude inside a polynomial piece; length and arc-length
-    # inversion must still be exact (scipy's adaptive quadrature is the reference).
+    # inversion must still be right. scipy's adaptive quadrature is the reference; its own
+    # error reaches 1e-10 on such curves, hence 1e-9 (one rule per cell was off by up to 42 %).
     from scipy.integrate import quad
 
     from speedplan import InvalidInputError

@@ -112,9 +112,9 @@ class CurvePiece(Piece):
         speed = np.linalg.norm(d1, axis=1)
         mean_speed = arc[-1] / max(float(b[-1] - b[0]), 1e-300)
         # Tested on the unrefined nodes: the refinement puts nodes into slow stretches of
-        # curves that do not turn back, and would refuse them.
+        # curves that do not turn back, and would refuse them. Zero length: callers say.
         coarse_speed = np.linalg.norm(self.curve(coarse, 1), axis=1)
-        if mean_speed > 0 and coarse_speed.min() <= 1e-6 * mean_speed:  # zero length: callers
+        if mean_speed > 0 and coarse_speed.min() <= 1e-6 * mean_speed:
             # |r'| = 0: the curve stops and turns back (a cusp); heading and curvature are
             # undefined there and a vehicle would have to reverse.
             i = int(np.argmin(coarse_speed))
