@@ -218,8 +218,9 @@ class CurvePiece(Piece):
                 break  # where |r'| is huge, a step below τ's rounding still moves σ by > tol
             # σ(new) - u = f + ∫_τ^new |r'|: over a short step 4 points do what 16 do over
             # the cell from its start (half the time of the inversion on nurbs_edge.json).
-            f = f + self._speed_integral(tau, new, (_SHORT_NODES, _SHORT_WEIGHTS))
-            far = np.abs(new - tau) > _SHORT_STEP * (hi - lo)
+            near = np.abs(new - tau) <= _SHORT_STEP * (hi - lo)
+            f[near] += self._speed_integral(tau[near], new[near], (_SHORT_NODES, _SHORT_WEIGHTS))
+            far = ~near
             if np.any(far):
                 f[far] = self._arc[j[far]] + self._speed_integral(lo[far], new[far]) - flat[far]
             tau = new
