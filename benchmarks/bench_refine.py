@@ -24,7 +24,7 @@ NLP on the same instances, from the same start, with
 Instances are :func:`speedplan.solve.paper.paper_instance` draws (default family
 ``("rnd", "cnst", "logrnd")``, strongly varying ``J``, where the relaxation is not exact), seeds
 ``seed, seed + 1, ...``. The start is the relaxed ``w`` of ``solve_discrete(..., refine="never")``
-(``extras["relaxed_w"]``); every solver works on the problem scaled to unit ``h`` and ``w_max``
+(``relaxation.w``); every solver works on the problem scaled to unit ``h`` and ``w_max``
 exactly as ``solve_problem`` does, and every answer is re-checked by speedplan's own code on the
 original problem: ``ok`` is speedplan's acceptance test for a refinement (solver success, jerk
 violation <= ``jerk_tol``, linear violation <= the linear tolerance, after the same clipping into
@@ -69,8 +69,8 @@ import casadi as ca
 import numpy as np
 
 from speedplan import solve_discrete
-from speedplan._checks import FloatArray
-from speedplan.errors import SolverError, SpeedplanWarning
+from speedplan.core.checks import FloatArray
+from speedplan.core.errors import SolverError, SpeedplanWarning
 from speedplan.solve.discrete import _linear_tol  # speedplan's own acceptance tolerance
 from speedplan.solve.ipopt_ import IPOPT_OPTIONS, refine_ipopt
 from speedplan.solve.paper import paper_instance
@@ -155,8 +155,8 @@ def make_case(family: tuple[str, str, str], n: int, seed: int) -> Case:
     unit = problem.scaled(float(np.mean(problem.h)), w_scale)
     return Case(
         seed=seed, problem=problem, unit=unit, w_scale=w_scale,
-        w0=np.asarray(sol.extras["relaxed_w"]) / w_scale, lower_bound=sol.lower_bound,
-        relaxed_violation=float(sol.extras["relaxed_jerk_violation"]),
+        w0=np.asarray(sol.relaxation.w) / w_scale, lower_bound=sol.lower_bound,
+        relaxed_violation=float(sol.relaxation.jerk_violation),
     )
 
 

@@ -55,8 +55,8 @@ def run_family(family, instances, n, seed0, backend):
             failures += 1
             print(f"  {family} seed {seed0 + k}: {type(exc).__name__}: {exc}", file=sys.stderr)
             continue
-        errs.append(sol.extras["relaxed_jerk_violation"])
-        times.append(sol.extras["relaxation_time"])
+        errs.append(sol.relaxation.jerk_violation)
+        times.append(sol.relaxation.time)
         if not sol.exact:
             non_exact += 1
             gaps.append(100.0 * sol.gap)

@@ -3,8 +3,9 @@
 Speed, tangential-acceleration, lateral-acceleration and true jerk limits; see :func:`plan`.
 """
 
+from ._version import __version__
 from .batch import BatchResult, plan_many
-from .errors import (
+from .core.errors import (
     InfeasibleError,
     InvalidInputError,
     LimitWarning,
@@ -12,15 +13,12 @@ from .errors import (
     SpeedplanError,
     SpeedplanWarning,
 )
+from .core.limits import Limits
 from .geometry import Path, SpeedZone, speed_bounds
-from .limits import Limits
 from .plan import plan
 from .solve import DiscreteProblem, DiscreteSolution, solve_discrete
 from .timing import SpeedProfile, Trajectory, Verification
 from .waypoints import profile_from_waypoints
-
-__version__ = "0.1.0"
-
 
 __all__ = [
     "BatchResult",

@@ -9,8 +9,9 @@ from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from typing import Any
 
-from .errors import InvalidInputError
-from .plan import plan
+from .core.errors import InvalidInputError
+from .model import PlanRequest
+from .plan import plan_request
 from .timing import SpeedProfile
 
 __all__ = ["BatchResult", "plan_many"]
@@ -45,8 +46,9 @@ def _normalise(job: Any, index: int) -> dict[str, Any]:
     return kwargs
 
 
-def _run(kwargs: dict[str, Any]) -> SpeedProfile:
-    return plan(kwargs.pop("path"), kwargs.pop("limits"), **kwargs)
+def _request(kwargs: dict[str, Any]) -> PlanRequest:
+    kw = dict(kwargs)
+    return PlanRequest.create(kw.pop("path"), kw.pop("limits"), **kw)
 
 
 def _print_progress(done: int, total: int) -> None:
@@ -92,20 +94,33 @@ def plan_many(
     normalised = [_normalise(job, i) for i, job in enumerate(jobs)]
     total = len(normalised)
     report = _print_progress if progress is True else (progress or None)
-    own = executor is None
-    ex = executor if executor is not None else ProcessPoolExecutor(max_workers=os.cpu_count())
     results: list[BatchResult | None] = [None] * total
+    # Check every job here, before shipping any: a bad argument costs no worker round trip.
+    requests: dict[int, PlanRequest] = {}
+    for i, kwargs in enumerate(normalised):
+        try:
+            requests[i] = _request(kwargs)
+        except (InvalidInputError, TypeError) as exc:
+            results[i] = BatchResult(i, None, exc)
+    done = total - len(requests)
+    if report is not None and done:
+        report(done, total)
+    own = executor is None and bool(requests)
+    ex = executor if executor is not None else (
+        ProcessPoolExecutor(max_workers=os.cpu_count()) if requests else None)
     try:
-        futures = {ex.submit(_run, kwargs): i for i, kwargs in enumerate(normalised)}
-        for done, fut in enumerate(as_completed(futures), start=1):
-            i = futures[fut]
-            try:
-                results[i] = BatchResult(i, fut.result(), None)
-            except Exception as exc:  # one job's failure must not lose the others
-                results[i] = BatchResult(i, None, exc)
-            if report is not None:
-                report(done, total)
+        if ex is not None:
+            futures = {ex.submit(plan_request, req): i for i, req in requests.items()}
+            for fut in as_completed(futures):
+                i = futures[fut]
+                try:
+                    results[i] = BatchResult(i, fut.result(), None)
+                except Exception as exc:  # one job's failure must not lose the others
+                    results[i] = BatchResult(i, None, exc)
+                done += 1
+                if report is not None:
+                    report(done, total)
     finally:
-        if own:
+        if own and ex is not None:
             ex.shutdown()
     return [r for r in results if r is not None]

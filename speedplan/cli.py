@@ -15,8 +15,14 @@ from pathlib import Path as FsPath
 
 import numpy as np
 
-from .errors import InfeasibleError, InvalidInputError, LimitWarning, SolverError, SpeedplanError
-from .limits import Limits
+from .core.errors import (
+    InfeasibleError,
+    InvalidInputError,
+    LimitWarning,
+    SolverError,
+    SpeedplanError,
+)
+from .core.limits import Limits
 
 __all__ = ["EXIT_CODES", "main"]
 
@@ -98,7 +104,7 @@ def _run_plan(args: argparse.Namespace, pathfile: FsPath) -> int:
         profile = plan(path, limits, n=args.n, ds=args.ds, v0=args.v0, a0=args.a0, vf=args.vf,
                        af=args.af, zones=zones or None, standstill=args.standstill)
     elapsed = time.perf_counter() - t0
-    check = profile.options["verification"]
+    check = profile.verification or profile.verify()
     print(f"path      {pathfile.name}: {path.length:.3f} m, {profile.s.size} grid nodes")
     print(f"duration  {profile.duration:.4f} s   (planned in {elapsed:.3f} s)")
     print(f"status    {profile.status}   exact={profile.exact}   gap={profile.gap:.2e}")
@@ -134,7 +140,7 @@ def _run_bench(args: argparse.Namespace) -> int:
         for k in range(args.instances):
             inst = paper_instance(*fam, n=args.n, seed=1000 * i + k)
             sol = solve_discrete(inst.w_max, inst.A, inst.J)
-            times.append(sol.extras["relaxation_time"])
+            times.append(sol.relaxation.time if sol.relaxation else 0.0)
             non_exact += not sol.exact
         print(f"{fam[0]:8s} {fam[1]:5s} {fam[2]:5s} {non_exact:>5d}/{args.instances:<3d} "
               f"{float(np.median(times)):16.4f}   [{i + 1}/{len(FAMILIES)}]", flush=True)

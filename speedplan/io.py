@@ -33,8 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import as_array
-from .errors import InvalidInputError
+from .core.checks import as_array
+from .core.errors import InvalidInputError
 from .geometry import Path, SpeedZone
 from .geometry.fitting import KINDS
 from .geometry.primitives import ClothoidPiece

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import SpeedplanError
+from .core.errors import SpeedplanError
 
 if TYPE_CHECKING:
     from .timing import SpeedProfile, Trajectory

@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from .core.limits import Limits
 from .geometry import Path, SpeedZone
-from .limits import Limits
 from .plan import plan
 from .timing import Trajectory
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from speedplan.errors import InfeasibleError, SolverError
+from speedplan.core.errors import InfeasibleError, SolverError
 from speedplan.solve.banded import solve_relaxation_banded
 from speedplan.solve.clarabel_ import solve_relaxation
 from speedplan.solve.paper import FAMILIES, paper_instance

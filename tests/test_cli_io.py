@@ -14,6 +14,7 @@ import pytest
 import speedplan as sp
 from speedplan.geometry import Line
 from speedplan.io import read_path, read_zones
+from speedplan.plot import plot_profile
 
 LGV_ARGS = ["--v-max", "2", "--a-max", "1", "--a-lat-max", "1", "--j-max", "0.5"]
 
@@ -106,7 +107,7 @@ def test_sample_files_load_with_sane_lengths(request):
 def test_plot_axes_are_sane(tmp_path):
     prof = sp.plan(sp.Path.from_segments([Line(10.0)]),
                    sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
-    fig = prof.plot(str(tmp_path / "p.png"))
+    fig = plot_profile(prof, str(tmp_path / "p.png"))
     axes = fig.axes
     assert axes[1].get_xlabel() == "s [m]" and axes[1].get_ylim()[1] >= 2.0
     assert axes[3].get_ylabel() == "jerk [m/s³]"

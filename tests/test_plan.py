@@ -105,7 +105,7 @@ def test_line_arc_line(transitions):
         segs = [Line(10.0), Clothoid(1.5, 0, 0.5), Arc(2.0, np.pi / 2 - 0.75),
                 Clothoid(1.5, 0.5, 0), Line(10.0)]
     profile = plan(Path.from_segments(segs), LGV)
-    assert profile.options["verification"].ok
+    assert profile.verification.ok
     assert_physics(profile)
 
 

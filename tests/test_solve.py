@@ -63,7 +63,7 @@ def test_strongly_varying_jerk_is_mostly_inexact_and_refinement_closes_gap():
     assert len(inexact) > len(results) / 2
     for r in inexact:
         assert r.refined and r.status == "refined"
-        assert r.extras["relaxed_jerk_violation"] > JERK_TOL
+        assert r.relaxation.jerk_violation > JERK_TOL
         assert r.jerk_violation <= JERK_TOL
         assert 0 <= r.gap < 0.01
 
@@ -73,7 +73,7 @@ def test_negative_jerk_rows_never_violated_with_constant_bounds():
     for seed in range(4):
         inst = paper_instance("rnd", "cnst", "cnst", n=N_CI, seed=seed)
         sol = solve_discrete(inst.w_max, inst.A, inst.J, refine="always")
-        w = sol.extras["relaxed_w"]
+        w = sol.relaxation.w
         d2 = w[:-2] - 2 * w[1:-1] + w[2:]
         assert np.max(-d2 - inst.J / np.sqrt(w[1:-1])) <= JERK_TOL
 
@@ -105,7 +105,7 @@ def test_objective_matches_independent_cvxpy_formulation(family):
 def test_no_jerk_pass_matches_cvxpy_and_socp_with_huge_jerk():
     inst = paper_instance("rnd", "rnd", "cnst", n=80, seed=5)
     sol = solve_discrete(inst.w_max, inst.A, np.inf)
-    assert sol.extras["backend"] == "pass" and sol.status == "optimal"
+    assert sol.backend == "pass" and sol.status == "optimal"
     assert sol.objective == pytest.approx(_cvxpy_relaxation(inst.w_max, inst.A, None, jerk=False),
                                           rel=1e-6)
     socp = solve_discrete(inst.w_max, inst.A, 1e9)
@@ -177,8 +177,8 @@ def test_refine_always_agrees_with_exact_relaxation():
     inst = paper_instance("pw cnst", "cnst", "cnst", n=100, seed=2)
     sol = solve_discrete(inst.w_max, inst.A, inst.J, refine="always")
     assert sol.refined and sol.exact and sol.status == "optimal"
-    assert sol.extras["refine_objective"] == pytest.approx(sol.objective, rel=1e-5)
-    assert sol.extras["refine_objective"] >= sol.lower_bound * (1 - 1e-9)
+    assert sol.refinement.objective == pytest.approx(sol.objective, rel=1e-5)
+    assert sol.refinement.objective >= sol.lower_bound * (1 - 1e-9)
 
 
 def test_refine_never_warns_and_reports_violation():
@@ -260,14 +260,14 @@ def test_banded_backend_gives_the_same_certified_answer(family):
     inst = paper_instance(*family, n=N_CI, seed=7)
     ref = solve_discrete(inst.w_max, inst.A, inst.J, backend="clarabel")
     fast = solve_discrete(inst.w_max, inst.A, inst.J, backend="banded")
-    assert fast.extras["backend"] == "banded"
+    assert fast.backend == "banded"
     assert (fast.exact, fast.status) == (ref.exact, ref.status)
     assert fast.lower_bound == pytest.approx(ref.lower_bound, rel=1e-6)
     assert fast.objective == pytest.approx(ref.objective, rel=1e-5)
 
 
 def test_a_failing_backend_falls_back_to_the_other(monkeypatch):
-    from speedplan.errors import SolverError
+    from speedplan.core.errors import SolverError
     from speedplan.solve import discrete
 
     def jammed(problem):
@@ -277,8 +277,8 @@ def test_a_failing_backend_falls_back_to_the_other(monkeypatch):
     inst = paper_instance("rnd", "cnst", "cnst", n=N_CI, seed=7)
     sol = solve_discrete(inst.w_max, inst.A, inst.J, backend="banded")
     ref = solve_discrete(inst.w_max, inst.A, inst.J, backend="clarabel")
-    assert sol.extras["backend"] == "clarabel"
-    assert sol.extras["backend_fallback"] == "banded: stopped with status NoProgress"
+    assert sol.backend == "clarabel"
+    assert sol.relaxation.fallback == "banded: stopped with status NoProgress"
     assert sol.objective == pytest.approx(ref.objective, rel=1e-12)
 
 
@@ -314,9 +314,9 @@ def test_very_fine_grid_is_answered_by_the_banded_method_on_its_certificate(name
     limits = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
     prof = sp.plan(path, limits, n=20000, refine="never")
     sol = prof.solution
-    assert sol.extras["backend"] == "banded"
-    assert sol.extras.get("backend_fallback") is None
-    assert sol.extras["iterations"] < 50  # 32 and 25 measured; 100 (max_iter) before
+    assert sol.backend == "banded"
+    assert sol.relaxation.fallback is None
+    assert sol.relaxation.iterations < 50  # 32 and 25 measured; 100 (max_iter) before
     assert prof.status == "optimal"
     assert sol.objective - sol.lower_bound <= 1e-6 * sol.objective
     assert prof.verify().ok

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from speedplan.solve.boundary import max_jerk_envelope
+from speedplan.model.boundary import max_jerk_envelope
 from speedplan.timing import TimeLaw
 
 

@@ -6,8 +6,8 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import FloatArray, as_array
-from ..errors import InvalidInputError
+from ..core.checks import FloatArray, as_array
+from ..core.errors import InvalidInputError
 
 __all__ = ["as_int", "check_waypoints", "wrap_angle"]
 

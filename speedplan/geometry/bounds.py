@@ -9,12 +9,12 @@ from typing import Any
 import numpy as np
 import shapely
 
-from .._checks import FloatArray, as_array, as_scalar
-from ..errors import InvalidInputError
-from ..limits import Limits
+from ..core.checks import FloatArray, as_array, as_scalar
+from ..core.errors import InvalidInputError
+from ..core.limits import Limits
 from .path import Path
 
-__all__ = ["SpeedBound", "SpeedZone", "speed_bounds", "zone_intervals"]
+__all__ = ["SpeedBound", "SpeedZone", "check_zones", "speed_bounds", "zone_intervals"]
 
 
 @dataclass(frozen=True)
@@ -111,7 +111,7 @@ def speed_bounds(
         raise InvalidInputError(f"`path` must be a speedplan.Path; got {type(path).__name__}")
     if not isinstance(limits, Limits):
         raise InvalidInputError(f"`limits` must be a speedplan.Limits; got {type(limits).__name__}")
-    zone_list = _check_zones(zones)
+    zone_list = check_zones(zones)
     q = as_array("s", s)
     # path.curvature also checks that s lies on the path.
     return _bounds(path, limits, q, path.curvature(q), zone_list, v_limit)
@@ -177,7 +177,7 @@ class SpeedBound:
             raise InvalidInputError(
                 f"`curvature` must have the shape of `s` {q.shape}; got {kappa.shape}"
             )
-        return _bounds(self.path, self.limits, q, kappa, _check_zones(self.zones), self.v_limit)
+        return _bounds(self.path, self.limits, q, kappa, check_zones(self.zones), self.v_limit)
 
 
 def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:
@@ -226,7 +226,7 @@ def zone_intervals(
     ...  zone_intervals(p, [SpeedZone(shapely.box(2, -1, 5, 1), 0.5)])]
     [(2.0, 5.0, 0.5)]
     """
-    zone_list = _check_zones(zones)
+    zone_list = check_zones(zones)
     tol = as_scalar("tol", tol, positive=True)
     L = path.length
     s = np.linspace(0.0, L, int(np.clip(np.ceil(L / 0.01), 2000, 200_000)) + 1)
@@ -253,7 +253,8 @@ def zone_intervals(
     return sorted(out)
 
 
-def _check_zones(zones: Any) -> list[SpeedZone]:
+def check_zones(zones: Any) -> list[SpeedZone]:
+    """``zones`` as a list of :class:`SpeedZone`; raise naming the entry that is not one."""
     if zones is None:
         return []
     try:

@@ -8,8 +8,8 @@ from typing import Any
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from .._checks import FloatArray, as_array, as_scalar, choice
-from ..errors import InvalidInputError
+from ..core.checks import FloatArray, as_array, as_scalar, choice
+from ..core.errors import InvalidInputError
 from ._checks import check_waypoints, wrap_angle
 from .pieces import CurvePiece, Piece
 from .primitives import ClothoidPiece

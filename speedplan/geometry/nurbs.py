@@ -8,8 +8,8 @@ from typing import Any
 import numpy as np
 from scipy.interpolate import BSpline
 
-from .._checks import FloatArray, as_array
-from ..errors import InvalidInputError
+from ..core.checks import FloatArray, as_array
+from ..core.errors import InvalidInputError
 from ._checks import as_int
 from .pieces import CurvePiece
 

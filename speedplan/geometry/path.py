@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import FloatArray, IntArray, as_array, as_scalar, grid_size
-from ..errors import InvalidInputError
+from ..core.checks import FloatArray, IntArray, as_array, as_scalar, grid_size
+from ..core.errors import InvalidInputError
 from ._checks import as_int
 from .pieces import Piece
 from .primitives import Arc, Clothoid, Line, as_segment, segment_piece

@@ -17,8 +17,8 @@ from typing import Protocol
 
 import numpy as np
 
-from .._checks import FloatArray, IntArray
-from ..errors import InvalidInputError
+from ..core.checks import FloatArray, IntArray
+from ..core.errors import InvalidInputError
 
 __all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "CurvePiece", "ParametricCurve", "Piece",
            "ReversedPiece"]

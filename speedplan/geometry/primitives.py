@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import FloatArray, as_scalar
-from ..errors import InvalidInputError
+from ..core.checks import FloatArray, as_scalar
+from ..core.errors import InvalidInputError
 from .pieces import GAUSS_NODES, GAUSS_WEIGHTS, Piece
 
 __all__ = ["Arc", "Clothoid", "ClothoidPiece", "Line", "Segment", "as_segment", "segment_piece"]

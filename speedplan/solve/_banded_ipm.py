@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .._checks import FloatArray, IntArray
+from ..core.checks import FloatArray, IntArray
 
 #: Fraction of the step to the cone boundary taken per iteration.
 STEP = 0.99

@@ -56,8 +56,8 @@ import time
 
 import numpy as np
 
-from .._checks import FloatArray
-from ..errors import InfeasibleError, SolverError
+from ..core.checks import FloatArray
+from ..core.errors import InfeasibleError, SolverError
 from . import _banded_ipm as ipm
 from .clarabel_ import RelaxationResult
 from .nojerk import check_reachable, max_feasible_w, min_feasible_w

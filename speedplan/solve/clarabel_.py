@@ -17,8 +17,8 @@ import clarabel
 import numpy as np
 import scipy.sparse as sp
 
-from .._checks import FloatArray, IntArray
-from ..errors import InfeasibleError, SolverError
+from ..core.checks import FloatArray, IntArray
+from ..core.errors import InfeasibleError, SolverError
 from .problem import DiscreteProblem
 
 __all__ = ["RelaxationResult", "solve_relaxation"]

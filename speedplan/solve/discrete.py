@@ -18,14 +18,14 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
-from ..errors import InvalidInputError, SolverError, SpeedplanWarning
+from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
+from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
 from .banded import solve_relaxation_banded
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .ipopt_ import refine_ipopt
 from .nojerk import check_reachable, max_feasible_w
 from .problem import DiscreteProblem
-from .solution import DiscreteSolution
+from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
 __all__ = ["BACKENDS", "REFINE_MODES", "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
 
@@ -107,7 +107,7 @@ def solve_problem(
         return DiscreteSolution(
             w=w, objective=obj, lower_bound=obj, gap=0.0, exact=True, exact_a_priori=True,
             jerk_violation=0.0, refined=False, status="optimal",
-            solve_time=time.perf_counter() - t_start, extras={"backend": "pass"},
+            solve_time=time.perf_counter() - t_start, backend="pass",
         )
 
     # Solve in units where the mean step and the largest bound are 1: well-scaled cones.
@@ -121,16 +121,15 @@ def solve_problem(
     lower = min(relax.dual_objective, relax.primal_objective) * time_scale
     relaxed_violation = problem.jerk_violation(w_relaxed)
     exact = relaxed_violation <= problem.jerk_tol
-    extras: dict[str, Any] = {
-        "backend": backend,
-        "backend_fallback": fallback_reason,
-        "iterations": relax.iterations,
-        "relaxation_status": relax.status,
-        "relaxation_time": relax.solve_time + relax.setup_time,
-        "relaxed_jerk_violation": relaxed_violation,
-        "relaxed_w": w_relaxed,
-    }
-    w, status, refined = w_relaxed, "optimal" if exact else "relaxed", False
+    relaxation = RelaxationInfo(
+        backend=backend, status=relax.status, iterations=relax.iterations,
+        time=relax.solve_time + relax.setup_time, w=w_relaxed,
+        jerk_violation=relaxed_violation, fallback=fallback_reason,
+    )
+    w = w_relaxed
+    status: Status = "optimal" if exact else "relaxed"
+    refined = False
+    refinement: RefinementInfo | None = None
 
     if refine == "always" or (refine == "auto" and not exact):
         refined = True
@@ -141,9 +140,10 @@ def solve_problem(
             and problem.linear_violation(w_ref) <= _linear_tol(problem)
             and problem.jerk_violation(w_ref) <= problem.jerk_tol
         )
-        extras.update(refine_status=ref.status, refine_time=ref.solve_time,
-                      refine_iterations=ref.iterations,
-                      refine_objective=problem.travel_time(w_ref) if ref_ok else None)
+        refinement = RefinementInfo(
+            status=ref.status, accepted=ref_ok, iterations=ref.iterations, time=ref.solve_time,
+            objective=problem.travel_time(w_ref) if ref_ok else None,
+        )
         if not exact:
             if ref_ok:
                 w, status = w_ref, "refined"
@@ -180,7 +180,9 @@ def solve_problem(
         refined=refined,
         status=status,
         solve_time=time.perf_counter() - t_start,
-        extras=extras,
+        backend=backend,
+        relaxation=relaxation,
+        refinement=refinement,
     )
 
 
@@ -229,7 +231,8 @@ def solve_discrete(
         Boundary values ``w_1`` and ``w_n`` (the paper: 0).
     refine : {"auto", "always", "never"}
         When to run the IPOPT refinement: when the relaxation is not exact, always (its result
-        is then in ``extras``), or never (a non-exact result has status ``"relaxed"`` and warns).
+        is then in ``refinement``), or never (a non-exact result has status ``"relaxed"`` and
+        warns).
     backend : {"auto", "clarabel", "banded"}
         Relaxation backend: Clarabel (reference), the structure-exploiting banded
         interior-point method, or ``"auto"`` (banded from :data:`AUTO_BANDED_FROM` nodes on).

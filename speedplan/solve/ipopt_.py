@@ -14,8 +14,8 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from .._checks import FloatArray
-from ..errors import SolverError
+from ..core.checks import FloatArray
+from ..core.errors import SolverError
 from .problem import DiscreteProblem
 
 __all__ = ["RefineResult", "refine_ipopt"]

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import FloatArray
-from ..errors import InfeasibleError
+from ..core.checks import FloatArray
+from ..core.errors import InfeasibleError
 from .problem import DiscreteProblem
 
 __all__ = ["check_reachable", "max_feasible_w", "min_feasible_w"]

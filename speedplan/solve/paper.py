@@ -14,7 +14,7 @@ from itertools import product
 
 import numpy as np
 
-from .._checks import FloatArray, choice
+from ..core.checks import FloatArray, choice
 
 __all__ = ["FAMILIES", "PaperInstance", "paper_instance"]
 

@@ -19,7 +19,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from .._checks import FloatArray
+from ..core.checks import FloatArray
 
 __all__ = ["DiscreteProblem"]
 

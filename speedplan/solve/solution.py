@@ -1,15 +1,18 @@
-"""The result object of a discrete solve."""
+"""The typed result objects of a discrete solve."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
+from typing import Literal
 
-from .._checks import FloatArray
+from ..core.checks import FloatArray
 
-__all__ = ["STATUSES", "DiscreteSolution"]
+__all__ = ["STATUSES", "DiscreteSolution", "RefinementInfo", "RelaxationInfo", "Status"]
 
-#: Closed set of ``DiscreteSolution.status`` values and their meaning.
+#: ``DiscreteSolution.status``: a closed set of values.
+Status = Literal["optimal", "refined", "scaled", "relaxed"]
+
+#: What each :data:`Status` means.
 STATUSES: dict[str, str] = {
     "optimal": "globally optimal: the relaxation is exact (or there are no jerk rows)",
     "refined": "feasible local optimum from IPOPT; the optimum lies in [lower_bound, objective]",
@@ -17,6 +20,63 @@ STATUSES: dict[str, str] = {
     "the optimum lies in [lower_bound, objective]",
     "relaxed": "relaxation only (refine='never'): w violates some jerk rows (see jerk_violation)",
 }
+
+
+@dataclass(frozen=True)
+class RelaxationInfo:
+    """How the convex relaxation was solved.
+
+    Attributes
+    ----------
+    backend : str
+        The backend that produced the answer: ``"clarabel"`` or ``"banded"``.
+    status : str
+        That backend's own status (``"Solved"``, ``"AlmostSolved"``).
+    iterations : int
+        Interior-point iterations.
+    time : float
+        Setup and solve time [s].
+    w : ndarray
+        The relaxed ``w``, clipped to its bounds (the refinement starts from it).
+    jerk_violation : float
+        Largest jerk-row violation of ``w`` (``<= jerk_tol``: the relaxation is exact).
+    fallback : str or None
+        Why the first backend tried was abandoned, or ``None`` when it answered.
+    """
+
+    backend: str
+    status: str
+    iterations: int
+    time: float
+    w: FloatArray
+    jerk_violation: float
+    fallback: str | None = None
+
+
+@dataclass(frozen=True)
+class RefinementInfo:
+    """How the nonconvex refinement (CasADi + IPOPT) went.
+
+    Attributes
+    ----------
+    status : str
+        IPOPT's return status.
+    accepted : bool
+        Whether our own checks found its point feasible (it is then the returned ``w`` when
+        the relaxation was not exact).
+    iterations : int
+        IPOPT iterations.
+    time : float
+        Wall time including building the NLP [s].
+    objective : float or None
+        Travel time of the refined point when accepted.
+    """
+
+    status: str
+    accepted: bool
+    iterations: int
+    time: float
+    objective: float | None
 
 
 @dataclass(frozen=True)
@@ -46,9 +106,13 @@ class DiscreteSolution:
         One of :data:`STATUSES`.
     solve_time : float
         Wall time of the whole solve [s].
-    extras : dict
-        Backend details: ``backend``, ``iterations``, ``relaxation_time``, ``refine_time``,
-        ``refine_status``, ``relaxed_w``, ``relaxed_jerk_violation``.
+    backend : str
+        ``"pass"`` (no jerk rows: the exact forward/backward pass), ``"clarabel"`` or
+        ``"banded"``.
+    relaxation : RelaxationInfo or None
+        Details of the relaxation (``None`` for the pass).
+    refinement : RefinementInfo or None
+        Details of the refinement when it ran.
     """
 
     w: FloatArray
@@ -59,14 +123,21 @@ class DiscreteSolution:
     exact_a_priori: bool
     jerk_violation: float
     refined: bool
-    status: str
+    status: Status
     solve_time: float
-    extras: dict[str, Any] = field(default_factory=dict)
+    backend: str
+    relaxation: RelaxationInfo | None = None
+    refinement: RefinementInfo | None = None
 
     @property
     def feasible(self) -> bool:
         """Whether ``w`` satisfies every row of the original problem (within tolerance)."""
         return self.status != "relaxed"
+
+    @property
+    def message(self) -> str:
+        """What :attr:`status` means."""
+        return STATUSES[self.status]
 
     def __repr__(self) -> str:
         return (

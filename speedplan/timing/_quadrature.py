@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .._checks import FloatArray, IntArray
+from ..core.checks import FloatArray, IntArray
 from ..geometry.pieces import GAUSS_NODES, GAUSS_WEIGHTS
 
 __all__ = ["piece_integrals"]

@@ -26,7 +26,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .._checks import FloatArray, IntArray
+from ..core.checks import FloatArray, IntArray
 from ._quadrature import piece_integrals
 
 __all__ = ["TimeLaw"]

@@ -3,16 +3,16 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import FloatArray, as_array, as_scalar
-from ..errors import InvalidInputError
+from ..core.checks import FloatArray, as_array, as_scalar
+from ..core.errors import InvalidInputError
+from ..core.limits import Limits
 from ..geometry.bounds import SpeedBound
-from ..limits import Limits
 from ..solve.solution import DiscreteSolution
 from .law import TimeLaw
 from .trajectory import Trajectory
@@ -20,6 +20,7 @@ from .verify import Verification
 
 if TYPE_CHECKING:
     from ..geometry import Path
+    from ..model import PlanRequest
 
 __all__ = ["SpeedProfile"]
 
@@ -46,6 +47,10 @@ class SpeedProfile:
         The continuous time law built from ``w``.
     speed_bound : callable
         ``s -> mu+(s)``, the squared-speed bound from limits, curvature and zones [m²/s²].
+    request : PlanRequest or None
+        The validated arguments :func:`speedplan.plan` was called with.
+    verification : Verification or None
+        The check :func:`speedplan.plan` ran (``verify()`` at its default sampling).
     """
 
     path: Path
@@ -55,7 +60,8 @@ class SpeedProfile:
     solution: DiscreteSolution
     law: TimeLaw
     speed_bound: Callable[[FloatArray], FloatArray]
-    options: dict[str, Any] = field(default_factory=dict)
+    request: PlanRequest | None = None
+    verification: Verification | None = None
 
     # ---- the speed law on the grid ----------------------------------------------------------
     @property
@@ -202,13 +208,6 @@ class SpeedProfile:
             },
             dt=float(step),
         )
-
-    def plot(self, file: str | None = None, **options: Any) -> Any:
-        """Figure of the profile; see :func:`speedplan.plot.plot_profile` (``plot`` extra)."""
-        # Lazy: matplotlib is optional and the plotting module sits above this layer.
-        from ..plot import plot_profile
-
-        return plot_profile(self, file, **options)
 
     def __repr__(self) -> str:
         return (

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from .._checks import FloatArray
+from ..core.checks import FloatArray
 
 __all__ = ["COLUMNS", "Trajectory"]
 

@@ -12,9 +12,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .._checks import FloatArray, grid_size
-from .nojerk import max_feasible_w
-from .problem import DiscreteProblem
+from ..core.checks import FloatArray, grid_size
+from ..solve.nojerk import max_feasible_w
+from ..solve.problem import DiscreteProblem
 
 __all__ = ["DEFAULT_PER_PHASE", "MAX_DEFAULT_NODES", "adaptive_grid", "uniform_grid"]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ._checks import as_scalar
+from .checks import as_scalar
 
 __all__ = ["Limits"]
 

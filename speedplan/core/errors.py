@@ -53,7 +53,7 @@ class SolverError(SpeedplanError):
         self.status = status
 
 
-class SpeedplanWarning(RuntimeWarning):
+class SpeedplanWarning(UserWarning):
     """A result was produced but something about it deserves attention (see the message)."""
 
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import FloatArray
-from ..errors import InfeasibleError
+from ..core.checks import FloatArray
+from ..core.errors import InfeasibleError
 
 __all__ = ["check_boundary_state", "jerk_motion_w", "max_jerk_envelope"]
 

@@ -1,0 +1,24 @@
+"""Base layer: errors and warnings, vehicle limits, input checks and shared numerics.
+
+Every other layer imports from here; this layer imports nothing else from speedplan.
+"""
+
+from .errors import (
+    InfeasibleError,
+    InvalidInputError,
+    LimitWarning,
+    SolverError,
+    SpeedplanError,
+    SpeedplanWarning,
+)
+from .limits import Limits
+
+__all__ = [
+    "InfeasibleError",
+    "InvalidInputError",
+    "LimitWarning",
+    "Limits",
+    "SolverError",
+    "SpeedplanError",
+    "SpeedplanWarning",
+]

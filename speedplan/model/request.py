@@ -1,0 +1,152 @@
+"""A planning request: the arguments of :func:`speedplan.plan`, validated once."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..core.checks import as_scalar, choice
+from ..core.errors import InvalidInputError
+from ..core.limits import Limits
+from ..geometry import Path, SpeedZone
+from ..geometry.bounds import check_zones
+from ..solve.discrete import BACKENDS, REFINE_MODES
+
+__all__ = ["MIN_RELATIVE_LENGTH", "STANDSTILL_MODES", "PlanRequest"]
+
+#: ``"smooth"``: acceleration is 0 at a standstill and jerk-limited from the first instant.
+#: ``"free"``: the paper's model, where acceleration may jump at a standstill.
+STANDSTILL_MODES = ("smooth", "free")
+#: Shortest path planned, relative to ``v_max² / a_max`` (4e-9 m for v_max = 2 m/s, a_max = 1
+#: m/s²; relative, so that millimetres and metres agree). Far below any vehicle's resolution;
+#: much shorter paths (nearly coincident waypoints) made the solvers fail with misleading
+#: messages.
+MIN_RELATIVE_LENGTH = 1e-9
+
+
+@dataclass(frozen=True)
+class PlanRequest:
+    """What :func:`speedplan.plan` was asked, after validation (see its parameters).
+
+    Build it with :meth:`create`, which raises :class:`~speedplan.InvalidInputError` naming
+    the argument at fault; :func:`speedplan.plan_many` uses it to check every job before
+    shipping any.
+
+    Examples
+    --------
+    >>> from speedplan import Limits, Path
+    >>> from speedplan.model import PlanRequest
+    >>> req = PlanRequest.create(Path.from_waypoints([[0, 0], [5, 0]], kind="polyline"),
+    ...                          Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5), v0=0.5)
+    >>> req.v0, req.smooth_standstill
+    (0.5, True)
+    """
+
+    path: Path
+    limits: Limits
+    n: int | None = None
+    ds: float | None = None
+    v0: float = 0.0
+    a0: float = 0.0
+    vf: float = 0.0
+    af: float = 0.0
+    zones: tuple[SpeedZone, ...] | None = None
+    v_limit: Any = None
+    refine: str = "auto"
+    standstill: str = "smooth"
+    backend: str = "auto"
+
+    @classmethod
+    def create(
+        cls,
+        path: Any,
+        limits: Any,
+        *,
+        n: Any = None,
+        ds: Any = None,
+        v0: Any = 0.0,
+        a0: Any = 0.0,
+        vf: Any = 0.0,
+        af: Any = 0.0,
+        zones: Sequence[SpeedZone] | None = None,
+        v_limit: Any = None,
+        refine: str = "auto",
+        standstill: str = "smooth",
+        backend: str = "auto",
+    ) -> PlanRequest:
+        """Check every argument; raise :class:`~speedplan.InvalidInputError` naming a bad one."""
+        if not isinstance(path, Path):
+            raise InvalidInputError(
+                f"`path` must be a speedplan.Path; got {type(path).__name__} (build one with "
+                "Path.from_waypoints, Path.from_segments, Path.from_nurbs or Path.from_linestring)"
+            )
+        if not isinstance(limits, Limits):
+            raise InvalidInputError(
+                f"`limits` must be a speedplan.Limits; got {type(limits).__name__}"
+            )
+        choice("refine", refine, REFINE_MODES)
+        choice("standstill", standstill, STANDSTILL_MODES)
+        choice("backend", backend, BACKENDS)
+        if n is not None and ds is not None:
+            raise InvalidInputError("pass at most one of `n` and `ds`")
+        if n is not None and (isinstance(n, bool) or not isinstance(n, int | np.integer)
+                              or n < 3):
+            raise InvalidInputError(f"`n` must be an integer >= 3; got {n!r}")
+        request = cls(
+            path=path,
+            limits=limits,
+            n=None if n is None else int(n),
+            ds=None if ds is None else as_scalar("ds", ds, positive=True),
+            v0=as_scalar("v0", v0, nonnegative=True),
+            a0=as_scalar("a0", a0),
+            vf=as_scalar("vf", vf, nonnegative=True),
+            af=as_scalar("af", af),
+            zones=None if zones is None else tuple(check_zones(zones)),
+            v_limit=v_limit,
+            refine=refine,
+            standstill=standstill,
+            backend=backend,
+        )
+        request._check_accelerations()
+        request._check_length()
+        return request
+
+    @property
+    def jerk_limited(self) -> bool:
+        """Whether the limits bound the jerk."""
+        return bool(np.isfinite(self.limits.j_max))
+
+    @property
+    def smooth_standstill(self) -> bool:
+        """Whether acceleration is 0 at a standstill (jerk-limited, ``standstill="smooth"``)."""
+        return self.jerk_limited and self.standstill == "smooth"
+
+    def _check_accelerations(self) -> None:
+        lim = self.limits
+        for name, a in (("a0", self.a0), ("af", self.af)):
+            if a > lim.a_max * (1 + 1e-12) or a < -lim.a_decel * (1 + 1e-12):
+                raise InvalidInputError(
+                    f"`{name}`={a!r} m/s² is outside [-a_decel, a_max] = "
+                    f"[{-lim.a_decel!r}, {lim.a_max!r}]; pass an acceleration within the limits"
+                )
+        if self.smooth_standstill:
+            for vname, v, aname, a in (("v0", self.v0, "a0", self.a0),
+                                       ("vf", self.vf, "af", self.af)):
+                if v == 0.0 and a != 0.0:
+                    raise InvalidInputError(
+                        f"`{aname}`={a!r} with `{vname}`=0: a jerk-limited vehicle at rest has "
+                        "zero acceleration; pass 0, or standstill='free' for the paper's model"
+                    )
+
+    def _check_length(self) -> None:
+        length = float(self.path.length)
+        min_length = MIN_RELATIVE_LENGTH * self.limits.v_max**2 / self.limits.a_max
+        if not length >= min_length:
+            raise InvalidInputError(
+                f"`path` is {length:.3g} m long, shorter than {min_length:.3g} m "
+                "(1e-9 v_max²/a_max): there is no motion to plan (nearly coincident "
+                "waypoints?); skip the move or check the path"
+            )
