@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from speedplan import InfeasibleError, InvalidInputError, solve_discrete
+from speedplan import InfeasibleError, InvalidInputError, SpeedplanWarning, solve_discrete
 from speedplan.solve import JERK_TOL, DiscreteProblem, solve_problem
 from speedplan.solve.discrete import _scale_into_jerk_bounds
 from speedplan.solve.nojerk import max_feasible_w
@@ -183,7 +183,7 @@ def test_refine_always_agrees_with_exact_relaxation():
 
 def test_refine_never_warns_and_reports_violation():
     inst = paper_instance("rnd", "cnst", "logrnd", n=N_CI, seed=0)
-    with pytest.warns(RuntimeWarning, match="relaxed"):
+    with pytest.warns(SpeedplanWarning, match="relaxed"):
         sol = solve_discrete(inst.w_max, inst.A, inst.J, refine="never")
     assert sol.status == "relaxed" and not sol.feasible
     assert sol.jerk_violation > JERK_TOL
@@ -191,7 +191,7 @@ def test_refine_never_warns_and_reports_violation():
 
 def test_scaling_fallback_is_feasible_and_bounded_by_relaxation():
     inst = paper_instance("rnd", "cnst", "logrnd", n=N_CI, seed=0)
-    with pytest.warns(RuntimeWarning, match="relaxed"):
+    with pytest.warns(SpeedplanWarning, match="relaxed"):
         sol = solve_discrete(inst.w_max, inst.A, inst.J, refine="never")
     p = DiscreteProblem(s=np.arange(N_CI, dtype=float), w_max=inst.w_max, accel=inst.A,
                         decel=inst.A, jerk=inst.J)
