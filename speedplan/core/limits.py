@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from .checks import as_scalar
 
 __all__ = ["Limits"]
@@ -25,6 +27,12 @@ class Limits:
         Jerk limit, the time derivative of tangential acceleration [m/s³]; ``inf`` for none.
     a_decel : float, optional
         Braking limit [m/s²]; defaults to ``a_max``.
+    j_lat_max : float, optional
+        Lateral jerk limit, the time derivative of the lateral acceleration ``κ v²`` [m/s³];
+        ``None`` or ``inf`` for none (the default). Finite only on curvature-continuous (G2)
+        paths: where the curvature jumps the vehicle has to stop.
+    yaw_rate_max : float, optional
+        Yaw-rate limit ``|κ| v`` [rad/s]; ``None`` or ``inf`` for none (the default).
 
     Notes
     -----
@@ -44,6 +52,8 @@ class Limits:
     a_lat_max: float
     j_max: float
     a_decel: float = field(default=None)  # type: ignore[assignment]
+    j_lat_max: float = field(default=None)  # type: ignore[assignment]
+    yaw_rate_max: float = field(default=None)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -54,6 +64,10 @@ class Limits:
         set_(self, "j_max", as_scalar("j_max", self.j_max, positive=True, allow_inf=True))
         decel = self.a_max if self.a_decel is None else self.a_decel
         set_(self, "a_decel", as_scalar("a_decel", decel, positive=True))
+        for name in ("j_lat_max", "yaw_rate_max"):  # None: no limit, stored as inf
+            value = getattr(self, name)
+            set_(self, name, np.inf if value is None else as_scalar(name, value, positive=True,
+                                                                     allow_inf=True))
 
     @property
     def A(self) -> float:

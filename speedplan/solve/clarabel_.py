@@ -91,22 +91,24 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
         low = np.flatnonzero(problem.w_min[1:-1] > 0) + 1
         n_lower = low.size
         add(n_lower, [iw + low], [-one(n_lower)], -problem.w_min[low])
-    finite = np.flatnonzero(np.isfinite(problem.jerk))
     n_jerk = 0
-    if finite.size:
-        d2 = problem.second_difference.tocoo()
-        coef = (d2.data.reshape(m, 3)[finite] * (tau[finite] / problem.jerk[finite])[:, None])
-        wcols = d2.col.reshape(m, 3)[finite]
+    wcols = (np.arange(m)[:, None] + np.arange(3)[None, :]) + iw
+    for family in problem.stencil_families():  # jerk rows, then lateral-jerk rows
+        finite = np.flatnonzero(np.isfinite(family.bound))
+        if not finite.size:
+            continue
+        coef = np.asarray(family.coef)[finite] * (tau[finite] / family.bound[finite])[:, None]
+        cols = wcols[finite]
         tcol = (it + finite)[:, None]
         k = finite.size
-        for sign in (1.0, -1.0):  # ±τ w''/J - t <= 0
+        for sign in (1.0, -1.0):  # ±τ (c·w)/B - t <= 0
             add(
                 k,
-                [wcols[:, 0], wcols[:, 1], wcols[:, 2], tcol[:, 0]],
+                [cols[:, 0], cols[:, 1], cols[:, 2], tcol[:, 0]],
                 [sign * coef[:, 0], sign * coef[:, 1], sign * coef[:, 2], -one(k)],
                 np.zeros(k),
             )
-        n_jerk = 2 * k
+        n_jerk += 2 * k
     n_nonneg = 2 * (n - 1) + m + n_lower + n_jerk
     # Second-order cones, interleaved per node: (w+1, 2z, w-1) and (t+z, t-z, 2 sqrt(τ)).
     j = np.arange(m)

@@ -99,7 +99,13 @@ def solve_problem(
     refine = choice("refine", refine, REFINE_MODES)
     backend = choice("backend", backend, BACKENDS)
     if backend == "auto":
-        backend = "banded" if problem.n >= AUTO_BANDED_FROM else "clarabel"
+        banded_ok = problem.n >= AUTO_BANDED_FROM and not problem.has_lateral
+        backend = "banded" if banded_ok else "clarabel"
+    elif backend == "banded" and problem.has_lateral:
+        raise InvalidInputError(
+            "backend='banded' does not handle lateral-jerk rows yet; use backend='clarabel' or "
+            "'auto'"
+        )
     check_reachable(problem)
     if not problem.has_jerk or problem.n < 3:
         w = max_feasible_w(problem)

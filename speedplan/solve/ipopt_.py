@@ -60,12 +60,14 @@ def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
     g_parts = [dw]
     lbg = [-problem.decel * problem.h]
     ubg = [problem.accel * problem.h]
-    finite = np.flatnonzero(np.isfinite(problem.jerk))
-    if finite.size:
-        d2 = ca.DM(problem.second_difference[finite].tocsc())
-        wpp = ca.mtimes(d2, w_full)
+    for family in problem.stencil_families():  # jerk rows, then lateral-jerk rows
+        finite = np.flatnonzero(np.isfinite(family.bound))
+        if not finite.size:
+            continue
+        stencil = ca.DM(problem.stencil_matrix(family.coef)[finite].tocsc())
+        load = ca.mtimes(stencil, w_full)
         xs = x[finite.tolist()] if finite.size < m else x
-        g_parts.append(wpp * ca.sqrt(xs) / ca.DM(problem.jerk[finite]))
+        g_parts.append(load * ca.sqrt(xs) / ca.DM(family.bound[finite]))
         lbg.append(-np.ones(finite.size))
         ubg.append(np.ones(finite.size))
     nlp = {"x": x, "f": f, "g": ca.vertcat(*g_parts)}

@@ -21,13 +21,40 @@ import scipy.sparse as sp
 
 from ..core.checks import FloatArray
 
-__all__ = ["DiscreteProblem"]
+__all__ = ["DiscreteProblem", "StencilRows"]
 
 #: Paper's exactness test: a jerk row may be violated by at most 1e-5 (``h = 1``, ``w_max``
 #: up to 100). We apply it relative to the largest bound, which is the same number at the
 #: paper's scale and makes the test invariant when ``w`` is rescaled.
 JERK_TOL = 1e-5
 JERK_TOL_REL = JERK_TOL / 100.0
+
+
+@dataclass(frozen=True)
+class StencilRows:
+    """Rows ``|c0_i w_{i-1} + c1_i w_i + c2_i w_{i+1}| sqrt(w_i) <= bound_i`` at interior nodes.
+
+    The structure of the jerk rows (whose stencil is the second difference): a linear form of
+    three neighbouring ``w`` times ``sqrt(w_i)``, relaxed the same way with the same epigraph
+    variable ``t_i >= τ_i / sqrt(w_i)``, ``t_i >= ±τ_i (c_i · w) / bound_i``. Lateral jerk
+    ``d(κ v²)/dt = sqrt(w) (κ' w + κ w')`` has it.
+
+    Attributes
+    ----------
+    coef : ndarray, shape (n-2, 3)
+        Stencil of each interior node, in units of ``1/m²`` (``c · w`` has the units of
+        ``w''``).
+    bound : ndarray, shape (n-2,)
+        Bound of each row [m/s³] (> 0); ``inf`` drops the row.
+    """
+
+    coef: FloatArray
+    bound: FloatArray
+
+    def scaled(self, s_scale: float, w_scale: float) -> StencilRows:
+        """The rows in units ``s/s_scale`` and ``w/w_scale`` (as :meth:`DiscreteProblem.scaled`)."""
+        return StencilRows(coef=self.coef * s_scale**2,
+                           bound=self.bound * s_scale**2 / w_scale**1.5)
 
 
 @dataclass(frozen=True)
@@ -50,6 +77,8 @@ class DiscreteProblem:
         Lower bounds on ``w`` (e.g. a jerk-limited vehicle leaving a moving state cannot
         slow down faster than its envelope). Lower bounds can make the relaxation inexact
         (the paper's Section 5.1); the refinement then applies.
+    lateral : StencilRows, optional
+        Lateral-jerk rows, relaxed like the jerk rows and part of the exactness test.
     """
 
     s: FloatArray
@@ -60,6 +89,7 @@ class DiscreteProblem:
     w_start: float = 0.0
     w_end: float = 0.0
     w_min: FloatArray | None = None
+    lateral: StencilRows | None = None
 
     @property
     def n(self) -> int:
@@ -89,20 +119,40 @@ class DiscreteProblem:
 
     @cached_property
     def has_jerk(self) -> bool:
-        """Whether any jerk row is finite."""
-        return bool(np.isfinite(self.jerk).any())
+        """Whether any jerk row (or lateral-jerk row) is finite."""
+        return bool(np.isfinite(self.jerk).any()) or self.has_lateral
+
+    @cached_property
+    def has_lateral(self) -> bool:
+        """Whether any lateral-jerk row is finite."""
+        return self.lateral is not None and bool(np.isfinite(self.lateral.bound).any())
+
+    @cached_property
+    def second_difference_weights(self) -> FloatArray:
+        """Weights ``(n-2, 3)`` of ``w_{i-1}, w_i, w_{i+1}`` in ``w''_i`` (non-uniform grid)."""
+        h0, h1 = self.h[:-1], self.h[1:]
+        return np.column_stack(
+            (2.0 / (h0 * (h0 + h1)), -2.0 / (h0 * h1), 2.0 / (h1 * (h0 + h1)))
+        )
+
+    def stencil_families(self) -> list[StencilRows]:
+        """Every row family of the jerk rows' structure: the jerk rows, then lateral jerk."""
+        out = [StencilRows(coef=self.second_difference_weights, bound=self.jerk)]
+        if self.lateral is not None:
+            out.append(self.lateral)
+        return out
 
     @cached_property
     def second_difference(self) -> sp.csr_matrix:
         """Sparse (n-2, n) operator mapping ``w`` to ``w''`` at interior nodes."""
-        h0, h1 = self.h[:-1], self.h[1:]
+        return self.stencil_matrix(self.second_difference_weights)
+
+    def stencil_matrix(self, coef: FloatArray) -> sp.csr_matrix:
+        """Sparse (n-2, n) operator of the three-point stencils ``coef`` at interior nodes."""
         m = self.n - 2
         rows = np.repeat(np.arange(m), 3)
         cols = (np.arange(m)[:, None] + np.arange(3)[None, :]).ravel()
-        vals = np.column_stack(
-            (2.0 / (h0 * (h0 + h1)), -2.0 / (h0 * h1), 2.0 / (h1 * (h0 + h1)))
-        ).ravel()
-        return sp.csr_matrix((vals, (rows, cols)), shape=(m, self.n))
+        return sp.csr_matrix((np.asarray(coef).ravel(), (rows, cols)), shape=(m, self.n))
 
     def travel_time(self, w: FloatArray) -> float:
         """The objective ``Σ τ_i / sqrt(w_i)`` over interior nodes (inf if some ``w_i <= 0``)."""
@@ -118,12 +168,20 @@ class DiscreteProblem:
         invariant under the paper's scaling ``(h, A, J) -> (ρh, A/ρ, J/ρ²)``. Rows with
         ``J = inf`` give ``-inf``.
         """
-        wpp = self.second_difference @ w
+        return self._rows(self.second_difference @ w, self.jerk, w)
+
+    def lateral_rows(self, w: FloatArray) -> FloatArray:
+        """Per interior node, the same measure for the lateral-jerk rows (``-inf`` without)."""
+        if self.lateral is None:
+            return np.full(self.n - 2, -np.inf)
+        return self._rows(self.stencil_matrix(self.lateral.coef) @ w, self.lateral.bound, w)
+
+    def _rows(self, load: FloatArray, bound: FloatArray, w: FloatArray) -> FloatArray:
         wi = np.maximum(w[1:-1], 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            cap = np.where(np.isfinite(self.jerk), self.jerk / np.sqrt(wi), np.inf)
+            cap = np.where(np.isfinite(bound), bound / np.sqrt(wi), np.inf)
         cap = np.where(np.isnan(cap), np.inf, cap)
-        out = np.asarray(self.tau**2 * (np.abs(wpp) - cap), dtype=np.float64)
+        out = np.asarray(self.tau**2 * (np.abs(load) - cap), dtype=np.float64)
         return out
 
     @cached_property
@@ -135,7 +193,10 @@ class DiscreteProblem:
         """Largest jerk-row violation (``<= 0`` means every jerk row holds)."""
         if not self.has_jerk or self.n < 3:
             return 0.0
-        return max(float(np.max(self.jerk_rows(w))), 0.0)
+        worst = float(np.max(self.jerk_rows(w)))
+        if self.has_lateral:
+            worst = max(worst, float(np.max(self.lateral_rows(w))))
+        return max(worst, 0.0)
 
     def linear_violation(self, w: FloatArray) -> float:
         """Largest violation of the linear rows (acceleration, bounds, boundary), in ``w`` units."""
@@ -159,8 +220,8 @@ class DiscreteProblem:
         """
         if not self.has_jerk or self.n < 3:
             return True
-        if self.has_lower_bounds:
-            return False  # the corollary assumes no lower bounds (paper, Section 5.1)
+        if self.has_lower_bounds or self.has_lateral:
+            return False  # the corollary assumes neither (paper, Section 5.1)
         constant = (
             self.uniform
             and np.ptp(self.accel) == 0
@@ -195,4 +256,5 @@ class DiscreteProblem:
             w_start=self.w_start / w_scale,
             w_end=self.w_end / w_scale,
             w_min=None if self.w_min is None else self.w_min / w_scale,
+            lateral=None if self.lateral is None else self.lateral.scaled(s_scale, w_scale),
         )
