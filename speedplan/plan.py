@@ -1,7 +1,8 @@
-"""plan(): validate the request -> model it -> solve -> time law -> verified profile."""
+"""plan(): validate the request -> model it -> solve each leg -> time law -> verified profile."""
 
 from __future__ import annotations
 
+import time
 import warnings
 from collections.abc import Sequence
 from dataclasses import replace
@@ -10,12 +11,18 @@ from typing import Any
 from .core.errors import LimitWarning
 from .core.limits import Limits
 from .geometry import Path, SpeedBound, SpeedZone
-from .model import PlanRequest, build_model
+from .model import ForcedLeg, Leg, PlanRequest, build_model
+from .model.build import leg_on_grid
+from .model.refine import refined_grid
 from .model.request import STANDSTILL_MODES
-from .timing import SpeedProfile, TimeLaw
+from .solve import DiscreteSolution
+from .timing import LegResult, SpeedProfile, law_for
 
 # SpeedBound is re-exported so that pickles made when it lived here still load.
-__all__ = ["STANDSTILL_MODES", "SpeedBound", "plan", "plan_request"]
+__all__ = ["MAX_REFINEMENTS", "STANDSTILL_MODES", "SpeedBound", "plan", "plan_request"]
+
+#: Rounds of local grid refinement where the continuous law exceeds a tolerance.
+MAX_REFINEMENTS = 2
 
 
 def plan(
@@ -43,8 +50,9 @@ def plan(
     limits : Limits
         Speed, acceleration, braking, lateral acceleration and jerk limits (SI).
     n, ds : int or float, optional
-        Uniform grid with ``n`` nodes or step at most ``ds`` [m]. By default the grid is
-        adaptive: ~80 nodes per jerk transition, finer near standstill.
+        Uniform grid with ``n`` nodes or step at most ``ds`` [m] (per leg). By default the
+        grid is adaptive and smoothly graded: ~80 nodes per jerk transition, coarse in long
+        cruises.
     v0, a0 : float
         Speed [m/s] and acceleration [m/s²] at the start (default: at rest).
     vf, af : float
@@ -57,24 +65,28 @@ def plan(
         IPOPT refinement when the relaxation is not exact (see :func:`solve_discrete`).
     standstill : {"smooth", "free"}
         ``"smooth"`` (default): acceleration 0 at a standstill, jerk-limited from the first
-        instant. ``"free"``: the paper's model, where acceleration may jump at a standstill.
+        instant. ``"free"``: the paper's model, where acceleration may jump *at a standstill*
+        (moving boundary states stay jerk-limited).
     backend : {"auto", "clarabel", "banded"}
         Relaxation backend (see :func:`speedplan.solve_discrete`).
 
     Returns
     -------
     SpeedProfile
-        The speed law, its certificate, and ``sample(dt)`` for a time trajectory. A
-        :class:`~speedplan.LimitWarning` is issued when :meth:`SpeedProfile.verify` finds a
-        limit exceeded beyond its tolerance.
+        The speed law, its certificate, and ``sample(dt)`` for a time trajectory. Its
+        continuous trajectory is checked against every limit (:meth:`SpeedProfile.verify`);
+        where it exceeds a tolerance the grid is refined there, up to
+        :data:`MAX_REFINEMENTS` times; if it still does, the status is
+        ``"limits_exceeded"`` and a :class:`~speedplan.LimitWarning` is issued.
 
     Raises
     ------
     InvalidInputError
         Malformed arguments, a path shorter than ``1e-9 v_max² / a_max`` (nearly coincident
-        waypoints), or boundary states beyond the limits.
+        waypoints), or boundary speeds beyond the speed bound.
     InfeasibleError
-        No speed law meets the boundary states (the message says which constraint, where).
+        No jerk-limited motion meets the boundary states (the message says which state, which
+        limit and where, ``s`` in metres).
 
     Examples
     --------
@@ -83,10 +95,10 @@ def plan(
     >>> from speedplan import Limits, Path, plan
     >>> path = Path.from_waypoints([[0, 0], [30, 0]], kind="polyline")
     >>> prof = plan(path, Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
-    >>> round(prof.duration, 1), prof.status
+    >>> round(prof.duration, 3), prof.status
     (19.0, 'optimal')
     >>> traj = prof.sample(dt=0.01)
-    >>> bool(traj.v.max() <= 2.0 * 1.005)
+    >>> bool(traj.v.max() <= 2.0 * 1.001)
     True
     """
     request = PlanRequest.create(
@@ -99,19 +111,45 @@ def plan(
 def plan_request(request: PlanRequest) -> SpeedProfile:
     """:func:`plan` for an already validated :class:`~speedplan.model.PlanRequest`."""
     model = build_model(request)
-    solution = model.solve()
-    spec = model.time_law
-    law = TimeLaw(model.problem.s, solution.w, p=spec.p, accel_start=spec.accel_start,
-                  accel_end=spec.accel_end)
-    profile = SpeedProfile(path=request.path, limits=request.limits, s=model.problem.s,
-                           w=solution.w, solution=solution, law=law, speed_bound=model.bound,
-                           request=request)
+    legs = [_solve(leg) for leg in model.legs]
+    profile = SpeedProfile(path=request.path, limits=request.limits, legs=tuple(legs),
+                           speed_bound=model.bound, request=request)
+    for _ in range(MAX_REFINEMENTS):
+        leg_checks = [profile.check_leg(i) for i in range(len(legs))]
+        if all(c.verification.ok for c in leg_checks):
+            break
+        for i, (leg, leg_check) in enumerate(zip(model.legs, leg_checks, strict=True)):
+            if not leg_check.verification.ok and isinstance(leg, Leg):
+                grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess)
+                finer = leg_on_grid(request, leg.bound, grid, leg.start, leg.v0, leg.a0,
+                                    leg.vf, leg.af)
+                legs[i] = _solve(finer)
+        profile = replace(profile, legs=tuple(legs))
     check = profile.verify()
     if not check.ok:
-        worst = ", ".join(f"{k} {r:.3f}×" for k, r in check.violations.items())
+        worst = ", ".join(f"{k} {r:.3f}× at s={check.where.get(k, float('nan')):.4g} m"
+                          for k, r in check.violations.items())
         warnings.warn(
-            f"the planned trajectory exceeds limits beyond tolerance ({worst} of the limit); "
-            "refine the grid (larger n or smaller ds) — see profile.verify()",
+            f"the planned trajectory exceeds limits beyond tolerance ({worst} of the limit) "
+            f"even after {MAX_REFINEMENTS} local refinements; status 'limits_exceeded' — see "
+            "profile.verification, or plan with a finer grid (n or ds)",
             LimitWarning, stacklevel=3,
         )
-    return replace(profile, verification=check)
+    return replace(profile, verification=check, limits_exceeded=not check.ok)
+
+
+def _solve(leg: Leg | ForcedLeg) -> LegResult:
+    """Solve one leg and build its law."""
+    if isinstance(leg, ForcedLeg):
+        t0 = time.perf_counter()
+        law = law_for(leg.s, leg.w, leg.time_law)
+        duration = law.duration
+        solution = DiscreteSolution(
+            w=leg.w, objective=duration, lower_bound=duration, gap=0.0, exact=True,
+            exact_a_priori=True, jerk_violation=0.0, refined=False, status="optimal",
+            solve_time=time.perf_counter() - t0, backend="forced",
+        )
+        return LegResult(start=leg.start, s=leg.s, solution=solution, law=law)
+    solution = leg.solve()
+    return LegResult(start=leg.start, s=leg.problem.s, solution=solution,
+                     law=law_for(leg.problem.s, solution.w, leg.time_law))

@@ -62,7 +62,7 @@ def test_cli_json_output(tmp_path, request):
         (["plan", "paths/u_turn.json", "--v-max", "-1", "--a-max", "1", "--a-lat-max", "1",
           "--j-max", "1"], 2, "`v_max`"),
         (["plan", "paths/slow_zone.json", *LGV_ARGS, "--v0", "2", "--a-decel", "0.01"], 3,
-         "cannot brake"),
+         "too short"),
         (["plan", "paths/u_turn.json", *LGV_ARGS, "--standstill", "bogus"], 2, "invalid choice"),
         (["frobnicate"], 2, "invalid choice"),
     ],

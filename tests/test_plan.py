@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import glob
+import itertools
 import warnings
 
 import numpy as np
@@ -13,14 +14,15 @@ from speedplan import (
     InfeasibleError,
     InvalidInputError,
     Limits,
-    LimitWarning,
     Path,
     SpeedZone,
     plan,
 )
 from speedplan.geometry import Arc, Clothoid, Line
 from speedplan.io import read_path, read_zones
-from speedplan.timing import TOLERANCES
+from speedplan.model import PlanRequest, build_model
+from speedplan.timing import TOLERANCES, law_for
+from speedplan.timing.verify import check_law
 
 LGV = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 ROAD = Limits(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0)
@@ -119,14 +121,40 @@ def test_every_sample_path(file):
     assert_physics(profile)
 
 
-def test_limit_ratios_shrink_as_the_grid_is_refined():
+def _law_check(path, lim, **kw):
+    """The check of a plan's law on its initial grid, before any local refinement."""
+    leg = build_model(PlanRequest.create(path, lim, **kw)).legs[0]
+    law = law_for(leg.problem.s, leg.solve().w, leg.time_law)
+    return check_law(law, 0.0, path, leg.bound, lim).verification, law.duration
+
+
+def test_limit_ratios_and_duration_converge_as_the_grid_is_refined():
     path = Path.from_segments([Line(30.0)])
-    with pytest.warns(LimitWarning, match="jerk"):  # too coarse: plan() says so
-        coarse = plan(path, LGV, n=300).verify()
-    assert not coarse.ok and "jerk" in coarse.violations
-    fine = plan(path, LGV, n=2400).verify()
-    assert fine.ratios["jerk"] < coarse.ratios["jerk"]
-    assert fine.ratios["jerk"] <= 1.0 + TOLERANCES["jerk"] / 2
+    results = [_law_check(path, LGV, n=n) for n in (300, 600, 1200, 2400)]
+    jerk = [check.ratios["jerk"] for check, _ in results]
+    assert jerk[0] > 1.05 and all(b < a for a, b in itertools.pairwise(jerk))
+    assert jerk[-1] <= 1.01
+    reference = ruckig_duration(30.0, LGV)
+    errors = [abs(d / reference - 1) for _, d in results]
+    assert all(b < a for a, b in itertools.pairwise(errors))
+    assert errors[-1] < 1e-5
+
+
+def test_coarse_grid_is_refined_where_the_limits_are_exceeded():
+    path = Path.from_segments([Line(30.0)])
+    before, _ = _law_check(path, LGV, n=300)
+    assert "jerk" in before.violations  # the uniform 300-node law breaks the 5 % tolerance
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        profile = plan(path, LGV, n=300)
+    assert profile.status == "optimal" and profile.verification.ok
+    assert profile.s.size > 300
+    cruise = (profile.s[:-1] > 12.0) & (profile.s[:-1] < 18.0)
+    steps = np.diff(profile.s)
+    assert steps[cruise] == pytest.approx(30.0 / 299, rel=1e-2)  # the cruise keeps its steps
+    assert steps.min() < 0.6 * 30.0 / 299  # halved where the jerk was exceeded
+    assert_physics(profile)
+    assert profile.duration >= ruckig_duration(30.0, LGV) * (1 - 1e-4)
 
 
 def test_moving_start_begins_exactly_at_the_given_state():
@@ -148,11 +176,13 @@ def test_impossible_boundary_states():
         plan(line, LGV, v0=2.5)
     with pytest.raises(InvalidInputError, match="`a0`"):
         plan(line, LGV, v0=0.0, a0=0.3)
-    with pytest.raises(InfeasibleError, match=r"pass through zero"):
+    with pytest.raises(InfeasibleError, match=r"falls to .* < 0") as info:
         plan(line, LGV, v0=0.2, a0=-0.9)
+    assert info.value.constraint == "jerk" and info.value.s == 0.0
     zone = SpeedZone([(1.0, -1.0), (5.0, -1.0), (5.0, 1.0), (1.0, 1.0)], v_max=0.5)
-    with pytest.raises(InfeasibleError, match="cannot brake from v0=2") as info:
+    with pytest.raises(InfeasibleError, match=r"from v0=2 m/s.* cannot slow down") as info:
         plan(line, LGV, v0=2.0, zones=[zone])
+    assert info.value.constraint == "speed_bound"
     assert info.value.s == pytest.approx(1.0, abs=0.05)
 
 
@@ -216,7 +246,8 @@ def test_moving_start_that_must_brake_is_jerk_limited_from_its_first_instant():
     close_zone = SpeedZone([(2.0, -1.0), (6.0, -1.0), (6.0, 1.0), (2.0, 1.0)], v_max=0.3)
     with pytest.raises(InfeasibleError, match="j_max") as info:
         plan(near, LGV, v0=2.0, zones=[close_zone])
-    assert info.value.constraint == "jerk" and info.value.s == pytest.approx(2.0, abs=0.05)
+    assert info.value.constraint == "speed_bound"
+    assert info.value.s == pytest.approx(2.0, abs=0.05)
 
 
 def test_verify_with_plans_bound_equals_verify_with_any_callable():

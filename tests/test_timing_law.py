@@ -1,4 +1,4 @@
-"""The time law on closed-form speed laws (no solver involved)."""
+"""The time law on closed-form speed laws and synthetic discrete data (no solver involved)."""
 
 from __future__ import annotations
 
@@ -8,12 +8,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from speedplan.model.boundary import max_jerk_envelope
+from speedplan.model.grid import GRADING
 from speedplan.timing import TimeLaw
+from speedplan.timing.law import LawChain
 
 
 def test_constant_speed_is_exact():
     s = np.linspace(0, 10, 21)
-    law = TimeLaw(s, np.full(21, 4.0))
+    law = TimeLaw(s, np.full(21, 4.0), accel_start=0.0, accel_end=0.0)
     assert law.duration == pytest.approx(5.0, rel=1e-13)
     t = np.array([0.0, 1.25, 5.0])
     assert law.position_at(t) == pytest.approx([0.0, 2.5, 10.0], rel=1e-12)
@@ -21,53 +23,158 @@ def test_constant_speed_is_exact():
     assert v == pytest.approx(2.0) and np.abs(a).max() < 1e-12 and np.abs(j).max() < 1e-12
 
 
-def test_constant_acceleration_from_speed_is_exact_with_w_interpolation():
-    # w = v0² + 2 a s is linear: t = (v - v0) / a exactly.
-    s = np.linspace(0, 8, 9)
+def test_constant_acceleration_from_speed_is_exact():
+    # w = v0² + 2 a s is linear: t = (v - v0) / a exactly, on a grid of arbitrary steps.
+    s = np.sort(np.concatenate(([0.0, 8.0], np.random.default_rng(1).uniform(0, 8, 9))))
     w = 1.0 + 2 * 0.5 * s
-    law = TimeLaw(s, w, p=1.0)
+    law = TimeLaw(s, w, accel_start=0.5, accel_end=0.5)
     assert law.duration == pytest.approx((3.0 - 1.0) / 0.5, rel=1e-12)
-    _, _, a, _ = law.kinematics(np.array([0.0, 4.0, 8.0]))
-    assert a == pytest.approx(0.5, rel=1e-12)
+    _, _, a, j = law.kinematics(np.array([0.0, 4.0, 8.0]))
+    assert a == pytest.approx(0.5, rel=1e-12) and np.abs(j).max() < 1e-12
+    assert np.abs(law.node_offsets()).max() < 1e-12
 
 
 @settings(max_examples=20, deadline=None)
-@given(j=st.floats(0.05, 20.0), length=st.floats(0.1, 50.0))
-def test_max_jerk_start_reproduced_exactly(j, length):
-    # From rest with jerk j: s = j t³/6, v = j t²/2, a = j t. u = w^(3/4) is linear in s,
-    # so the interpolant reproduces it exactly on any grid.
-    s = np.sort(np.concatenate(([0.0, length], np.random.default_rng(0).uniform(0, length, 7))))
-    law = TimeLaw(s, max_jerk_envelope(s, j))
-    t_end = (6 * length / j) ** (1 / 3)
-    assert law.duration == pytest.approx(t_end, rel=1e-10)
-    tt = np.linspace(0, t_end, 11)
-    q = law.position_at(tt)
-    assert q == pytest.approx(j * tt**3 / 6, rel=1e-9, abs=1e-12 * length)
-    _, v, a, jerk = law.kinematics(q)
-    assert v == pytest.approx(j * tt**2 / 2, rel=1e-8, abs=1e-12)
-    assert a == pytest.approx(j * tt, rel=1e-8, abs=1e-12)
-    assert jerk == pytest.approx(np.full(11, j), rel=1e-8)
+@given(j=st.floats(0.05, 20.0), length=st.floats(0.001, 5000.0))
+def test_max_jerk_start_and_stop_are_reproduced(j, length):
+    # A rest-to-rest move that is a max-jerk start followed by its mirror (jerk +j, then -j
+    # then +j): u = w^(3/4) is linear near both ends, so the law follows the exact motion there
+    # (up to the bend that anchors the w-region's node offsets: 1e-6 relative on this grid).
+    s = np.linspace(0.0, length, 401)
+    w = np.minimum(max_jerk_envelope(s, j), max_jerk_envelope(length - s, j))
+    law = TimeLaw(s, w, j_max=j)
+    lead, trail = law._regions
+    assert lead > 0 and trail > 0
+    d = s[: lead // 2]  # well inside the standstill region
+    _, v, a, jerk = law.kinematics(d)
+    t = (6 * d / j) ** (1 / 3)
+    assert v == pytest.approx(j * t**2 / 2, rel=1e-5, abs=1e-15 * max(length, 1))
+    assert a == pytest.approx(j * t, rel=1e-5, abs=1e-15 * max(length, 1))
+    assert jerk == pytest.approx(np.full(d.size, j), rel=1e-4)
+    assert law.kinematics(np.array([0.0, length]))[1] == pytest.approx([0.0, 0.0], abs=1e-300)
 
 
 def test_prescribed_end_accelerations_are_met_exactly():
     s = np.linspace(0, 5, 11)
     w = (1.0 + 0.1 * s) ** 2
     law = TimeLaw(s, w, accel_start=0.3, accel_end=-0.2)
-    _, _, a, _ = law.kinematics(np.array([0.0, 5.0]))
+    _, v, a, _ = law.kinematics(np.array([0.0, 5.0]))
     assert a == pytest.approx([0.3, -0.2], abs=1e-12)
-    _, v, _, _ = law.kinematics(np.array([0.0, 5.0]))
     assert v == pytest.approx([1.0, 1.5], rel=1e-12)
+
+
+def _abrupt_grid():
+    # Steps that jump by 6x and back, as the old adaptive grid did at its node cap.
+    h = np.concatenate((np.full(40, 0.01), np.full(30, 0.06), np.full(40, 0.01), np.full(50, 0.06)))
+    return np.concatenate(([0.0], np.cumsum(h)))
+
+
+def test_node_offsets_are_local_on_a_grid_with_abrupt_steps():
+    # The trapezoid integration of midpoint slopes that main used drifted on such grids (a
+    # 400 m move cruised 9.7 % above v_max). The dual-cell law's offset at node k is exactly
+    # h_{k-1} h_k w''_k / 8 minus that of the first interior node (the local term telescopes).
+    s = _abrupt_grid()
+    w = 4.0 + np.sin(s) * 0.5  # curvature everywhere, so every step change could drift
+    law = TimeLaw(s, w, accel_start=0.25 * np.cos(0.0), accel_end=0.25 * np.cos(s[-1]))
+    h = np.diff(s)
+    h0, h1 = h[:-1], h[1:]
+    d2 = 2 * (w[:-2] / (h0 * (h0 + h1)) - w[1:-1] / (h0 * h1) + w[2:] / (h1 * (h0 + h1)))
+    local = h0 * h1 * d2 / 8.0
+    off = law.node_offsets()[1:-1]
+    # Between the correction windows of the moving ends (20 cells each) they are the local
+    # term exactly; in the windows they differ by the start's own local term, spread out.
+    inner = slice(25, s.size - 25)
+    assert np.abs(off[inner] - local[inner]).max() < 1e-13
+    assert np.abs(off).max() < 2 * np.abs(local).max() + 1e-12
+    assert law.node_offsets()[[0, -1]] == pytest.approx([0.0, 0.0], abs=1e-14)
+
+
+def test_jerk_follows_the_discrete_rows_within_the_step_ratio():
+    # w'' on each half dual cell is D2 h_k / h_{k-1} or D2 h_{k-1} / h_k: the law's jerk
+    # exceeds the discrete jerk by at most the step ratio (and sqrt(w) inside the cell).
+    rng = np.random.default_rng(3)
+    h = 0.01 * np.exp(np.cumsum(rng.uniform(-GRADING, GRADING, 400)))
+    s = np.concatenate(([0.0], np.cumsum(h)))
+    w = 1.0 + 0.3 * np.sin(3 * s)
+    law = TimeLaw(s, w, accel_start=0.45, accel_end=0.45 * np.cos(3 * s[-1]))
+    hh = np.diff(s)
+    h0, h1 = hh[:-1], hh[1:]
+    d2 = 2 * (w[:-2] / (h0 * (h0 + h1)) - w[1:-1] / (h0 * h1) + w[2:] / (h1 * (h0 + h1)))
+    discrete = np.abs(0.5 * d2 * np.sqrt(w[1:-1])).max()
+    ex = law.extremes()
+    realised = max(ex["jerk"][1].max(), -ex["jerk"][2].min())
+    assert realised <= discrete * (1 + GRADING) * (1 + 1e-3)
+
+
+def test_no_c1_interpolant_of_a_jerk_switch_stays_within_the_limit():
+    # Why the law does not pass exactly through the nodes. Discrete data satisfying every
+    # jerk row |D2| sqrt(w) <= 2 j: a cruise, then the braking jerk saturated from one node on.
+    # Any C¹ curve through it with |w''| <= c (c = the limit's curvature) starting the cell
+    # before the drop with zero slope can drop at most 0.914 c h² over the next cell (it may
+    # first swing up and down: the best swing turns at h (1 - 1/√2)); the data drop c h².
+    W, j, h = 225.0, 0.5, 0.4
+    c = 2 * j / np.sqrt(W) * (1 - 1e-12)
+    w = np.full(12, W)
+    w[6] = W - c * h**2
+    for k in range(7, 12):
+        w[k] = 2 * w[k - 1] - w[k - 2] - c * h**2
+    d2 = (w[:-2] - 2 * w[1:-1] + w[2:]) / h**2
+    assert np.all(np.abs(d2) * np.sqrt(w[1:-1]) <= 2 * j * (1 + 1e-12))  # a valid solution
+    tau = h * (1 - 1 / np.sqrt(2))
+    slope = c * (2 * tau - h)  # the most negative slope at s_5 after a cell with equal ends
+    best_drop = -slope * h + 0.5 * c * h**2
+    assert best_drop == pytest.approx(0.914 * c * h**2, rel=1e-3)
+    assert W - w[6] > best_drop * 1.09  # so any node-exact C¹ law needs > 1.09× the jerk
+    # The dual-cell law stays within the limit instead (up to sqrt(w) in the cell) ...
+    s = np.arange(12) * h
+    law = TimeLaw(s, w, accel_start=0.0, accel_end=(w[-1] - w[-2]) / (2 * h))
+    ex = law.extremes()
+    assert max(ex["jerk"][1].max(), -ex["jerk"][2].min()) <= j * (1 + 1e-3)
+    # ... at the price of a local node offset of at most h² |w''| / 8 (1e-6 relative here).
+    assert np.abs(law.node_offsets()).max() <= h**2 * c / 8 * (1 + 1e-9) + 1e-12
 
 
 def test_time_and_position_are_inverse_near_standstill():
     s = np.linspace(0, 3, 31)
     w = np.minimum(max_jerk_envelope(s, 0.5), max_jerk_envelope(3 - s, 0.5))
-    law = TimeLaw(s, w)
+    law = TimeLaw(s, w, j_max=0.5)
     tt = np.linspace(0, law.duration, 2001)
     q = law.position_at(tt)
     assert np.all(np.diff(q) >= 0)
     assert q[0] == 0.0 and q[-1] == pytest.approx(3.0, abs=1e-12)
-    # Near the stop, s is resolved to ~1e-15 m while v -> 0: the time error ds/v is bounded by
-    # float resolution, ~3e-10 s at 3 ms before the stop.
     inner = (tt > 1e-3) & (tt < law.duration - 1e-3)
     assert law.time_at(q[inner]) == pytest.approx(tt[inner], abs=1e-9)
+
+
+def test_extremes_are_exact_maxima_of_each_piece():
+    # Against dense sampling of the same law: the closed-form extremes bound every sample
+    # and are attained (within sampling resolution).
+    s = np.linspace(0, 4, 41)
+    w = np.minimum(max_jerk_envelope(s, 0.5), max_jerk_envelope(4 - s, 0.5))
+    w = np.minimum(w, 1.2)
+    law = TimeLaw(s, w, j_max=0.5)
+    ex = law.extremes()
+    knots = law.knots
+    frac = np.linspace(1e-9, 1 - 1e-9, 2001)  # inside each piece (a knot belongs to the next)
+    q = knots[:-1, None] + np.diff(knots)[:, None] * frac[None, :]
+    _, _, a, jerk = law.kinematics(q.ravel())
+    a, jerk = a.reshape(q.shape), jerk.reshape(q.shape)
+    for name, val in (("a", a), ("jerk", jerk)):
+        top, bottom = ex[name][1], ex[name][2]
+        scale = np.abs(val).max()
+        assert np.all(val.max(axis=1) <= top + 1e-12 * scale)
+        assert np.all(val.min(axis=1) >= bottom - 1e-12 * scale)
+        assert np.all(val.max(axis=1) >= top - 1e-3 * scale)  # u^(1/3) -> 0 at a stop
+
+
+def test_chain_of_laws_meets_at_rest():
+    s = np.linspace(0, 2, 41)
+    w = np.minimum(max_jerk_envelope(s, 0.5), max_jerk_envelope(2 - s, 0.5))
+    one = TimeLaw(s, w, j_max=0.5)
+    chain = LawChain((one, one), np.array([0.0, 2.0]))
+    assert chain.duration == pytest.approx(2 * one.duration, rel=1e-14)
+    t = np.linspace(0, chain.duration, 101)
+    q = chain.position_at(t)
+    assert np.all(np.diff(q) >= -1e-15) and q[-1] == pytest.approx(4.0)
+    assert chain.time_at(q) == pytest.approx(t, abs=1e-9)
+    assert chain.kinematics(np.array([2.0]))[1] == pytest.approx([0.0], abs=1e-12)

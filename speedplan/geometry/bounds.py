@@ -69,9 +69,10 @@ def speed_bounds(
 ) -> FloatArray:
     """Upper bound ``mu+(s)`` on ``w = v²`` [m²/s²] at arc lengths ``s`` [m].
 
-    ``mu+(s) = min(v_max², a_lat_max / |k(s)|)``; where ``a_lat_max`` is ``inf`` or the
-    curvature is 0 there is no lateral bound. It is further lowered to ``zone.v_max²`` wherever
-    the path point lies inside or on the boundary of a zone's polygon, and by ``v_limit``.
+    ``mu+(s) = min(v_max², a_lat_max / |k(s)|, (yaw_rate_max / |k(s)|)²)``; where a limit is
+    ``inf`` or the curvature is 0 that term is absent. It is further lowered to
+    ``zone.v_max²`` wherever the path point lies inside or on the boundary of a zone's
+    polygon, and by ``v_limit``.
 
     Parameters
     ----------
@@ -124,9 +125,11 @@ def _bounds(
     """:func:`speed_bounds` at ``q`` once the path's curvature there is known."""
     w = np.full(q.shape, limits.v_max**2)
     kappa = np.abs(curvature)
-    if np.isfinite(limits.a_lat_max):
-        with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore"):
+        if np.isfinite(limits.a_lat_max):
             w = np.minimum(w, np.where(kappa > 0, limits.a_lat_max / kappa, np.inf))
+        if np.isfinite(limits.yaw_rate_max):  # |κ| v <= ω
+            w = np.minimum(w, np.where(kappa > 0, (limits.yaw_rate_max / kappa) ** 2, np.inf))
     if zone_list:
         xy = path.point(q)
         for zone in zone_list:
@@ -159,10 +162,17 @@ class SpeedBound:
     limits: Limits
     zones: list[SpeedZone] | None = None
     v_limit: Any = None
+    offset: float = 0.0
+
+    def at_offset(self, offset: float) -> SpeedBound:
+        """The same bound read from ``offset`` [m] on: ``s -> mu+(offset + s)``."""
+        return SpeedBound(self.path, self.limits, self.zones, self.v_limit,
+                          self.offset + float(offset))
 
     def __call__(self, s: FloatArray) -> FloatArray:
         """Bound at arc lengths ``s`` [m²/s²]."""
-        return speed_bounds(self.path, self.limits, s, zones=self.zones, v_limit=self.v_limit)
+        q = as_array("s", s) + self.offset if self.offset else s
+        return speed_bounds(self.path, self.limits, q, zones=self.zones, v_limit=self.v_limit)
 
     def given_curvature(self, s: Any, curvature: Any) -> FloatArray:
         """Bound at arc lengths ``s`` [m] where the path's ``curvature`` [1/m] is known.
@@ -171,7 +181,7 @@ class SpeedBound:
         arc-length inversion (``SpeedProfile.verify`` has it already). Neither ``s`` nor
         ``curvature`` is checked against the path.
         """
-        q = as_array("s", s)
+        q = as_array("s", s) + self.offset
         kappa = np.asarray(curvature, dtype=np.float64)  # NaN passes: verify() reports it
         if kappa.shape != q.shape:
             raise InvalidInputError(

@@ -19,13 +19,10 @@ import numpy as np
 
 from ..core.checks import FloatArray, IntArray
 from ..core.errors import InvalidInputError
+from ..core.numerics import GAUSS_NODES, GAUSS_WEIGHTS, SHORT_NODES, SHORT_WEIGHTS
 
 __all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "CurvePiece", "ParametricCurve", "Piece",
            "ReversedPiece"]
-
-#: 16-point Gauss–Legendre rule on [0, 1]: exact for polynomials of degree 31.
-GAUSS_NODES, GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(16)
-GAUSS_NODES, GAUSS_WEIGHTS = 0.5 * (GAUSS_NODES + 1.0), 0.5 * GAUSS_WEIGHTS
 
 #: Sub-intervals per polynomial piece in the arc-length table of a :class:`CurvePiece`.
 _TABLE_SPLIT = 8
@@ -37,8 +34,7 @@ _INVERSION_STEPS = 60
 #: 4-point Gauss–Legendre rule on [0, 1] for the arc length over a Newton step of the
 #: inversion; used for steps of at most ``_SHORT_STEP`` of a table cell, where it is exact to
 #: rounding (a cell takes the 16-point rule).
-_SHORT_NODES, _SHORT_WEIGHTS = np.polynomial.legendre.leggauss(4)
-_SHORT_NODES, _SHORT_WEIGHTS = 0.5 * (_SHORT_NODES + 1.0), 0.5 * _SHORT_WEIGHTS
+_SHORT_NODES, _SHORT_WEIGHTS = SHORT_NODES, SHORT_WEIGHTS
 _SHORT_STEP = 1e-3
 
 

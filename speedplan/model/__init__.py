@@ -8,6 +8,7 @@ Modules, one job each:
   (envelopes, reachability);
 * :mod:`~speedplan.model.grid` — the default arc-length grids;
 * :mod:`~speedplan.model.standstill` — jerk rows next to a standstill;
+* :mod:`~speedplan.model.refine` — local grid refinement where a law exceeds a limit;
 * :mod:`~speedplan.model.build` — :func:`build_model`: request -> :class:`Model` (speed bound,
   :class:`~speedplan.solve.DiscreteProblem`, time-law options), and solving it with errors in
   physical terms.
@@ -15,7 +16,8 @@ Modules, one job each:
 This layer imports ``core``, ``geometry`` and ``solve``.
 """
 
-from .build import Model, TimeLawSpec, build_model
+from .build import ForcedLeg, Leg, Model, TimeLawSpec, build_model
 from .request import STANDSTILL_MODES, PlanRequest
 
-__all__ = ["STANDSTILL_MODES", "Model", "PlanRequest", "TimeLawSpec", "build_model"]
+__all__ = ["STANDSTILL_MODES", "ForcedLeg", "Leg", "Model", "PlanRequest", "TimeLawSpec",
+           "build_model"]

@@ -1,30 +1,42 @@
-"""From a physical request to the discrete problem: bounds, envelopes, grid, jerk rows.
+"""From a physical request to discrete problems: legs, bounds, envelopes, grid, jerk rows.
 
 :func:`build_model` is the one place where limits in SI units become the rows of a
-:class:`~speedplan.solve.DiscreteProblem`; :meth:`Model.solve` solves it and restates a
-discrete infeasibility in speeds and metres.
+:class:`~speedplan.solve.DiscreteProblem`. A request is split into *legs* at every point
+where the vehicle must be at rest: where a boundary state forces a stop on the way (a
+decelerating start whose speed falls exactly to zero: the motion to that point is forced, a
+:class:`ForcedLeg`), and — with the route and cusp support — at cusps and stops. Each
+:class:`Leg` is planned on its own; :meth:`Leg.solve` restates a discrete infeasibility in
+speeds and metres.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
+from ..core.limits import Limits
 from ..geometry import SpeedBound
 from ..solve import DiscreteProblem, DiscreteSolution, solve_problem
-from .boundary import check_boundary_state, jerk_motion_w
+from .boundary import check_reachable_states, jerk_motion_w, turnaround_speed
 from .grid import adaptive_grid, uniform_grid
 from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
 
-__all__ = ["NO_JERK_NODES", "Model", "TimeLawSpec", "build_model", "node_bounds"]
+__all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "TimeLawSpec", "build_leg",
+           "build_model", "node_bounds"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
+#: A decelerating boundary state whose speed falls to within this fraction of its own speed
+#: (``v - a²/(2 j)``) of zero comes to rest on the way: the gain of passing through at that
+#: speed is below any resolvable time, and the dip could not be gridded.
+TOUCH_ZERO = 1e-6
+#: Nodes of the sampled forced motion of a :class:`ForcedLeg`.
+FORCED_NODES = 401
 
 
 @dataclass(frozen=True)
@@ -33,100 +45,209 @@ class TimeLawSpec:
 
     Attributes
     ----------
-    p : float
-        Exponent of the interpolated ``u = w^p``: 3/4 for a smooth standstill, 1 otherwise.
+    j_max : float or None
+        Jerk limit of a smooth standstill (the law then follows the max-jerk start and stop
+        exactly at ends at rest); ``None`` for the free standstill or no jerk limit.
     accel_start, accel_end : float or None
         Prescribed accelerations at moving ends [m/s²]; ``None`` keeps the discrete slope.
     """
 
-    p: float
+    j_max: float | None
     accel_start: float | None
     accel_end: float | None
 
 
 @dataclass(frozen=True)
+class Leg:
+    """One piece of the request, from one boundary state (or stop) to the next.
+
+    Attributes
+    ----------
+    start : float
+        Arc length of the leg's start along the request's path [m].
+    length : float
+        Leg length [m].
+    v0, a0, vf, af : float
+        Boundary states of the leg [m/s, m/s²].
+    bound : SpeedBound
+        Speed bound on the leg's own path (arc length from 0) [m²/s²].
+    problem : DiscreteProblem
+        Grid (from 0 to ``length``), node bounds with the boundary envelopes, rows.
+    time_law : TimeLawSpec
+        How to build the continuous law from its solution.
+    refine : str
+        Refinement mode; ``backend``: relaxation backend (from the request).
+    """
+
+    start: float
+    length: float
+    v0: float
+    a0: float
+    vf: float
+    af: float
+    bound: SpeedBound
+    problem: DiscreteProblem
+    time_law: TimeLawSpec
+    limits: Limits
+    refine: str = "auto"
+    backend: str = "auto"
+
+    def solve(self) -> DiscreteSolution:
+        """Solve the leg's discrete problem; an infeasibility is restated physically."""
+        try:
+            return solve_problem(self.problem, refine=self.refine, backend=self.backend)
+        except InfeasibleError as exc:
+            raise _explain(exc, self) from exc
+
+
+@dataclass(frozen=True)
+class ForcedLeg:
+    """A piece of motion with no freedom left: the max-jerk motion from a state to rest.
+
+    From ``(v0, a0)`` with ``v0 = a0² / (2 j)`` (``a0 < 0``) every jerk-limited motion must
+    apply ``+j`` until it is at rest; ``w`` is that motion sampled on ``s`` (or its time
+    reversal at the end of a request, arriving at ``(vf, af)`` from rest).
+    """
+
+    start: float
+    length: float
+    v0: float
+    a0: float
+    vf: float
+    af: float
+    s: FloatArray
+    w: FloatArray
+    time_law: TimeLawSpec
+
+
+@dataclass(frozen=True)
 class Model:
-    """A request modelled as a discrete problem.
+    """A request modelled as legs between standstills.
 
     Attributes
     ----------
     request : PlanRequest
         What was asked.
     bound : SpeedBound
-        ``s -> mu+(s)`` [m²/s²] (limits, curvature, zones, ``v_limit``).
-    problem : DiscreteProblem
-        Grid, node bounds (with the boundary envelopes), acceleration and jerk rows.
-    time_law : TimeLawSpec
-        How to build the continuous time law from the solution.
+        ``s -> mu+(s)`` [m²/s²] along the whole path.
+    legs : tuple of Leg or ForcedLeg
+        In order; consecutive legs meet at rest.
     """
 
     request: PlanRequest
     bound: SpeedBound
-    problem: DiscreteProblem
-    time_law: TimeLawSpec
-
-    def solve(self) -> DiscreteSolution:
-        """Solve the discrete problem; an infeasibility is restated in speeds and metres."""
-        try:
-            return solve_problem(self.problem, refine=self.request.refine,
-                                 backend=self.request.backend)
-        except InfeasibleError as exc:
-            raise explain_infeasible(exc, self) from exc
+    legs: tuple[Leg | ForcedLeg, ...] = field(default_factory=tuple)
 
 
 def build_model(request: PlanRequest) -> Model:
-    """Model ``request`` as a discrete problem.
+    """Model ``request``: split it into legs and build each leg's discrete problem.
 
     Raises
     ------
     InvalidInputError
         A boundary speed above the speed bound, or a speed bound of 0 inside the path.
     InfeasibleError
-        A boundary state no jerk-limited motion can leave or reach.
+        A boundary state no jerk-limited motion can leave or reach (which state, which
+        limit), or a path too short to join them.
     """
     lim = request.limits
-    check_boundary_state(request.v0, request.a0, lim.j_max, end=False)
-    check_boundary_state(request.vf, request.af, lim.j_max, end=True)
-    zone_list = None if request.zones is None else list(request.zones)
-    bound = SpeedBound(request.path, lim, zone_list, request.v_limit)
-    length = float(request.path.length)
+    path = request.path
+    length = float(path.length)
+    bound = SpeedBound(path, lim, None if request.zones is None else list(request.zones),
+                       request.v_limit)
     _check_end_speeds(request, bound, length)
-    envelopes = _Envelopes(request, length)
+    if request.jerk_limited:
+        check_reachable_states(request.v0, request.a0, request.vf, request.af, length,
+                               lim.v_max, lim.a_max, lim.a_decel, lim.j_max)
+    legs: list[Leg | ForcedLeg] = []
+    v0, a0, vf, af = request.v0, request.a0, request.vf, request.af
+    lo, hi = 0.0, length
+    head = _forced_stop(v0, a0, lim, end=False) if request.jerk_limited else None
+    tail = _forced_stop(vf, af, lim, end=True) if request.jerk_limited else None
+    if head is not None:
+        legs.append(head)
+        lo, v0, a0 = head.length, 0.0, 0.0
+    if tail is not None:
+        hi, vf, af = length - tail.length, 0.0, 0.0
+    if hi - lo > 1e-12 * length:
+        legs.append(build_leg(request, bound, lo, hi, v0, a0, vf, af))
+    elif head is not None and tail is not None:
+        raise InfeasibleError(
+            "the path is too short: both boundary states force a stop and the two stops "
+            "overlap", constraint="length", s=length)
+    if tail is not None:
+        legs.append(_shifted(tail, length - tail.length))
+    return Model(request=request, bound=bound, legs=tuple(legs))
 
+
+def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0: float,
+              a0: float, vf: float, af: float) -> Leg:
+    """The discrete problem of the stretch ``[lo, hi]`` of the request's path."""
+    lim = request.limits
+    length = hi - lo
+    leg_bound = bound if (lo == 0.0 and hi == float(request.path.length)) else _sub_bound(
+        request, bound, lo, hi)
+    env = _Envelopes(lim, request.smooth_standstill, request.jerk_limited, v0, a0, vf, af,
+                     length)
     if request.n is not None or request.ds is not None:
-        s = uniform_grid(length, n=request.n, ds=request.ds)
+        n = None if request.n is None else request.n
+        s = uniform_grid(length, n=n, ds=request.ds)
     elif request.jerk_limited:
-        s = adaptive_grid(length, lambda q: envelopes.cap(q, bound(q)), a_max=lim.a_max,
+        low = [v for v in (v0, vf) if v > 0] + [
+            turnaround_speed(v, a, lim.j_max) for v, a in ((v0, a0), (vf, -af))
+            if v > 0 and a < 0]
+        s = adaptive_grid(length, lambda q: env.cap(q, leg_bound(q)), a_max=lim.a_max,
                           a_decel=lim.a_decel, v_max=lim.v_max, j_max=lim.j_max,
-                          w_start=request.v0**2, w_end=request.vf**2)
+                          w_start=v0**2, w_end=vf**2,
+                          v_low=min((v for v in low if v > 0), default=None))
     else:
         s = uniform_grid(length, n=NO_JERK_NODES)
-    w_max = envelopes.cap(s, node_bounds(bound, s))
-    w_max[0] = max(w_max[0], request.v0**2)
-    w_max[-1] = max(w_max[-1], request.vf**2)
+    return leg_on_grid(request, leg_bound, s, lo, v0, a0, vf, af)
+
+
+def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: float, v0: float,
+                a0: float, vf: float, af: float) -> Leg:
+    """The leg's discrete problem on the grid ``s`` (from 0 to the leg's length)."""
+    lim = request.limits
+    length = float(s[-1])
+    env = _Envelopes(lim, request.smooth_standstill, request.jerk_limited, v0, a0, vf, af,
+                     length)
+    w_max = env.cap(s, node_bounds(bound, s))
+    w_max[0] = max(w_max[0], v0 * v0)
+    w_max[-1] = max(w_max[-1], vf * vf)
     if (w_max[1:-1] <= 0).any():
         i = int(np.flatnonzero(w_max[1:-1] <= 0)[0]) + 1
         raise InvalidInputError(
-            f"the speed bound is 0 at s={s[i]:.6g} m inside the path (infinite curvature, e.g. "
-            "a sharp polyline corner, or a zone with v_max=0); round the corners "
-            "(Path.from_waypoints(..., kind='clothoid')) or split the path there"
+            f"the speed bound is 0 at s={lo + s[i]:.6g} m inside the path ({_zero_cause(bound)}); "
+            "split the path there to plan a stop"
         )
+    floor = env.floor(s)
+    if floor is not None:
+        _check_floor(floor, w_max, s, lo, v0, a0, vf, af)
     m = s.size
     jerk = np.full(m - 2, lim.J)
     if request.smooth_standstill:
-        calibrate_standstill_rows(jerk, s, request.v0, request.a0, request.vf, request.af,
-                                  lim.j_max)
+        calibrate_standstill_rows(jerk, s, v0, a0, vf, af, lim.j_max)
     problem = DiscreteProblem(
         s=s, w_max=w_max,
         accel=np.full(m - 1, lim.A), decel=np.full(m - 1, lim.A_decel),
-        jerk=jerk, w_start=request.v0**2, w_end=request.vf**2, w_min=envelopes.floor(s),
+        jerk=jerk, w_start=v0 * v0, w_end=vf * vf, w_min=floor,
     )
     law = TimeLawSpec(
-        p=0.75 if request.smooth_standstill else 1.0,
-        accel_start=request.a0 if request.v0 > 0 else None,
-        accel_end=request.af if request.vf > 0 else None,
+        j_max=lim.j_max if request.smooth_standstill else None,
+        accel_start=a0 if v0 > 0 and request.jerk_limited else None,
+        accel_end=af if vf > 0 and request.jerk_limited else None,
     )
-    return Model(request=request, bound=bound, problem=problem, time_law=law)
+    return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
+               problem=problem, time_law=law, limits=lim, refine=request.refine,
+               backend=request.backend)
+
+
+def _zero_cause(bound: SpeedBound) -> str:
+    if bound.zones and any(z.v_max == 0 for z in bound.zones):
+        return "a zone with v_max=0 stops the vehicle"
+    return ("infinite curvature, e.g. a sharp polyline corner: round the corners "
+            "(Path.from_waypoints with the default kind)")
 
 
 def _check_end_speeds(request: PlanRequest, bound: SpeedBound, length: float) -> None:
@@ -140,35 +261,100 @@ def _check_end_speeds(request: PlanRequest, bound: SpeedBound, length: float) ->
             )
 
 
+def _check_floor(floor: FloatArray, w_max: FloatArray, s: FloatArray, lo: float, v0: float,
+                 a0: float, vf: float, af: float) -> None:
+    """The slowest motion from the start (into the end) must stay under the speed bound."""
+    over = floor[1:-1] > w_max[1:-1] * (1 + 1e-9) + 1e-300
+    if over.any():
+        i = int(np.flatnonzero(over)[0]) + 1
+        near_start = s[i] < 0.5 * s[-1]
+        state = (f"v0={v0:.6g} m/s, a0={a0:.6g} m/s²" if near_start else
+                 f"vf={vf:.6g} m/s, af={af:.6g} m/s²")
+        verb = "cannot slow down to" if near_start else "cannot come from"
+        raise InfeasibleError(
+            f"from {state} a jerk-limited vehicle {verb} the speed bound "
+            f"{np.sqrt(w_max[i]):.6g} m/s at s={lo + s[i]:.6g} m: even its slowest motion is "
+            f"at {np.sqrt(floor[i]):.6g} m/s there (j_max, a_decel, a_max)",
+            constraint="speed_bound", s=float(lo + s[i]),
+        )
+
+
 @dataclass(frozen=True)
 class _Envelopes:
     """Jerk-limited envelopes of the motions leaving the start state and reaching the end."""
 
-    request: PlanRequest
+    limits: Limits
+    smooth: bool
+    jerk_limited: bool
+    v0: float
+    a0: float
+    vf: float
+    af: float
     length: float
 
     def cap(self, s: FloatArray, w: FloatArray) -> FloatArray:
-        """``w`` capped by the fastest motion leaving (v0, a0) and arriving at (vf, af)."""
-        req, lim = self.request, self.request.limits
-        if req.smooth_standstill:
-            w = np.minimum(w, jerk_motion_w(s, req.v0, req.a0, lim.j_max, lim.a_max))
-            w = np.minimum(w, jerk_motion_w(self.length - s, req.vf, -req.af, lim.j_max,
+        """``w`` capped by the fastest motion leaving (v0, a0) and arriving at (vf, af).
+
+        At rest the cap is the max-jerk start only for a smooth standstill (the paper's free
+        standstill lets the acceleration jump there); a moving state is always capped.
+        """
+        lim = self.limits
+        if not self.jerk_limited:
+            return w
+        if self.smooth or self.v0 > 0:
+            w = np.minimum(w, jerk_motion_w(s, self.v0, self.a0, lim.j_max, lim.a_max))
+        if self.smooth or self.vf > 0:
+            w = np.minimum(w, jerk_motion_w(self.length - s, self.vf, -self.af, lim.j_max,
                                             lim.a_decel))
         return w
 
     def floor(self, s: FloatArray) -> FloatArray | None:
         """The slowest motion leaving a moving start (and arriving at a moving end)."""
-        req, lim = self.request, self.request.limits
-        if not req.smooth_standstill or (req.v0 == 0.0 and req.vf == 0.0):
+        lim = self.limits
+        if not self.jerk_limited or (self.v0 == 0.0 and self.vf == 0.0):
             return None
         lo = np.zeros_like(s)
-        if req.v0 > 0:
-            lo = np.maximum(lo, jerk_motion_w(s, req.v0, min(req.a0, 0.0), -lim.j_max,
-                                              -lim.a_decel))
-        if req.vf > 0:
-            lo = np.maximum(lo, jerk_motion_w(self.length - s, req.vf, min(-req.af, 0.0),
-                                              -lim.j_max, -lim.a_max))
+        if self.v0 > 0:
+            lo = np.maximum(lo, jerk_motion_w(s, self.v0, self.a0, -lim.j_max, -lim.a_decel))
+        if self.vf > 0:
+            lo = np.maximum(lo, jerk_motion_w(self.length - s, self.vf, -self.af, -lim.j_max,
+                                              -lim.a_max))
         return lo
+
+
+def _forced_stop(v: float, a: float, lim: Limits, *, end: bool) -> ForcedLeg | None:
+    """The forced motion to rest when a decelerating start (accelerating end) touches zero."""
+    slowing = -a if not end else a
+    if not (v > 0 and slowing > 0):
+        return None
+    dip = turnaround_speed(v, -slowing, lim.j_max)
+    if dip > TOUCH_ZERO * v:
+        return None
+    # v = slowing²/(2 j): the forced motion is the max-jerk stop, time reversed, so
+    # u = w^{3/4} falls linearly to 0 over its length |a|³ / (6 j²).
+    length = slowing**3 / (6.0 * lim.j_max**2)
+    frac = np.linspace(0.0, 1.0, FORCED_NODES)
+    s = frac * length
+    if end:  # from rest at the leg's start to (v, a) at its end
+        w = v * v * frac ** (4.0 / 3.0)
+        law = TimeLawSpec(j_max=lim.j_max, accel_start=None, accel_end=a)
+        return ForcedLeg(start=0.0, length=length, v0=0.0, a0=0.0, vf=v, af=a, s=s, w=w,
+                         time_law=law)
+    w = v * v * (1.0 - frac) ** (4.0 / 3.0)
+    law = TimeLawSpec(j_max=lim.j_max, accel_start=a, accel_end=None)
+    return ForcedLeg(start=0.0, length=length, v0=v, a0=a, vf=0.0, af=0.0, s=s, w=w,
+                     time_law=law)
+
+
+def _shifted(leg: ForcedLeg, start: float) -> ForcedLeg:
+    return ForcedLeg(start=start, length=leg.length, v0=leg.v0, a0=leg.a0, vf=leg.vf,
+                     af=leg.af, s=leg.s, w=leg.w, time_law=leg.time_law)
+
+
+def _sub_bound(request: PlanRequest, bound: SpeedBound, lo: float, hi: float) -> SpeedBound:
+    """The speed bound of the stretch ``[lo, hi]`` in the leg's own arc length."""
+    del request, hi
+    return bound.at_offset(lo)
 
 
 def node_bounds(bound: Any, s: FloatArray, per_interval: int = 8) -> FloatArray:
@@ -187,24 +373,26 @@ def node_bounds(bound: Any, s: FloatArray, per_interval: int = 8) -> FloatArray:
     return np.asarray(w, dtype=np.float64)
 
 
-def explain_infeasible(exc: InfeasibleError, model: Model) -> InfeasibleError:
-    """Restate a discrete infeasibility in speeds and metres."""
-    where = exc.s
-    problem, lim, req = model.problem, model.request.limits, model.request
-    if where is None:
-        return InfeasibleError(f"no speed law meets the request: {exc}", constraint=exc.constraint)
-    i = int(np.argmin(np.abs(problem.s - where)))
-    v_there = float(np.sqrt(problem.w_max[i]))
+def _explain(exc: InfeasibleError, leg: Leg) -> InfeasibleError:
+    """Restate a discrete infeasibility in speeds and metres (positions along the path)."""
+    lim = leg.limits
+    if exc.s is None:
+        return InfeasibleError(
+            f"no speed law meets the request between s={leg.start:.6g} m and "
+            f"s={leg.start + leg.length:.6g} m: {exc}", constraint=exc.constraint)
+    where = leg.start + exc.s
+    i = int(np.argmin(np.abs(leg.problem.s - exc.s)))
+    v_there = float(np.sqrt(leg.problem.w_max[i]))
     if exc.constraint == "decel":
-        msg = (f"cannot brake from v0={req.v0:.6g} m/s to {v_there:.6g} m/s (the speed bound at "
-               f"s={where:.4g} m) under a_decel={lim.a_decel:.6g} m/s²")
-    elif exc.constraint == "jerk":
-        msg = (f"cannot brake from v0={req.v0:.6g} m/s to {v_there:.6g} m/s (the speed bound at "
-               f"s={where:.4g} m) under j_max={lim.j_max:.6g} m/s³ and "
-               f"a_decel={lim.a_decel:.6g} m/s²")
+        msg = (f"cannot brake from v0={leg.v0:.6g} m/s to {v_there:.6g} m/s (the speed bound "
+               f"at s={where:.4g} m) under a_decel={lim.a_decel:.6g} m/s²")
     elif exc.constraint == "accel":
-        msg = (f"cannot reach vf={req.vf:.6g} m/s at the end from {v_there:.6g} m/s (the speed "
-               f"bound at s={where:.4g} m) under a_max={lim.a_max:.6g} m/s²")
+        msg = (f"cannot reach vf={leg.vf:.6g} m/s at the end from {v_there:.6g} m/s (the "
+               f"speed bound at s={where:.4g} m) under a_max={lim.a_max:.6g} m/s²")
+    elif exc.constraint == "jerk":
+        msg = (f"cannot slow down in time for the speed bound {v_there:.6g} m/s at "
+               f"s={where:.4g} m from v0={leg.v0:.6g} m/s, a0={leg.a0:.6g} m/s² under "
+               f"j_max={lim.j_max:.6g} m/s³ and a_decel={lim.a_decel:.6g} m/s²")
     else:
         msg = str(exc)
     return InfeasibleError(msg, constraint=exc.constraint, s=where)

@@ -1,9 +1,25 @@
-"""Default arc-length grids: fine where the jerk-limited transitions are short.
+"""Default arc-length grids: fine where jerk-limited transitions happen, smoothly graded.
 
-A transition between accelerating and cruising takes ``t_j = min(a/j, sqrt(v_max/j))``
-seconds; at speed ``v`` it spans ``v t_j`` metres and from rest ``ℓ = j t_j³ / 6``. The default
-grid places ``per_phase`` nodes on each such transition, using the speed of the exact no-jerk
-optimum as the estimate of ``v(s)``: fine near standstill, coarser at cruise.
+A jerk-limited change of speed at speed ``v`` takes ``min(t_j, sqrt(v / j))`` seconds
+(``t_j = min(a / j, sqrt(v_max / j))``) and spans ``λ(v) = v min(t_j, sqrt(v / j))`` metres;
+from rest the first transition spans ``ℓ = j t_j³ / 6``. The default grid puts ``per_phase``
+nodes on each such length, with ``v(s)`` estimated by the exact no-jerk optimum under the
+boundary envelopes (so a decelerating start that dips to a low speed gets a fine grid there).
+
+Two properties the time law relies on (:mod:`speedplan.timing.law`):
+
+* **smooth grading**: neighbouring steps differ by at most :data:`GRADING` (1 %) wherever
+  the speed may change, by :data:`CRUISE_GRADING` (10 %) inside long stretches at a constant
+  speed bound; the law's jerk error is the local step ratio minus one;
+* **cruise is coarse**: far (``> 2 v_max t_j + 2 ℓ``) from any kink of the no-jerk profile
+  (where it is linear in ``w``: a cruise, a constant acceleration or braking) the step grows,
+  by 10 % per node, up to :data:`CRUISE_STEP` of the length: a long move costs about 100
+  nodes more than a short one, and does not hit the node cap with a coarse transition.
+
+Nodes are placed by inverting the node count ``N(s) = ∫ ds / h(s)`` exactly for a step
+``h(s)`` piecewise linear on a fine pre-grid: consecutive steps follow ``h(s)``, with no jump
+where the pre-grid cells meet (the old grid inverted a piecewise-linear count and its steps
+jumped by up to 19 % there).
 """
 
 from __future__ import annotations
@@ -16,22 +32,106 @@ from ..core.checks import FloatArray, grid_size
 from ..solve.nojerk import max_feasible_w
 from ..solve.problem import DiscreteProblem
 
-__all__ = ["DEFAULT_PER_PHASE", "MAX_DEFAULT_NODES", "adaptive_grid", "uniform_grid"]
+__all__ = [
+    "CRUISE_GRADING",
+    "CRUISE_STEP",
+    "DEFAULT_PER_PHASE",
+    "GRADING",
+    "MAX_DEFAULT_NODES",
+    "MIN_NODES",
+    "MIN_RELATIVE_STEP",
+    "adaptive_grid",
+    "graded_steps",
+    "nodes_from_steps",
+    "uniform_grid",
+]
 
-#: Nodes per jerk transition of the default grid (measured: jerk within 6 % of j_max on a
-#: straight rest-to-rest move; see the convergence table in the docs).
+#: Nodes per jerk transition of the default grid.
 DEFAULT_PER_PHASE = 80
+#: Largest default grid; beyond, every step grows in proportion (the grading ratio with it).
 MAX_DEFAULT_NODES = 20_000
+#: Fewest nodes of a default grid.
 MIN_NODES = 200
+#: Finest step of a default grid, relative to the length: near the end of a path of length
+#: L, positions are rounded to ~1e-16 L, so a step of 1e-9 L still has 7 correct digits (a
+#: transition shorter than ~1e-7 L — a 0.1 µm final jerk phase on a 1 km move — is then
+#: not resolved, and plan() reports it: status "limits_exceeded").
+MIN_RELATIVE_STEP = 1e-9
+#: Largest relative change between neighbouring steps where the speed may change.
+GRADING = 0.01
+#: Largest relative change between neighbouring steps inside long constant-bound stretches.
+CRUISE_GRADING = 0.1
+#: Largest step inside long constant-bound stretches, as a fraction of the length: nothing
+#: changes there, the steps only grow (by :data:`CRUISE_GRADING` per node) from the fine
+#: transitions on either side.
+CRUISE_STEP = 0.01
 
 
 def uniform_grid(length: float, *, n: int | None = None, ds: float | None = None) -> FloatArray:
     """Uniform grid over ``[0, length]`` with ``n`` nodes or step at most ``ds``."""
     if n is None:
-        assert ds is not None
+        if ds is None:
+            raise ValueError("uniform_grid needs `n` or `ds`")
         n = int(np.ceil(length / ds)) + 1
     n = grid_size("n", max(int(n), 3))
     return np.linspace(0.0, length, n)
+
+
+def graded_steps(s: FloatArray, h: FloatArray, rate: FloatArray) -> FloatArray:
+    """Largest steps ``<= h`` that change by at most ``rate`` per unit length.
+
+    ``h_out(s_i) = min_j (h_j + |τ_i - τ_j|)`` with ``τ = ∫ rate ds``: two min-plus passes
+    (``np.minimum.accumulate``), the same O(n) construction as the no-jerk profile.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.linspace(0.0, 10.0, 11)
+    >>> h = np.where(s == 5.0, 0.1, 10.0)
+    >>> graded_steps(s, h, np.full(11, 0.1)).round(6).tolist()[3:8]
+    [0.3, 0.2, 0.1, 0.2, 0.3]
+    """
+    tau = np.concatenate(([0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(s))))
+    fwd = tau + np.minimum.accumulate(h - tau)
+    bwd = (-tau + np.minimum.accumulate((h + tau)[::-1])[::-1])
+    out: FloatArray = np.minimum(np.minimum(fwd, bwd), h)
+    return out
+
+
+def nodes_from_steps(s: FloatArray, h: FloatArray) -> FloatArray:
+    """Grid with local step ``h(s)`` (piecewise linear over the pre-grid ``s``).
+
+    ``N(s) = ∫ ds / h`` is inverted exactly in each pre-grid cell (``h`` linear there gives a
+    logarithmic count), after scaling ``h`` so that ``N(length)`` is an integer: consecutive
+    steps then follow ``h`` smoothly.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> g = nodes_from_steps(np.array([0.0, 1.0]), np.array([0.25, 0.25]))
+    >>> g.tolist()
+    [0.0, 0.25, 0.5, 0.75, 1.0]
+    """
+    ds = np.diff(s)
+    dh = np.diff(h)
+    slope = dh / ds
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cell = np.where(np.abs(dh) > 1e-12 * h[:-1], np.log(h[1:] / h[:-1]) / slope, ds / h[:-1])
+    total = float(cell.sum())
+    count = max(int(np.ceil(total - 1e-9)), 2)
+    cell *= count / total  # scale h by total / count: N(length) = count exactly
+    scale = total / count
+    cum = np.concatenate(([0.0], np.cumsum(cell)))
+    targets = np.arange(1, count, dtype=np.float64)
+    i = np.clip(np.searchsorted(cum, targets, side="right") - 1, 0, ds.size - 1)
+    frac = targets - cum[i]  # nodes counted into cell i
+    h0 = h[i] * scale
+    g = slope[i]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        inner = np.where(np.abs(g) * frac > 1e-12, h0 * np.expm1(g * frac) / g, h0 * frac)
+    grid = np.concatenate(([s[0]], np.minimum(s[i] + inner, s[i + 1]), [s[-1]]))
+    out: FloatArray = np.maximum.accumulate(grid)
+    return out
 
 
 def adaptive_grid(
@@ -44,23 +144,109 @@ def adaptive_grid(
     j_max: float,
     w_start: float,
     w_end: float,
+    v_low: float | None = None,
     per_phase: float = DEFAULT_PER_PHASE,
+    max_nodes: int = MAX_DEFAULT_NODES,
 ) -> FloatArray:
-    """Non-uniform grid with node density ``per_phase / max(ℓ, v_est(s) t_j)``."""
+    """Smoothly graded grid with about ``per_phase`` nodes per jerk transition.
+
+    Parameters
+    ----------
+    length : float
+        Path length [m].
+    w_bound : callable
+        ``s -> w`` upper bound [m²/s²] including the boundary envelopes.
+    a_max, a_decel, v_max, j_max : float
+        Limits [SI].
+    w_start, w_end : float
+        Boundary values of ``w``.
+    v_low : float, optional
+        Lowest positive speed [m/s] of a moving boundary state: its own speed, or the speed a
+        decelerating start dips to, ``v0 - a0²/(2 j)``. The grid resolves the transitions at
+        that speed (away from a standstill the max-jerk start is not there to follow).
+    per_phase : float
+        Nodes per transition length.
+    max_nodes : int
+        Node cap; beyond it every step grows in proportion.
+    """
     a = min(a_max, a_decel)
     t_j = min(a / j_max, np.sqrt(v_max / j_max))
     ell = j_max * t_j**3 / 6.0
-    n_pre = int(np.clip(4 * length / max(ell, 1e-12), 2001, 200_001))
-    sf = np.linspace(0.0, length, n_pre)
-    pre = DiscreteProblem(
-        s=sf, w_max=w_bound(sf), accel=np.full(n_pre - 1, 2 * a_max),
-        decel=np.full(n_pre - 1, 2 * a_decel), jerk=np.full(n_pre - 2, np.inf),
-        w_start=w_start, w_end=w_end,
-    )
-    v_est = np.sqrt(max_feasible_w(pre, pin_ends=False))
-    density = per_phase / np.maximum(ell, v_est * t_j)
-    cum = np.concatenate(([0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(sf))))
-    n = int(np.clip(np.ceil(cum[-1]) + 1, MIN_NODES, MAX_DEFAULT_NODES))
-    grid: FloatArray = np.interp(np.linspace(0.0, cum[-1], n), cum, sf)
-    grid[0], grid[-1] = 0.0, length
+
+    def scale(v: FloatArray) -> FloatArray:
+        out: FloatArray = v * np.minimum(t_j, np.sqrt(v / j_max))
+        return out
+
+    # A move shorter than its jerk phases is made of (up to) four of them: resolve each.
+    floor = min(ell, 0.25 * length)
+    if v_low is not None and v_low > 0:
+        floor = min(floor, float(scale(np.array(v_low))))
+    margin = 2.0 * (v_max * t_j + ell)
+
+    def steps(sf: FloatArray) -> FloatArray:
+        """The graded step on the pre-grid ``sf``."""
+        wb = w_bound(sf)
+        pre = DiscreteProblem(
+            s=sf, w_max=wb, accel=np.full(sf.size - 1, 2 * a_max),
+            decel=np.full(sf.size - 1, 2 * a_decel), jerk=np.full(sf.size - 2, np.inf),
+            w_start=w_start, w_end=w_end,
+        )
+        w_est = max_feasible_w(pre, pin_ends=False)
+        h = np.maximum(np.maximum(scale(np.sqrt(w_est)), floor) / per_phase,
+                       MIN_RELATIVE_STEP * length)
+        # Long stretches where the no-jerk optimum is linear in w (a cruise, a constant
+        # acceleration or braking) hold nothing to resolve: coarse, graded faster. The no-jerk
+        # pass sums A h along the path, so it is linear (or meets a constant bound) only to
+        # ~1e-16 of that sum, which on a long slow move is far above 1e-12 of the bound.
+        top = max(float(np.max(wb)), 1e-300)
+        tol = 1e-9 * top + 1e-15 * 2.0 * max(a_max, a_decel) * length
+        flat = np.zeros(sf.size, dtype=bool)
+        d_left, d_right = np.diff(w_est)[:-1], np.diff(w_est)[1:]
+        cells = np.diff(sf)
+        curv = np.abs(d_right / cells[1:] - d_left / cells[:-1]) * np.minimum(cells[1:],
+                                                                             cells[:-1])
+        flat[1:-1] = curv <= tol
+        far = _distance_to(~flat, sf) > margin
+        h = np.where(far, np.maximum(h, CRUISE_STEP * length), h)
+        return graded_steps(sf, h, np.where(far, CRUISE_GRADING, GRADING))
+
+    # Pre-grid: uniform, with geometric clusters at both ends (where the standstill and the
+    # boundary states put the shortest transitions), refined where it cannot follow h.
+    n_pre = int(np.clip(4 * length / max(floor, 1e-12), 2001, 200_001))
+    ends = np.geomspace(max(floor / 8.0, 1e-12 * length), 0.5 * length, 200)
+    sf = np.unique(np.concatenate((np.linspace(0.0, length, n_pre), ends, length - ends)))
+    sf = sf[(sf >= 0.0) & (sf <= length)]
+    h = steps(sf)
+    for _ in range(3):
+        cell = np.diff(sf)
+        need = np.ceil(cell / (2.0 * np.minimum(h[:-1], h[1:]))).astype(np.int64)
+        coarse = np.flatnonzero(need > 1)
+        if coarse.size == 0 or sf.size > 2_000_000:
+            break
+        extra = [sf[k] + cell[k] * np.arange(1, min(int(need[k]), 64)) / min(int(need[k]), 64)
+                 for k in coarse]
+        sf = np.unique(np.concatenate([sf, *extra]))
+        h = steps(sf)
+    h_max = np.maximum(h, CRUISE_STEP * length)
+    for _ in range(4):
+        count = float(np.sum(np.diff(sf) * 0.5 * (1.0 / h[1:] + 1.0 / h[:-1])))
+        if count <= max_nodes - 1:
+            break
+        # Too many nodes: every step grows in proportion, but none beyond the cruise step.
+        h = graded_steps(sf, np.minimum(h * (count / (max_nodes - 1)), h_max),
+                         np.full(sf.size, CRUISE_GRADING))
+    if count < MIN_NODES - 1:
+        h = h * (count / (MIN_NODES - 1))
+    grid = nodes_from_steps(sf, h)
+    grid_size("n", grid.size)
     return grid
+
+
+def _distance_to(mask: np.ndarray, s: FloatArray) -> FloatArray:
+    """Distance from every ``s`` to the nearest ``s`` where ``mask`` holds (inf if none)."""
+    if not mask.any():
+        return np.full(s.shape, np.inf)
+    left = np.maximum.accumulate(np.where(mask, s, -np.inf))
+    right = np.minimum.accumulate(np.where(mask, s, np.inf)[::-1])[::-1]
+    out: FloatArray = np.minimum(s - left, right - s)
+    return out

@@ -1,22 +1,45 @@
-"""The continuous time law built from the discrete solution.
+"""The continuous speed law built from the discrete solution, and the time it implies.
 
-Why not a spline of ``w(s)``? A global cubic spline rings at profile kinks and overshoots the
-jerk limit by ~40 %. We interpolate ``u = w^p`` instead, with ``p = 3/4`` by default:
+The discrete problem controls, at each node ``k``, the three-point second difference
+``D2_k`` of ``w = v²`` together with ``sqrt(w_k)``: that is the jerk. Its natural continuous
+counterpart is the *dual-cell* interpolant: ``w'`` continuous and piecewise linear, equal to
+the secant slope ``(w_{k+1} - w_k) / h_k`` at every cell midpoint, so that ``w''`` on the dual
+cell around node ``k`` (from the midpoint before it to the midpoint after it) is ``D2_k``.
+Acceleration ``w'/2`` then stays between the discrete secant accelerations, and the jerk
+``w'' sqrt(w) / 2`` between the discrete jerk rows (times ``sqrt(w(s) / w_k)``): the law
+inherits the discrete limits with no ringing, which a global spline through the nodes does
+not (a cubic spline overshoots the jerk by ~40 %).
 
-* ``u'`` is piecewise linear through the discrete slopes ``(u_{k+1} - u_k) / h_k`` placed at
-  the cell midpoints, so ``u''`` is piecewise constant and equal to the discrete second
-  difference — a local construction with no ringing; ``u`` is C¹, hence ``s(t)`` is C².
-* From rest with zero acceleration the jerk-limited optimum has ``w ∝ s^{4/3}``, i.e. ``u``
-  linear in ``s``: the construction reproduces it exactly, acceleration starts at 0 and the
-  jerk ``(2/9) u'² + (2/3) u u''`` stays bounded at standstill.
-* Speed, acceleration and jerk follow in closed form from ``w = u^{1/p}``:
-  ``v = u^{1/(2p)}``, ``a = w'/2``, ``j = w'' v / 2``; time is ``t(s) = ∫ ds / v`` by
-  Gauss–Legendre quadrature, with the substitution ``σ = y³`` on pieces that start or end at
-  standstill (the integrand is singular there).
+**Why the law does not pass exactly through the nodes.** The discrete optimum switches its
+jerk between a cell and the next (e.g. a cruise node followed by a saturated braking node);
+its values then admit no C¹ interpolant with the jerk within the limit: on a 400 m road move
+the data need twice the limit's curvature over half a cell (``tests/test_timing_law.py``
+shows it). The dual-cell law spreads the switch over the dual cell, which the jerk limit
+allows, at the price of a *local* node offset ``≈ h_{k-1} h_k D2_k / 8``: zero wherever the
+discrete ``w`` is locally linear (cruise, constant acceleration), O(h²) elsewhere, measured
+below 1e-4 relative at the default resolution.
 
-The discrete slopes are not re-interpolated at the nodes: ``u(s_k)`` differs from ``u_k`` by
-``h² Δu''/8``, a local term that vanishes as the grid is refined. A smooth correction with zero
-slope at both ends makes the end value exact.
+**No drift on any grid.** With the curvature ``D2_k`` split at the node as ``D2_k h_k /
+h_{k-1}`` before it and ``D2_k h_{k-1} / h_k`` after it (the slope change across the dual
+cell is unchanged), the node offsets telescope: each is the local term above, whatever the
+steps; the trapezoid integration of midpoint slopes used before accumulated
+``Σ D2_i (h_i² - h_{i-1}²) / 8`` instead, and on a grid whose step changed abruptly the
+vehicle cruised 9.7 % above ``v_max``. The split changes the jerk by the grid's step ratio
+``max(h_k / h_{k-1}, h_{k-1} / h_k) - 1``, which the default grids keep below 1 %.
+
+**Standstill.** From rest with zero acceleration the jerk-limited optimum has
+``w ∝ s^{4/3}`` (``w''`` singular at ``s = 0``); over the leading (trailing) nodes that follow
+the max-jerk start (stop) the same construction runs on ``u = w^{3/4}``, which is linear
+there: the law reproduces that motion exactly, acceleration starts at 0 and the jerk
+``(2/9) u'² + (2/3) u u''`` stays bounded. Value and slope pass to ``w`` at the junction.
+A last, local correction (piecewise quadratic over the final stretch, curvature
+``O(offset / length²)``) makes the end value exact.
+
+Everything is a chain of quadratic pieces in ``w`` or ``u``: speed, acceleration and jerk
+follow in closed form, their extremes over each piece too (:meth:`TimeLaw.extremes`, what
+:meth:`SpeedProfile.verify` checks), and ``t(s) = ∫ ds / v`` by Gauss–Legendre quadrature
+(with the substitutions ``σ = y²`` and ``σ = y³`` on pieces ending at standstill, where the
+integrand is singular).
 """
 
 from __future__ import annotations
@@ -27,164 +50,332 @@ from functools import cached_property
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
-from ._quadrature import piece_integrals
+from ..core.numerics import GAUSS_NODES, GAUSS_WEIGHTS
 
-__all__ = ["TimeLaw"]
+__all__ = ["STANDSTILL_EXPONENT", "LawChain", "TimeLaw"]
+
+#: Exponent ``p`` of ``u = w^p`` on standstill regions: ``w ∝ s^{4/3}`` makes ``u`` linear.
+STANDSTILL_EXPONENT = 0.75
+#: Relative tolerance of "the discrete jerk is saturated" (standstill regions).
+_SATURATED = 1e-3
+#: Pieces over which a moving end's correction is spread (20 cells).
+_END_WINDOW = 40
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
+class _Pieces:
+    """Quadratic pieces ``y = Y + G x + C x² / 2`` between knots, in ``w`` or ``u``."""
+
+    x: FloatArray  # knots, shape (m + 1,)
+    y: FloatArray  # values at the knots (in each piece's own variable, see left/right)
+    g: FloatArray  # slopes at the knots
+    c: FloatArray  # curvature of each piece, shape (m,)
+    is_u: np.ndarray  # bool per piece: variable u = w^{3/4}
+    y_right: FloatArray  # value at each piece's right knot in the piece's own variable
+    g_right: FloatArray  # slope at each piece's right knot in the piece's own variable
+
+
+@dataclass(frozen=True, eq=False)
 class TimeLaw:
-    """C¹ interpolant ``u(s) = w(s)^p`` and the exact time law it implies.
+    """C¹ speed law ``w(s)`` through the discrete solution and the exact time law it implies.
 
     Parameters
     ----------
     s, w : ndarray, shape (n,)
-        Grid and squared speeds at the nodes.
-    p : float
-        Exponent of the interpolated variable: 3/4 (smooth standstill) or 1 (interpolate w).
+        Grid [m] and squared speeds at the nodes [m²/s²].
     accel_start, accel_end : float or None
-        Prescribed acceleration at the ends (only where the speed is positive); ``None`` keeps
-        the discrete slope there.
+        Acceleration at a moving start (end) [m/s²]; ``None`` keeps the discrete slope.
+    j_max : float or None
+        Jerk limit [m/s³] of a smooth standstill: ends at rest then follow the max-jerk start
+        (stop) in ``u = w^{3/4}`` over the nodes that lie on it. ``None``: the paper's free
+        standstill (the acceleration may jump at rest).
+
+    Examples
+    --------
+    A constant acceleration from 1 m/s: ``w`` linear in ``s`` is reproduced exactly.
+
+    >>> import numpy as np
+    >>> from speedplan.timing import TimeLaw
+    >>> s = np.linspace(0.0, 2.0, 21)
+    >>> law = TimeLaw(s, 1.0 + s, accel_start=0.5, accel_end=0.5)
+    >>> w, v, a, j = law.kinematics(np.array([0.3, 1.7]))
+    >>> np.round(w, 12).tolist(), np.round(a, 12).tolist(), np.abs(np.round(j, 12)).tolist()
+    ([1.3, 2.7], [0.5, 0.5], [0.0, 0.0])
+    >>> bool(abs(law.duration - 2 * (np.sqrt(3.0) - 1.0)) < 1e-12)  # ∫ ds / sqrt(1 + s)
+    True
     """
 
     s: FloatArray
     w: FloatArray
-    p: float = 0.75
     accel_start: float | None = None
     accel_end: float | None = None
+    j_max: float | None = None
 
     # ---- construction -------------------------------------------------------------------
     @cached_property
-    def _knots(self) -> tuple[FloatArray, FloatArray, FloatArray, float]:
-        """Knots ``x``, slopes ``u'(x)``, values ``u(x)`` and the end-correction amplitude."""
-        s, p = self.s, self.p
-        u = np.maximum(self.w, 0.0) ** p
-        h = np.diff(s)
-        g = np.diff(u) / h
-        g_start, g_end = g[0], g[-1]
-        if self.accel_start is not None and u[0] > 0:
-            g_start = 2 * p * self.accel_start * u[0] ** (1 - 1 / p)
-        if self.accel_end is not None and u[-1] > 0:
-            g_end = 2 * p * self.accel_end * u[-1] ** (1 - 1 / p)
-        x = np.concatenate(([s[0]], s[:-1] + 0.5 * h, [s[-1]]))
-        gk = np.concatenate(([g_start], g, [g_end]))
-        U = u[0] + np.concatenate(([0.0], np.cumsum(0.5 * (gk[1:] + gk[:-1]) * np.diff(x))))
-        c = float(u[-1] - U[-1])
-        # Knot values including the correction; the ends exactly, so standstill stays at 0.
-        Uc = U + c * self._smoothstep(x)
-        Uc[0], Uc[-1] = u[0], u[-1]
-        return x, gk, Uc, c
+    def _regions(self) -> tuple[int, int]:
+        """Number of leading and trailing nodes whose dual cells are built in ``u``.
 
-    def _smoothstep(self, q: FloatArray) -> FloatArray:
-        z = (q - self.s[0]) / self.length
-        out: FloatArray = z * z * (3 - 2 * z)
-        return out
+        At an end at rest (smooth standstill), the nodes where the discrete jerk is saturated
+        are the max-jerk start (stop); the ``u``-region covers them but the last two, so the
+        junction to ``w`` lies inside that phase, away from its end.
+        """
+        w, n = np.maximum(self.w, 0.0), self.s.size
+        if self.j_max is None or not np.isfinite(self.j_max) or n < 3:
+            return 0, 0
+        h = np.diff(self.s)
+        h0, h1 = h[:-1], h[1:]
+        d2 = 2.0 * (w[:-2] / (h0 * (h0 + h1)) - w[1:-1] / (h0 * h1) + w[2:] / (h1 * (h0 + h1)))
+        saturated = 0.5 * d2 * np.sqrt(w[1:-1]) >= (1.0 - _SATURATED) * float(self.j_max)
+
+        def run(flags: np.ndarray) -> int:
+            off = np.flatnonzero(~flags)
+            return int(off[0]) if off.size else int(flags.size)
+
+        if saturated.all() and (w[0] > 0) != (w[-1] > 0):
+            # A forced stop (start), or its time reversal: the max-jerk motion to rest from a
+            # moving state, where u is linear all along: all of it in u.
+            return (0, n) if w[0] > 0 else (n, 0)
+        lead = max(1, run(saturated) - 1) if w[0] == 0.0 else 0
+        trail = max(1, run(saturated[::-1]) - 1) if w[-1] == 0.0 else 0
+        if lead + trail > n - 1:
+            lead = min(lead, n - 1 - trail) if lead else 0
+            trail = n - 1 - lead if trail else 0
+        return lead, trail
+
+    @cached_property
+    def _pieces(self) -> _Pieces:
+        """Build the pieces region by region, with every node offset local.
+
+        1. Each region (leading ``u``, middle ``w``, trailing ``u``) is built by
+           :func:`_fill_region` from its first knot's slope (the start slope, or the previous
+           region's end slope converted).
+        2. The ``w``-region is anchored: its node offsets telescope to the local terms
+           ``c⁺_k h_k² / 8`` plus one constant, which is removed (a uniform shift of the
+           region). A leading ``u``-region then takes the value and slope it must reach at
+           the junction through a parabola added to it (its start slope at rest is free:
+           the acceleration is 0 at ``u = 0`` whatever ``u'``); a moving start keeps its
+           exact value and slope and takes the shift through a short window of two opposite
+           curvatures (:func:`_shift_after`).
+        3. A trailing ``u``-region reaches ``u = 0`` through a parabola added to it; a moving
+           end takes its exact value through a window at the end.
+        """
+        s, n = self.s, self.s.size
+        w = np.maximum(self.w, 0.0)
+        h = np.diff(s)
+        lead, trail = self._regions
+        # Knots s_0, m_0, s_1, ..., m_{n-2}, s_{n-1}; piece 2k = [s_k, m_k], 2k+1 = [m_k, s_{k+1}].
+        x = np.empty(2 * n - 1)
+        x[0::2], x[1::2] = s, s[:-1] + 0.5 * h
+        m = x.size - 1
+        node_u = np.zeros(n, dtype=bool)
+        node_u[:lead] = True
+        node_u[n - trail:] = trail > 0
+        is_u = node_u[(np.arange(m) + 1) // 2]  # the node whose dual cell holds each piece
+        u = w**STANDSTILL_EXPONENT
+        y, g, c = np.zeros(m + 1), np.zeros(m + 1), np.zeros(m)
+        y_r, g_r = np.zeros(m), np.zeros(m)  # right ends, in each piece's own variable
+        mid_k0, mid_k1 = lead, max(n - trail, lead)
+        mid_p0 = 0 if lead == 0 else 2 * lead - 1
+        mid_p1 = m if trail == 0 else max(2 * (n - trail) - 1, mid_p0)
+        if lead == n:  # a forced start to a moving end: u all along, bent to meet the end
+            y[0], g[0] = u[0], (u[1] - u[0]) / h[0]
+            end = _convert(w[-1], self._end_slope(w, h, False, start=False), from_u=False)
+            _fill_region(x, h, u, 0, n, n, 0, m, y, g, c, end[1])
+            _bend_to(x, c, g, y, 0, m, end[0] - y[m], end[1] - g[m], free_start=True)
+            y[m] = u[-1]
+            return _Pieces(x=x, y=y, g=g, c=c, is_u=is_u, y_right=y[1:].copy(),
+                           g_right=g[1:].copy())
+        free_start = w[0] == 0.0  # at rest: the slope of u there is free
+        if lead:  # 1. the leading u-region, natural
+            y[0] = u[0]
+            g[0] = ((u[1] - u[0]) / h[0] if free_start else
+                    _convert(w[0], self._end_slope(w, h, False, start=True), from_u=False)[1])
+            _fill_region(x, h, u, 0, lead, n, 0, mid_p0, y, g, c, None)
+            g_junction = _convert(y[mid_p0], g[mid_p0], from_u=True)[1]
+        else:
+            g_junction = self._end_slope(w, h, False, start=True)
+        if mid_k1 > mid_k0:  # the w-region, from value 0, then anchored
+            y_u_end, g_u_end = y[mid_p0], g[mid_p0]
+            y[mid_p0], g[mid_p0] = 0.0, g_junction
+            _fill_region(x, h, w, mid_k0, mid_k1, n, mid_p0, mid_p1, y, g, c,
+                         None if trail else self._end_slope(w, h, False, start=False))
+            nodes = np.arange(max(mid_k0, 1) + (1 if lead else 0), min(mid_k1, n - 1))
+            if nodes.size:
+                local = c[2 * nodes] * h[nodes] ** 2 / 8.0
+                const = float(np.median(y[2 * nodes] - w[nodes] - local))
+            else:
+                const = float(y[2 * mid_k0] - w[mid_k0]) if mid_k0 < n else 0.0
+            if lead and free_start:
+                y[mid_p0:mid_p1 + 1] -= const
+                target = _convert(y[mid_p0], g[mid_p0], from_u=False)
+                _bend_to(x, c, g, y, 0, mid_p0, target[0] - y_u_end, target[1] - g_u_end,
+                         free_start=True)
+                y[mid_p0], g[mid_p0] = target  # the junction knot, in u for the left side
+                y_r[:mid_p0], g_r[:mid_p0] = y[1:mid_p0 + 1], g[1:mid_p0 + 1]
+                y[mid_p0], g[mid_p0] = _convert(target[0], target[1], from_u=True)
+            else:  # exact start values: the shift through a window at the region's start
+                start_value = _convert(y_u_end, g_u_end, from_u=True)[0] if lead else w[0]
+                y[mid_p0:mid_p1 + 1] += start_value
+                _shift_after(x, c, g, y, mid_p0, mid_p1, -(const + start_value), start=True)
+                if lead:
+                    y_r[:mid_p0], g_r[:mid_p0] = y[1:mid_p0 + 1], g[1:mid_p0 + 1]
+                    y[mid_p0] = start_value
+                    y_r[:mid_p0][-1:] = y_u_end
+                    g_r[:mid_p0][-1:] = g_u_end
+            y_r[mid_p0:mid_p1], g_r[mid_p0:mid_p1] = y[mid_p0 + 1:mid_p1 + 1], g[mid_p0 + 1:
+                                                                                   mid_p1 + 1]
+        if trail == n:  # a forced stop: u from the moving start (slope from its acceleration)
+            y[0], g[0] = _convert(w[0], g_junction, from_u=False)
+            mid_p1 = 0
+        if trail:  # 3. the trailing u-region, from the junction, bent to end at u = 0
+            p0 = mid_p1
+            if 0 < mid_k1 - mid_k0:
+                y[p0], g[p0] = _convert(y[p0], g[p0], from_u=False)
+            _fill_region(x, h, u, n - trail, n, n, p0, m, y, g, c, (u[-1] - u[-2]) / h[-1])
+            _bend_to(x, c, g, y, p0, m, u[-1] - y[m], 0.0, free_start=False)
+            y[m] = u[-1]
+            y_r[p0:], g_r[p0:] = y[p0 + 1:], g[p0 + 1:]
+        elif mid_k1 > mid_k0:  # a moving end: its exact value through a window
+            _shift_after(x, c, g, y, mid_p0, m, w[-1] - y[m], start=False)
+            y[m] = w[-1]
+            y_r[mid_p0:], g_r[mid_p0:] = y[mid_p0 + 1:], g[mid_p0 + 1:]
+        return _Pieces(x=x, y=y, g=g, c=c, is_u=is_u, y_right=y_r, g_right=g_r)
+
+    def _end_slope(self, val: FloatArray, h: FloatArray, in_u: bool, *, start: bool) -> float:
+        """Slope at an end: the prescribed acceleration at a moving end, else the secant."""
+        accel = self.accel_start if start else self.accel_end
+        w_end = self.w[0] if start else self.w[-1]
+        if not in_u and accel is not None and w_end > 0:
+            return 2.0 * float(accel)
+        return float((val[1] - val[0]) / h[0] if start else (val[-1] - val[-2]) / h[-1])
 
     @property
     def length(self) -> float:
         """Path length covered [m]."""
         return float(self.s[-1] - self.s[0])
 
-    def _u_piece(
-        self, j: IntArray, dx: FloatArray, dr: FloatArray
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``u, u', u''`` on piece ``j``, ``dx`` after its left knot and ``dr`` before its right.
-
-        ``u`` is evaluated from the nearer knot, so it stays accurate relative to its own size
-        next to a standstill end, where it tends to 0.
-        """
-        x, gk, Uc, c = self._knots
-        curv = (gk[j + 1] - gk[j]) / (x[j + 1] - x[j])
-        right = dx > dr
-        u = np.where(right, Uc[j + 1] - gk[j + 1] * dr + 0.5 * curv * dr * dr,
-                     Uc[j] + gk[j] * dx + 0.5 * curv * dx * dx)
-        du = gk[j] + curv * dx
-        ddu = curv
-        if c != 0.0:  # smoothstep correction: zero slope at both ends keeps end accelerations
-            L = self.length
-            q = x[j] + dx
-            z = (q - self.s[0]) / L
-            u = u + c * (self._smoothstep(q) - self._smoothstep(np.where(right, x[j + 1], x[j])))
-            du = du + c * 6 * z * (1 - z) / L
-            ddu = ddu + c * (6 - 12 * z) / L**2
-        return np.maximum(u, 0.0), du, ddu
-
-    def _piece(self, q: FloatArray) -> IntArray:
-        x = self._knots[0]
+    # ---- evaluation -------------------------------------------------------------------------
+    def _locate(self, q: FloatArray) -> IntArray:
+        x = self._pieces.x
         out: IntArray = np.clip(np.searchsorted(x, q, side="right") - 1, 0, x.size - 2)
         return out
 
-    def _u(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``u, u', u''`` at positions ``q`` (vectorised)."""
-        x = self._knots[0]
-        j = self._piece(q)
-        return self._u_piece(j, q - x[j], x[j + 1] - q)
+    def _y(self, j: IntArray, dx: FloatArray, dr: FloatArray
+           ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``y, y', y''`` on pieces ``j`` at ``dx`` after the left knot (``dr`` before the right).
 
-    # ---- kinematics along s ---------------------------------------------------------------
-    def kinematics(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """Return ``w, v, a, jerk`` at arc lengths ``q`` [m]."""
-        p = self.p
-        u, du, ddu = self._u(np.asarray(q, dtype=np.float64))
-        inv = 1.0 / p
-        w = u**inv
-        v = u ** (0.5 * inv)
-        if p == 1.0:  # interpolating w itself: a = w'/2, j = w'' v / 2
-            return w, v, 0.5 * du, 0.5 * ddu * v
-        with np.errstate(divide="ignore", invalid="ignore"):
-            a = 0.5 * inv * u ** (inv - 1) * du
-            # j = w'' v / 2 with the powers of u combined so that p = 3/4 is regular at u = 0.
-            jerk = 0.5 * (inv * (inv - 1) * u ** (1.5 * inv - 2) * du * du
-                          + inv * u ** (1.5 * inv - 1) * ddu)
-        a = np.where(u > 0, a, 0.0)
-        jerk = np.where(np.isfinite(jerk), jerk, np.inf)
+        ``y`` is evaluated from the nearer knot: accurate relative to its own size next to a
+        standstill, where it tends to 0.
+        """
+        p = self._pieces
+        cj = p.c[j]
+        right = dx > dr
+        y = np.where(right, p.y_right[j] - p.g_right[j] * dr + 0.5 * cj * dr * dr,
+                     p.y[j] + p.g[j] * dx + 0.5 * cj * dx * dx)
+        dy = np.where(right, p.g_right[j] - cj * dr, p.g[j] + cj * dx)
+        return np.maximum(y, 0.0), dy, cj
+
+    @staticmethod
+    def _physical(y: FloatArray, dy: FloatArray, ddy: FloatArray, is_u: np.ndarray
+                  ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``w, v, a, j`` from ``y, y', y''`` (``y = u = w^{3/4}`` where ``is_u``)."""
+        cube = np.cbrt(y)
+        w = np.where(is_u, y * cube, y)
+        v = np.sqrt(w)
+        a = np.where(is_u, (2.0 / 3.0) * cube * dy, 0.5 * dy)
+        jerk = np.where(is_u, (2.0 / 9.0) * dy * dy + (2.0 / 3.0) * y * ddy, 0.5 * ddy * v)
         return w, v, a, jerk
+
+    def kinematics(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Return ``w, v, a, jerk`` at arc lengths ``q`` [m] (SI units)."""
+        q = np.asarray(q, dtype=np.float64)
+        j = self._locate(q)
+        x = self._pieces.x
+        y, dy, ddy = self._y(j, q - x[j], x[j + 1] - q)
+        return self._physical(y, dy, ddy, self._pieces.is_u[j])
+
+    def node_offsets(self) -> FloatArray:
+        """``w_law(s_k) - w_k`` at every node [m²/s²] (see the module notes)."""
+        return self.kinematics(self.s)[0] - np.maximum(self.w, 0.0)
+
+    # ---- extremes ---------------------------------------------------------------------------
+    def extremes(self) -> dict[str, tuple[FloatArray, FloatArray, FloatArray]]:
+        """Exact extremes of each piece: ``{name: (s_of_max, max, min)}``.
+
+        For ``"w"``, ``"a"`` and ``"jerk"`` over every piece (arrays of one entry per piece),
+        from the closed forms: ``w`` and ``a`` are quadratic / linear in ``w``-pieces, and in
+        ``u``-pieces ``a`` and the jerk are extremal at the ends or where their derivative,
+        a polynomial in the piece's offset, vanishes.
+        """
+        p = self._pieces
+        width = np.diff(p.x)
+        cands = [np.zeros_like(width), width]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            vertex = -p.g[:-1] / p.c  # y' = 0: extremum of y (so of w), and of the u-jerk
+            # In u: a' ∝ y'² + 3 y y'' = 2.5 C² x² + 5 G C x + G² + 3 C Y = 0.
+            qa, qb = 2.5 * p.c**2, 5.0 * p.g[:-1] * p.c
+            qc = p.g[:-1] ** 2 + 3.0 * p.c * p.y[:-1]
+            disc = np.sqrt(np.maximum(qb * qb - 4.0 * qa * qc, 0.0))
+            r1, r2 = (-qb + disc) / (2.0 * qa), (-qb - disc) / (2.0 * qa)
+        for r in (vertex, np.where(p.is_u, r1, np.nan), np.where(p.is_u, r2, np.nan)):
+            inside = np.isfinite(r) & (r > 0) & (r < width)
+            cands.append(np.where(inside, r, 0.0))
+        dx = np.stack(cands)  # (candidates, pieces)
+        j = np.broadcast_to(np.arange(width.size), dx.shape)
+        y, dy, ddy = self._y(j, dx, width - dx)
+        w, _, a, jerk = self._physical(y, dy, ddy, np.broadcast_to(p.is_u, dx.shape))
+        out = {}
+        for name, val in (("w", w), ("a", a), ("jerk", jerk)):
+            i_max = np.argmax(val, axis=0)
+            cols = np.arange(width.size)
+            out[name] = (p.x[:-1] + dx[i_max, cols], val[i_max, cols], val.min(axis=0))
+        return out
+
+    @property
+    def knots(self) -> FloatArray:
+        """Knots of the pieces [m] (the grid nodes and the cell midpoints)."""
+        return self._pieces.x
 
     # ---- time -------------------------------------------------------------------------------
     def _integral(self, j: IntArray, lo: FloatArray, hi: FloatArray,
-                  singular_at: FloatArray) -> FloatArray:
-        """∫ ds / v over offsets ``[lo, hi]`` of piece ``j``.
+                  from_right: np.ndarray | None = None) -> FloatArray:
+        """``∫ ds / v`` over offsets ``[lo, hi]`` of pieces ``j`` (16-point Gauss–Legendre).
 
-        ``singular_at`` is -1 when the piece starts at standstill (then ``lo = 0``), +1 when it
-        ends there (then ``hi`` is the piece width) and 0 otherwise. Offsets are measured from
-        the singular end, so the integrand is evaluated without cancellation; the substitution
-        ``σ = y³`` removes the ``1/v`` singularity (compiled loop:
-        :func:`speedplan.timing._quadrature.piece_integrals`).
+        Offsets are measured from the left knot, or from the right knot where ``from_right``
+        (``lo`` nearer to it): next to a standstill at the right end the offsets then keep full
+        relative precision. A stretch that starts at a standstill end is integrated with
+        ``σ = y²`` (``w`` linear there, ``1/v ~ σ^{-1/2}``) or ``σ = y³`` (``u`` linear,
+        ``1/v ~ σ^{-2/3}``): the integrand becomes smooth.
         """
-        x, gk, uc, c = self._knots
-        return piece_integrals(
-            np.ascontiguousarray(j, dtype=np.intp), np.ascontiguousarray(lo, dtype=np.float64),
-            np.ascontiguousarray(hi, dtype=np.float64),
-            np.ascontiguousarray(singular_at, dtype=np.float64), x, gk, uc, float(c),
-            float(self.s[0]), self.length, float(self.p),
-        )
-
-    def _speed(self, q: FloatArray) -> FloatArray:
-        u, _, _ = self._u(q)
-        out: FloatArray = u ** (0.5 / self.p)
+        p = self._pieces
+        width = p.x[j + 1] - p.x[j]
+        right = np.zeros(j.shape, dtype=bool) if from_right is None else from_right
+        at_rest = np.where(right, p.y_right[j] <= 0.0, p.y[j] <= 0.0) & (lo <= 0.0)
+        power = np.where(p.is_u[j], 3.0, 2.0)
+        span = hi - lo
+        t = GAUSS_NODES[:, None]
+        tw = GAUSS_WEIGHTS[:, None]
+        off = np.where(at_rest, span * t**power, lo + span * t)  # from the anchoring knot
+        jac = np.where(at_rest, span * power * t ** (power - 1.0), span)
+        dx = np.where(right, width - off, off)
+        dr = np.where(right, off, width - off)
+        jb = np.broadcast_to(j, off.shape)
+        y, dy, ddy = self._y(jb, dx, dr)
+        _, v, _, _ = self._physical(y, dy, ddy, p.is_u[jb])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f = np.where(jac > 0, jac / v, 0.0)
+        out: FloatArray = np.sum(tw * f, axis=0)
         return out
 
     @cached_property
-    def _rest(self) -> tuple[bool, bool]:
-        x, _, _, _ = self._knots
-        u_ends, _, _ = self._u(np.array([x[0], x[-1]]))
-        return bool(u_ends[0] <= 0.0), bool(u_ends[1] <= 0.0)
-
-    def _singularity(self, j: IntArray) -> FloatArray:
-        x = self._knots[0]
-        rest_start, rest_end = self._rest
-        sing = np.zeros(j.shape, dtype=np.float64)
-        if rest_start:
-            sing = np.where(j == 0, -1.0, sing)
-        if rest_end:
-            sing = np.where(j == x.size - 2, 1.0, sing)
-        return sing
-
-    @cached_property
     def knot_times(self) -> FloatArray:
-        """Times at the interpolation knots [s]."""
-        x = self._knots[0]
+        """Times at the knots [s] (from 0 at the start)."""
+        x = self._pieces.x
         j = np.arange(x.size - 1)
-        seg = self._integral(j, np.zeros(j.size), np.diff(x), self._singularity(j))
+        p = self._pieces
+        right = (p.y_right <= 0.0) & (p.y[:-1] > 0.0)
+        seg = self._integral(j, np.zeros(j.size), np.diff(x), right)
         return np.concatenate(([0.0], np.cumsum(seg)))
 
     @property
@@ -195,57 +386,269 @@ class TimeLaw:
     def time_at(self, q: FloatArray) -> FloatArray:
         """Time ``t(s)`` at arc lengths ``q`` [s]."""
         q = np.clip(np.asarray(q, dtype=np.float64), self.s[0], self.s[-1])
-        x = self._knots[0]
-        j = self._piece(q)
-        sing = self._singularity(j)
-        to_end = sing > 0
-        # On a piece ending at standstill integrate to its end; elsewhere from its start.
+        x = self._pieces.x
+        j = self._locate(q)
         width = x[j + 1] - x[j]
         off = q - x[j]
-        lo = np.where(to_end, off, 0.0)
-        hi = np.where(to_end, width, off)
-        part = self._integral(j, lo, hi, np.where(to_end, 1.0, np.minimum(sing, 0.0)))
+        # Integrate from the nearer knot: short spans, and the standstill end stays exact.
+        from_right = off > 0.5 * width
+        part = self._integral(j, np.zeros(j.size), np.where(from_right, width - off, off),
+                              from_right)
         T = self.knot_times
-        out: FloatArray = np.where(to_end, T[j + 1] - part, T[j] + part)
+        out: FloatArray = np.where(from_right, T[j + 1] - part, T[j] + part)
         return out
 
     @cached_property
     def node_times(self) -> FloatArray:
         """Times at the grid nodes ``s`` [s]."""
-        return self.time_at(self.s)
+        return self.knot_times[0::2]
 
-    def position_at(self, t: FloatArray, *, tol: float = 1e-13) -> FloatArray:
-        """Arc length ``s(t)`` at times ``t``: Newton on ``t(s) = t`` safeguarded by bisection.
+    def _invert(self, t: FloatArray) -> tuple[IntArray, FloatArray, FloatArray]:
+        """Piece and offsets ``(j, dx, dr)`` reached at times ``t``.
 
-        Starts from linear interpolation between the grid nodes; Newton steps are taken only
-        while they at least halve the previous step (the Numerical Recipes ``rtsafe`` rule), so
-        convergence is guaranteed near standstill too.
+        Safeguarded Newton on the time within each piece, in the offset from the piece's
+        standstill end when it has one (else from its left knot): next to a stop the offset
+        keeps full relative precision, where an arc length near a long path's end would be
+        quantised to 1e-16 of the path (and the speed with it). Starts from the piece's own
+        power law (``σ = τ³`` in ``u``, ``τ²`` in ``w`` at a standstill, linear otherwise);
+        Newton steps are kept only inside the bracket, bisection otherwise.
         """
+        p = self._pieces
+        T = self.knot_times
         t = np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration)
-        T, grid = self.node_times, self.s
-        j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, grid.size - 2)
-        lo, hi = grid[j].copy(), grid[j + 1].copy()
-        q = np.interp(t, T, grid)
-        step_old = hi - lo
-        ttol = tol * max(self.duration, 1.0)
-        stol = 4e-16 * max(self.length, 1.0)
-        active = np.arange(t.size)
-        for _ in range(200):
-            if active.size == 0:
+        j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, p.c.size - 1)
+        width = p.x[j + 1] - p.x[j]
+        span_t = T[j + 1] - T[j]
+        rest_left = p.y[j] <= 0.0
+        rest_right = (p.y_right[j] <= 0.0) & ~rest_left
+        power = np.where(p.is_u[j], 3.0, 2.0)
+        # Time measured from the offset's origin: the right knot for a right standstill.
+        tau = np.where(rest_right, T[j + 1] - t, t - T[j])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            frac = np.clip(np.where(span_t > 0, tau / span_t, 0.0), 0.0, 1.0)
+        off = width * np.where(rest_left | rest_right, frac**power, frac)
+        lo, hi = np.zeros_like(off), width.copy()
+        ttol = 1e-15 * np.maximum(span_t, 1e-300)
+        act = np.flatnonzero((tau > 0) & (tau < span_t))  # at a knot the offset is exact
+        for _ in range(100):
+            if act.size == 0:
                 break
-            qa = q[active]
-            f = self.time_at(qa) - t[active]
-            keep = (np.abs(f) > ttol) & (hi[active] - lo[active] > stol)
-            active, qa, f = active[keep], qa[keep], f[keep]
-            la = np.where(f < 0, qa, lo[active])
-            ha = np.where(f > 0, qa, hi[active])
-            newton_step = f * self._speed(qa)
-            use_newton = ((qa - newton_step > la) & (qa - newton_step < ha)
-                          & (np.abs(2 * newton_step) <= np.abs(step_old[active])))
-            new_q = np.where(use_newton, qa - newton_step, 0.5 * (la + ha))
-            step_old[active] = np.abs(new_q - qa)
-            lo[active], hi[active], q[active] = la, ha, new_q
-            moving = step_old[active] > stol
-            active = active[moving]
-        out: FloatArray = q
+            ja, wa, oa, rr = j[act], width[act], off[act], rest_right[act]
+            part = self._integral(ja, 0.0 * oa, oa, rr)
+            f = part - tau[act]  # increasing in the offset
+            lo[act] = np.where(f <= 0, oa, lo[act])
+            hi[act] = np.where(f >= 0, oa, hi[act])
+            y, dy, ddy = self._y(ja, np.where(rr, wa - oa, oa), np.where(rr, oa, wa - oa))
+            v = self._physical(y, dy, ddy, p.is_u[ja])[1]
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                newton = oa - f * v
+            inside = (newton >= lo[act]) & (newton <= hi[act])
+            converged = np.abs(f) <= ttol[act]
+            new = np.where(converged, oa, np.where(inside, newton, 0.5 * (lo[act] + hi[act])))
+            off[act] = new
+            moving = ~converged & (np.abs(new - oa) > 4e-16 * np.maximum(np.abs(new), 1e-300))
+            act = act[moving]
+        off = np.where(tau >= span_t, width, np.where(tau <= 0, 0.0, off))
+        dx = np.where(rest_right, width - off, off)
+        dr = np.where(rest_right, off, width - off)
+        return j, dx, dr
+
+    def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
+                                                FloatArray]:
+        """``s, w, v, a, jerk`` at times ``t`` [SI], the kinematics from the local offsets."""
+        j, dx, dr = self._invert(np.atleast_1d(np.asarray(t, dtype=np.float64)))
+        p = self._pieces
+        y, dy, ddy = self._y(j, dx, dr)
+        w, v, a, jerk = self._physical(y, dy, ddy, p.is_u[j])
+        q = np.where(dx <= dr, p.x[j] + dx, p.x[j + 1] - dr)
+        return q, w, v, a, jerk
+
+    def position_at(self, t: FloatArray) -> FloatArray:
+        """Arc length ``s(t)`` at times ``t`` [m] (see :meth:`state_at`)."""
+        return self.state_at(t)[0]
+
+
+def _fill_region(x: FloatArray, h: FloatArray, val: FloatArray, k0: int, k1: int, n: int,
+                 p0: int, p1: int, y: FloatArray, g: FloatArray, c: FloatArray,
+                 g_end: float | None) -> None:
+    """Curvatures, knot values and slopes of the dual cells ``k0 <= k < k1`` (in place).
+
+    ``y[p0]`` and ``g[p0]`` (the region's first knot) are given. The slope at each midpoint
+    knot is the secant of its cell; across a dual cell with a node inside, the slope change is
+    split at the node as ``D2 h_k / h_{k-1}`` before it and ``D2 h_{k-1} / h_k`` after it.
+    """
+    sec = np.diff(val) / h
+    # Target slope at the right end of each dual cell k: the midpoint m_k, or the path end.
+    targets = np.array(sec[k0:min(k1, n - 1)], dtype=np.float64)
+    if k1 == n:
+        targets = np.append(targets, 0.0 if g_end is None else g_end)
+    slopes = np.concatenate(([g[p0]], targets))  # at the region's knots from p0 on
+    dg = np.diff(slopes)
+    ks = np.arange(k0, k1)
+    inner = (ks > 0) & (ks < n - 1)
+    ki = ks[inner]
+    d2 = dg[inner] / (0.5 * (h[ki - 1] + h[ki]))
+    c[2 * ki - 1] = d2 * h[ki] / h[ki - 1]
+    c[2 * ki] = d2 * h[ki - 1] / h[ki]
+    if k0 == 0:
+        c[0] = dg[0] / (0.5 * h[0])
+    if k1 == n:
+        c[2 * n - 3] = dg[-1] / (0.5 * h[-1])
+    span = np.diff(x[p0:p1 + 1])
+    g[p0 + 1:p1 + 1] = g[p0] + np.cumsum(c[p0:p1] * span)
+    y[p0 + 1:p1 + 1] = y[p0] + np.cumsum(span * 0.5 * (g[p0:p1] + g[p0 + 1:p1 + 1]))
+
+
+def _recompute(x: FloatArray, c: FloatArray, g: FloatArray, y: FloatArray, p0: int,
+               p1: int) -> None:
+    """Slopes and values of knots ``p0 + 1 .. p1`` from knot ``p0`` and the curvatures."""
+    span = np.diff(x[p0:p1 + 1])
+    g[p0 + 1:p1 + 1] = g[p0] + np.cumsum(c[p0:p1] * span)
+    y[p0 + 1:p1 + 1] = y[p0] + np.cumsum(span * 0.5 * (g[p0:p1] + g[p0 + 1:p1 + 1]))
+
+
+def _bend_to(x: FloatArray, c: FloatArray, g: FloatArray, y: FloatArray, p0: int, p1: int,
+             d_value: float, d_slope: float, *, free_start: bool) -> None:
+    """Add ``σ (x - x0) + κ (x - x0)²/2`` over pieces ``p0 .. p1 - 1`` (in place).
+
+    ``free_start``: the value at ``x0`` is kept, its slope changes by ``σ``, and the end
+    changes by ``d_value`` in value and ``d_slope`` in slope. Otherwise ``σ = 0`` (value and
+    slope at ``x0`` kept) and only the end value changes by ``d_value`` (the end slope is
+    free: a standstill in ``u``).
+    """
+    length = x[p1] - x[p0]
+    if free_start:
+        kappa = 2.0 * (d_slope * length - d_value) / (length * length)
+        g[p0] += d_slope - kappa * length
+    else:
+        kappa = 2.0 * d_value / (length * length)
+    c[p0:p1] += kappa
+    _recompute(x, c, g, y, p0, p1)
+
+
+def _shift_after(x: FloatArray, c: FloatArray, g: FloatArray, y: FloatArray, p0: int, p1: int,
+                 shift: float, *, start: bool) -> None:
+    """Shift the values by ``shift`` through a window at the start (end) of ``p0 .. p1``.
+
+    Curvatures ``+c1`` then ``-c2`` over the window (:data:`_END_WINDOW` pieces, or the
+    region if shorter) change the value by ``shift`` and leave the slope at its far end
+    unchanged; at the start, the values after the window move by ``shift``; at the end, the
+    window ends on the exact end value. The added curvature is ``O(shift / window²)``.
+    """
+    if shift == 0.0 or p1 - p0 < 2:
+        return
+    size = min(p1 - p0, _END_WINDOW)
+    a, b = (p0, p0 + size) if start else (p1 - size, p1)
+    mid = (a + b) // 2
+    l1, l2 = x[mid] - x[a], x[b] - x[mid]
+    c1 = 2.0 * shift / (l1 * (l1 + l2))
+    c[a:mid] += c1
+    c[mid:b] -= c1 * l1 / l2
+    _recompute(x, c, g, y, a, b)
+    if start and b < p1:
+        y[b + 1:p1 + 1] += shift
+
+
+def _convert(y: float, g: float, from_u: bool) -> tuple[float, float]:
+    """Value and slope at a junction, from ``u = w^{3/4}`` to ``w`` or back."""
+    if from_u:
+        cube = float(np.cbrt(max(y, 0.0)))
+        return y * cube, (4.0 / 3.0) * cube * g
+    u = max(y, 0.0) ** STANDSTILL_EXPONENT
+    return u, 0.75 * g * (u / y if y > 0 else 0.0)
+
+
+@dataclass(frozen=True, eq=False)
+class LawChain:
+    """Laws of consecutive legs that meet at rest, as one law along the whole path.
+
+    Leg ``i`` covers ``[offsets[i], offsets[i] + laws[i].length]`` of the path and starts at
+    time ``start_times[i]``; every method of :class:`TimeLaw` is available with the path's arc
+    length and the time from the start of the first leg.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.timing.law import LawChain, TimeLaw
+    >>> s = np.linspace(0.0, 1.0, 11)
+    >>> one = TimeLaw(s, 1.0 + 0 * s, accel_start=0.0, accel_end=0.0)
+    >>> chain = LawChain((one, one), np.array([0.0, 1.0]))
+    >>> round(chain.duration, 12), chain.kinematics(np.array([1.5]))[1].tolist()
+    (2.0, [1.0])
+    """
+
+    laws: tuple[TimeLaw, ...]
+    offsets: FloatArray
+
+    @cached_property
+    def start_times(self) -> FloatArray:
+        """Time at which each leg starts [s]."""
+        return np.concatenate(([0.0], np.cumsum([law.duration for law in self.laws])))[:-1]
+
+    @property
+    def duration(self) -> float:
+        """Total travel time [s]."""
+        return float(self.start_times[-1] + self.laws[-1].duration)
+
+    @property
+    def length(self) -> float:
+        """Length covered [m]."""
+        return float(self.offsets[-1] + self.laws[-1].length)
+
+    def _leg(self, q: FloatArray) -> IntArray:
+        out: IntArray = np.clip(np.searchsorted(self.offsets, q, side="right") - 1, 0,
+                                len(self.laws) - 1)
         return out
+
+    def _map(self, q: FloatArray, fn: str) -> tuple[FloatArray, ...]:
+        q = np.atleast_1d(np.asarray(q, dtype=np.float64))
+        leg = self._leg(q)
+        outs: list[FloatArray] | None = None
+        for i in np.unique(leg):
+            sel = leg == i
+            res = getattr(self.laws[i], fn)(q[sel] - self.offsets[i])
+            res = res if isinstance(res, tuple) else (res,)
+            if outs is None:
+                outs = [np.empty(q.shape) for _ in res]
+            for o, r in zip(outs, res, strict=True):
+                o[sel] = r
+        assert outs is not None
+        return tuple(outs)
+
+    def kinematics(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``w, v, a, jerk`` at path arc lengths ``q`` [m]."""
+        w, v, a, j = self._map(q, "kinematics")
+        return w, v, a, j
+
+    def time_at(self, q: FloatArray) -> FloatArray:
+        """Time ``t(s)`` at path arc lengths ``q`` [s]."""
+        q = np.atleast_1d(np.asarray(q, dtype=np.float64))
+        (t,) = self._map(q, "time_at")
+        return t + self.start_times[self._leg(q)]
+
+    def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
+                                                FloatArray]:
+        """``s, w, v, a, jerk`` at times ``t`` (see :meth:`TimeLaw.state_at`)."""
+        t = np.atleast_1d(np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration))
+        leg = np.clip(np.searchsorted(self.start_times, t, side="right") - 1, 0,
+                      len(self.laws) - 1)
+        out: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray] = (
+            np.empty(t.shape), np.empty(t.shape), np.empty(t.shape), np.empty(t.shape),
+            np.empty(t.shape))
+        for i in np.unique(leg):
+            sel = leg == i
+            res = self.laws[i].state_at(t[sel] - self.start_times[i])
+            for o, r in zip(out, res, strict=True):
+                o[sel] = r
+            out[0][sel] += self.offsets[i]
+        return out
+
+    def position_at(self, t: FloatArray) -> FloatArray:
+        """Path arc length ``s(t)`` at times ``t`` [m]."""
+        return self.state_at(t)[0]
+
+    @cached_property
+    def node_times(self) -> FloatArray:
+        """Times at the nodes of every leg, shared stop nodes once [s]."""
+        parts = [law.node_times + t0 for law, t0 in zip(self.laws, self.start_times, strict=True)]
+        return np.concatenate([parts[0]] + [p[1:] for p in parts[1:]])

@@ -1,35 +1,107 @@
-"""SpeedProfile: the planned speed law along a path, its time law and its checks."""
+"""SpeedProfile: the planned speed law along a path, its certificate, time law and checks."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from ..core.checks import FloatArray, as_array, as_scalar
 from ..core.errors import InvalidInputError
 from ..core.limits import Limits
-from ..geometry.bounds import SpeedBound
+from ..solve.solution import STATUSES as SOLUTION_STATUSES
 from ..solve.solution import DiscreteSolution
-from .law import TimeLaw
+from .law import LawChain, TimeLaw
 from .trajectory import Trajectory
-from .verify import Verification
+from .verify import LegCheck, Verification, check_law, curvature_rate
 
 if TYPE_CHECKING:
     from ..geometry import Path
     from ..model import PlanRequest
 
-__all__ = ["SpeedProfile"]
+__all__ = ["PROFILE_STATUSES", "LegResult", "ProfileStatus", "SpeedProfile", "combine"]
+
+#: ``SpeedProfile.status``: the solution statuses, and one that says the limits are exceeded.
+ProfileStatus = Literal["optimal", "refined", "scaled", "relaxed", "limits_exceeded"]
+
+#: What each :data:`ProfileStatus` means.
+PROFILE_STATUSES: dict[str, str] = {
+    **SOLUTION_STATUSES,
+    "limits_exceeded": "the continuous trajectory exceeds a limit beyond its tolerance even "
+    "after local refinement of the grid (see verification); never returned as 'optimal'",
+}
+
+_WORST = ("optimal", "refined", "scaled", "relaxed")
+
+
+@dataclass(frozen=True, eq=False)
+class LegResult:
+    """One leg of a profile: where it lies, its discrete solution and its law.
+
+    Attributes
+    ----------
+    start : float
+        Arc length of the leg's start along the path [m].
+    s : ndarray
+        The leg's grid, from 0 [m].
+    solution : DiscreteSolution
+        Its discrete solve (a forced leg has ``backend == "forced"``).
+    law : TimeLaw
+        Its continuous law.
+    check : LegCheck or None
+        Its verification.
+    """
+
+    start: float
+    s: FloatArray
+    solution: DiscreteSolution
+    law: TimeLaw
+    check: LegCheck | None = None
+
+
+def combine(solutions: list[DiscreteSolution]) -> DiscreteSolution:
+    """One certificate for legs solved separately: sums of objectives and bounds.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.timing.profile import combine
+    >>> from speedplan.solve.solution import DiscreteSolution
+    >>> one = DiscreteSolution(w=np.zeros(3), objective=2.0, lower_bound=2.0, gap=0.0,
+    ...                        exact=True, exact_a_priori=True, jerk_violation=0.0,
+    ...                        refined=False, status="optimal", solve_time=0.1, backend="pass")
+    >>> both = combine([one, one])
+    >>> both.objective, both.w.size, both.status
+    (4.0, 5, 'optimal')
+    """
+    if len(solutions) == 1:
+        return solutions[0]
+    objective = float(sum(x.objective for x in solutions))
+    lower = float(sum(x.lower_bound for x in solutions))
+    w = np.concatenate([solutions[0].w] + [x.w[1:] for x in solutions[1:]])
+    status = max((x.status for x in solutions), key=_WORST.index)
+    backends = sorted({x.backend for x in solutions})
+    return DiscreteSolution(
+        w=w, objective=objective, lower_bound=lower,
+        gap=(objective - lower) / lower if lower > 0 else 0.0,
+        exact=all(x.exact for x in solutions),
+        exact_a_priori=all(x.exact_a_priori for x in solutions),
+        jerk_violation=max(x.jerk_violation for x in solutions),
+        refined=any(x.refined for x in solutions), status=status,
+        solve_time=float(sum(x.solve_time for x in solutions)), backend="+".join(backends),
+    )
 
 
 @dataclass(frozen=True, eq=False)
 class SpeedProfile:
     """Minimum-time speed law along a path, with its certificate and time law.
 
-    Built by :func:`speedplan.plan`; not usually constructed by hand.
+    Built by :func:`speedplan.plan`; not usually constructed by hand. A path with cusps, or a
+    boundary state that forces a stop on the way, is planned as several *legs* that meet at
+    rest (``legs``); every array here covers the whole path.
 
     Attributes
     ----------
@@ -37,33 +109,50 @@ class SpeedProfile:
         The path followed.
     limits : Limits
         The limits planned for.
-    s : ndarray
-        Arc-length grid of the discrete problem [m].
-    w : ndarray
-        Squared speed at the grid nodes [m²/s²].
-    solution : DiscreteSolution
-        The discrete solve with its certificate (``lower_bound``, ``gap``, ``status``).
-    law : TimeLaw
-        The continuous time law built from ``w``.
+    legs : tuple of LegResult
+        The legs, in order.
     speed_bound : callable
         ``s -> mu+(s)``, the squared-speed bound from limits, curvature and zones [m²/s²].
     request : PlanRequest or None
         The validated arguments :func:`speedplan.plan` was called with.
     verification : Verification or None
-        The check :func:`speedplan.plan` ran (``verify()`` at its default sampling).
+        The check :func:`speedplan.plan` ran.
+    limits_exceeded : bool
+        Whether that check still failed after local refinement (then :attr:`status` is
+        ``"limits_exceeded"``).
     """
 
     path: Path
     limits: Limits
-    s: FloatArray
-    w: FloatArray
-    solution: DiscreteSolution
-    law: TimeLaw
+    legs: tuple[LegResult, ...]
     speed_bound: Callable[[FloatArray], FloatArray]
     request: PlanRequest | None = None
     verification: Verification | None = None
+    limits_exceeded: bool = False
 
     # ---- the speed law on the grid ----------------------------------------------------------
+    @cached_property
+    def law(self) -> LawChain:
+        """The continuous law along the whole path."""
+        return LawChain(tuple(leg.law for leg in self.legs),
+                        np.array([leg.start for leg in self.legs]))
+
+    @cached_property
+    def s(self) -> FloatArray:
+        """Arc-length grid of every leg, shared stop nodes once [m]."""
+        parts = [leg.start + leg.s for leg in self.legs]
+        return np.concatenate([parts[0]] + [p[1:] for p in parts[1:]])
+
+    @cached_property
+    def solution(self) -> DiscreteSolution:
+        """The discrete solution (the legs' combined certificate when there are several)."""
+        return combine([leg.solution for leg in self.legs])
+
+    @property
+    def w(self) -> FloatArray:
+        """Squared speed at the grid nodes [m²/s²]."""
+        return self.solution.w
+
     @property
     def v(self) -> FloatArray:
         """Speed at the grid nodes [m/s]."""
@@ -73,7 +162,7 @@ class SpeedProfile:
     @cached_property
     def t(self) -> FloatArray:
         """Time at which each grid node is reached [s]."""
-        return self.law.time_at(self.s)
+        return self.law.node_times
 
     @property
     def duration(self) -> float:
@@ -102,9 +191,14 @@ class SpeedProfile:
         return self.solution.exact
 
     @property
-    def status(self) -> str:
-        """Solver status, see :data:`speedplan.solve.STATUSES`."""
-        return self.solution.status
+    def status(self) -> ProfileStatus:
+        """One of :data:`PROFILE_STATUSES`: the solution's, or ``"limits_exceeded"``."""
+        return "limits_exceeded" if self.limits_exceeded else self.solution.status
+
+    @property
+    def message(self) -> str:
+        """What :attr:`status` means."""
+        return PROFILE_STATUSES[self.status]
 
     # ---- sampling in time -------------------------------------------------------------------
     def at(self, t: Any) -> Trajectory:
@@ -121,21 +215,17 @@ class SpeedProfile:
         """
         times = as_array("t", t)
         tt = np.clip(np.atleast_1d(times), 0.0, self.duration)
-        q, v, a, jerk, kappa = self._motion(tt)
-        xy = np.asarray(self.path.point(q)).reshape(-1, 2)
+        q, w, v, a, jerk = self.law.state_at(tt)
+        xy, heading, kappa = self.path.evaluate(q)
+        xy = np.asarray(xy).reshape(-1, 2)
+        direction = (np.asarray(self.path.direction(q), dtype=np.float64)
+                     if hasattr(self.path, "direction") else np.ones(q.size))
+        lat_jerk = v * (curvature_rate(self.path, q) * w + 2.0 * kappa * a)
         return Trajectory(
-            t=tt, s=q, x=xy[:, 0], y=xy[:, 1],
-            heading=np.asarray(self.path.heading(q), dtype=np.float64),
-            curvature=kappa, v=v, a=a, j=jerk, a_lat=kappa * v * v,
+            t=tt, s=q, x=xy[:, 0], y=xy[:, 1], heading=np.asarray(heading, dtype=np.float64),
+            curvature=kappa, v=v, a=a, j=jerk, a_lat=kappa * v * v, yaw_rate=kappa * v,
+            j_lat=lat_jerk, direction=direction,
         )
-
-    def _motion(
-        self, tt: FloatArray
-    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
-        """``s, v, a, j`` and the curvature at times ``tt`` (within ``[0, duration]``)."""
-        q = self.law.position_at(tt)
-        _, v, a, jerk = self.law.kinematics(q)
-        return q, v, a, jerk, np.asarray(self.path.curvature(q), dtype=np.float64)
 
     def sample(self, dt: float = 0.01) -> Trajectory:
         """Trajectory sampled every ``dt`` seconds from 0; the last sample is at ``duration``.
@@ -162,55 +252,29 @@ class SpeedProfile:
         return times
 
     # ---- checks ---------------------------------------------------------------------------
-    def verify(self, dt: float | None = None) -> Verification:
-        """Measure the realised maxima on a fine time sampling and compare with the limits.
+    def verify(self) -> Verification:
+        """Compare the continuous trajectory with the limits (see :mod:`speedplan.timing.verify`).
 
-        Parameters
-        ----------
-        dt : float, optional
-            Sampling period [s]; default 1 ms, or ``duration / 200 000`` if that is longer.
+        Acceleration and jerk: exact extremes of every piece of the law. Speed bound, lateral
+        acceleration, yaw rate and lateral jerk: at 8 points per grid cell and at each
+        piece's speed maximum.
         """
-        step = dt if dt is not None else max(1e-3, self.duration / 200_000)
-        # The states of sample(step) that the limits involve: positions and headings are not
-        # needed, and on clothoid paths they cost as much as the time law.
-        q, v, a, jerk, kappa = self._motion(self._sample_times(step))
-        a_lat = kappa * v * v
-        lim = self.limits
-        bound_fn = self.speed_bound
-        if isinstance(bound_fn, SpeedBound) and bound_fn.path is self.path:  # reuse curvature
-            bound = bound_fn.given_curvature(q, kappa)
-        else:
-            bound = bound_fn(q)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            speed_ratio = np.where(bound > 0, v / np.sqrt(bound), np.where(v > 0, np.inf, 0.0))
+        return Verification.merged([self.check_leg(i).verification
+                                    for i in range(len(self.legs))])
 
-        def ratio(value: float, limit: float) -> float:
-            if not np.isfinite(value):
-                return float("inf")  # a NaN or infinite sample is a violation, never ignored
-            return float(value / limit) if np.isfinite(limit) else 0.0
-
-        max_accel = float(np.max(np.append(a, 0.0)))
-        max_decel = float(np.max(np.append(-a, 0.0)))
-        max_jerk = float(np.max(np.abs(jerk)))
-        max_lat = float(np.max(np.abs(a_lat)))
-        return Verification(
-            max_speed=float(v.max()),
-            max_accel=max_accel,
-            max_decel=max_decel,
-            max_jerk=max_jerk,
-            max_lateral=max_lat,
-            ratios={
-                "speed": ratio(float(speed_ratio.max()), 1.0),
-                "accel": ratio(max_accel, lim.a_max),
-                "decel": ratio(max_decel, lim.a_decel),
-                "lateral": ratio(max_lat, lim.a_lat_max),
-                "jerk": ratio(max_jerk, lim.j_max),
-            },
-            dt=float(step),
-        )
+    def check_leg(self, i: int) -> LegCheck:
+        """The check of leg ``i`` (which of its law pieces exceed a tolerance)."""
+        leg = self.legs[i]
+        return check_law(leg.law, leg.start, self.path, self.speed_bound, self.limits)
 
     def __repr__(self) -> str:
         return (
             f"SpeedProfile(duration={self.duration:.6g} s, length={self.path.length:.6g} m, "
-            f"status={self.status!r}, gap={self.gap:.3g}, n={self.s.size})"
+            f"status={self.status!r}, gap={self.gap:.3g}, n={self.s.size}, legs={len(self.legs)})"
         )
+
+
+def law_for(s: FloatArray, w: FloatArray, spec: Any) -> TimeLaw:
+    """The :class:`TimeLaw` of a leg's solution under its :class:`~speedplan.model.TimeLawSpec`."""
+    return TimeLaw(s, w, accel_start=spec.accel_start, accel_end=spec.accel_end,
+                   j_max=spec.j_max)

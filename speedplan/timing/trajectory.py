@@ -26,6 +26,9 @@ COLUMNS: dict[str, str] = {
     "a": "m/s^2",
     "j": "m/s^3",
     "a_lat": "m/s^2",
+    "yaw_rate": "rad/s",
+    "j_lat": "m/s^3",
+    "direction": "1",
 }
 
 
@@ -35,9 +38,12 @@ class Trajectory:
 
     Attributes
     ----------
-    t : time [s]; s : arc length [m]; x, y : position [m]; heading [rad];
-    curvature [1/m]; v : speed [m/s]; a : tangential acceleration [m/s²];
-    j : jerk [m/s³]; a_lat : lateral acceleration ``curvature · v²`` [m/s²].
+    t : time [s]; s : arc length [m]; x, y : position [m]; heading [rad] (the vehicle's
+    yaw, continuous, also through cusps); curvature [1/m] (of the curve in the direction of
+    travel); v : speed [m/s] (>= 0, along the direction of travel); a : tangential
+    acceleration [m/s²]; j : jerk [m/s³]; a_lat : lateral acceleration ``curvature · v²``
+    [m/s²]; yaw_rate : ``curvature · v`` [rad/s]; j_lat : lateral jerk
+    ``d(curvature · v²)/dt`` [m/s³]; direction : +1 driving forward, -1 in reverse.
     """
 
     t: FloatArray
@@ -50,6 +56,9 @@ class Trajectory:
     a: FloatArray
     j: FloatArray
     a_lat: FloatArray
+    yaw_rate: FloatArray
+    j_lat: FloatArray
+    direction: FloatArray
 
     def __len__(self) -> int:
         return int(self.t.size)

@@ -1,43 +1,106 @@
-"""Measure a planned trajectory against its limits on a fine time sampling."""
+"""Measure a planned law against its limits, piece by piece.
+
+The law is a chain of quadratic pieces (:mod:`speedplan.timing.law`), so the extremes of
+acceleration and jerk over each piece are exact closed forms (:meth:`TimeLaw.extremes`):
+nothing between samples can escape. What depends on the path — the speed bound (curvature,
+zones, ``v_limit``), lateral acceleration ``κ v²``, yaw rate ``κ v`` and lateral jerk
+``v (κ' w + 2 κ a)`` — is evaluated at :data:`SAMPLES_PER_PIECE` points of every piece
+(both ends included: 8 per grid cell, as dense as the discrete problem's own bound sampling)
+and at the piece's speed maximum.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
-__all__ = ["TOLERANCES", "Verification"]
+import numpy as np
 
-#: Documented tolerances of the time law at the default resolution, as fractions of each
-#: limit; all shrink as the grid is refined (see the convergence table in the docs).
+from ..core.checks import FloatArray
+from ..core.limits import Limits
+from ..geometry import Path, SpeedBound
+from .law import TimeLaw
+
+__all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "Verification",
+           "check_law", "curvature_rate"]
+
+#: Documented tolerances at the default resolution, as fractions of each limit; all shrink
+#: as the grid is refined (docs/convergence.md, docs/failure-modes.md).
 TOLERANCES: dict[str, float] = {
-    "speed": 0.005,
-    "accel": 0.02,
-    "decel": 0.02,
-    "lateral": 0.02,
-    "jerk": 0.10,
+    "speed": 0.001,
+    "accel": 0.01,
+    "decel": 0.01,
+    "lateral": 0.01,
+    "jerk": 0.05,
+    "yaw_rate": 0.001,
+    "lateral_jerk": 0.05,
 }
+#: Every checked limit, in report order.
+LIMIT_NAMES = tuple(TOLERANCES)
+#: Points per law piece where path-dependent quantities are evaluated (ends included).
+SAMPLES_PER_PIECE = 5
 
 
 @dataclass(frozen=True)
 class Verification:
-    """Realised maxima of a trajectory and their ratios to the limits.
+    """Realised maxima of a law and their ratios to the limits.
 
-    ``ratios[name]`` is the realised maximum divided by its limit (``speed`` against the local
-    bound ``sqrt(mu+(s))``, which includes ``v_max``, lateral limits and zones); a ratio above
-    ``1 + TOLERANCES[name]`` is a violation. Limits that are ``inf`` give a ratio of 0.
+    Attributes
+    ----------
+    maxima : dict
+        Largest realised value of each quantity, SI units (``"speed"`` [m/s], ``"accel"``
+        and ``"decel"`` [m/s²], ``"lateral"`` [m/s²], ``"jerk"`` and ``"lateral_jerk"``
+        [m/s³], ``"yaw_rate"`` [rad/s]).
+    ratios : dict
+        Each maximum divided by its limit (``"speed"`` against the local bound
+        ``sqrt(mu+(s))``, which includes ``v_max``, lateral limits and zones); limits that are
+        ``inf`` give 0. A ratio above ``1 + TOLERANCES[name]`` is a violation.
+    where : dict
+        Arc length [m] at which each ratio is largest.
+
+    Examples
+    --------
+    >>> from speedplan import Limits, Path, plan
+    >>> prof = plan(Path.from_waypoints([[0, 0], [10, 0]], kind="polyline"),
+    ...             Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    >>> check = prof.verify()
+    >>> check.ok, check.ratios["jerk"] <= 1.05
+    (True, True)
     """
 
-    max_speed: float
-    max_accel: float
-    max_decel: float
-    max_jerk: float
-    max_lateral: float
+    maxima: dict[str, float]
     ratios: dict[str, float]
-    dt: float
+    where: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def max_speed(self) -> float:
+        """Largest speed [m/s]."""
+        return self.maxima["speed"]
+
+    @property
+    def max_accel(self) -> float:
+        """Largest acceleration [m/s²]."""
+        return self.maxima["accel"]
+
+    @property
+    def max_decel(self) -> float:
+        """Largest braking deceleration [m/s²]."""
+        return self.maxima["decel"]
+
+    @property
+    def max_jerk(self) -> float:
+        """Largest absolute jerk [m/s³]."""
+        return self.maxima["jerk"]
+
+    @property
+    def max_lateral(self) -> float:
+        """Largest absolute lateral acceleration [m/s²]."""
+        return self.maxima["lateral"]
 
     @property
     def violations(self) -> dict[str, float]:
         """The ratios exceeding their tolerance."""
-        return {k: r for k, r in self.ratios.items() if r > 1.0 + TOLERANCES[k]}
+        return {k: r for k, r in self.ratios.items() if not r <= 1.0 + TOLERANCES[k]}
 
     @property
     def ok(self) -> bool:
@@ -45,9 +108,107 @@ class Verification:
         return not self.violations
 
     def summary(self) -> str:
-        """One line per limit: realised ratio and tolerance."""
-        return "\n".join(
-            f"{k:8s} {r:8.4f} of limit (tolerance {1 + TOLERANCES[k]:.3f})"
-            f"{'  VIOLATED' if r > 1 + TOLERANCES[k] else ''}"
-            for k, r in self.ratios.items()
-        )
+        """One line per limit: realised ratio, tolerance and where."""
+        lines = []
+        for k, r in self.ratios.items():
+            flag = "  VIOLATED" if not r <= 1 + TOLERANCES[k] else ""
+            at = f" at s={self.where[k]:.4g} m" if k in self.where and r > 0 else ""
+            lines.append(f"{k:12s} {r:8.4f} of limit (tolerance {1 + TOLERANCES[k]:.3f}){at}"
+                         f"{flag}")
+        return "\n".join(lines)
+
+    @staticmethod
+    def merged(parts: list[Verification]) -> Verification:
+        """The worst of several verifications (legs of one profile)."""
+        maxima = {k: max(p.maxima[k] for p in parts) for k in LIMIT_NAMES}
+        ratios, where = {}, {}
+        for k in LIMIT_NAMES:
+            worst = max(parts, key=lambda p: (p.ratios[k] if np.isfinite(p.ratios[k])
+                                              else np.inf))
+            ratios[k] = worst.ratios[k]
+            if k in worst.where:
+                where[k] = worst.where[k]
+        return Verification(maxima=maxima, ratios=ratios, where=where)
+
+
+@dataclass(frozen=True)
+class LegCheck:
+    """:class:`Verification` of one leg, and which of its pieces exceed a tolerance."""
+
+    verification: Verification
+    excess: np.ndarray  # bool per law piece
+    knots: FloatArray  # the law's knots, leg arc length [m]
+
+
+def curvature_rate(path: Path, s: FloatArray) -> FloatArray:
+    """``dκ/ds`` [1/m²] by a central difference (one-sided at the path's ends).
+
+    Where the curvature jumps (a G1 path) the result is of order ``jump / (2 δ)``: lateral
+    jerk is then unbounded, which is what it is physically.
+    """
+    length = path.length
+    delta = max(1e-7 * length, 1e-9)
+    lo = np.clip(s - delta, 0.0, length)
+    hi = np.clip(s + delta, 0.0, length)
+    out: FloatArray = (path.curvature(hi) - path.curvature(lo)) / (hi - lo)
+    return out
+
+
+def check_law(law: TimeLaw, offset: float, path: Path,
+              bound: Callable[[FloatArray], FloatArray], limits: Limits) -> LegCheck:
+    """Check the law of one leg that covers ``[offset, offset + law.length]`` of ``path``."""
+    ex = law.extremes()
+    knots = law.knots
+    width = np.diff(knots)
+    frac = np.linspace(0.0, 1.0, SAMPLES_PER_PIECE)
+    q = knots[:-1, None] + width[:, None] * frac[None, :]
+    q = np.concatenate((q, ex["w"][0][:, None]), axis=1)  # + the piece's speed maximum
+    shape = q.shape
+    q = np.clip(q.ravel(), 0.0, law.length)
+    glob = offset + q
+    w, v, a, _ = law.kinematics(q)
+    kappa = np.asarray(path.curvature(glob), dtype=np.float64)
+    if isinstance(bound, SpeedBound) and bound.path is path:  # reuse the curvature
+        wb = bound.given_curvature(glob, kappa)
+    else:
+        wb = np.asarray(bound(glob), dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        speed = np.where(wb > 0, v / np.sqrt(wb), np.where(v > 0, np.inf, 0.0))
+    lateral = np.abs(kappa) * w
+    yaw = np.abs(kappa) * v
+    if np.isfinite(limits.j_lat_max):
+        lat_jerk = np.abs(v * (curvature_rate(path, glob) * w + 2.0 * kappa * a))
+    else:
+        lat_jerk = np.zeros_like(w)
+    per_sample = {"speed": (speed, v, 1.0), "lateral": (lateral, lateral, limits.a_lat_max),
+                  "yaw_rate": (yaw, yaw, limits.yaw_rate_max),
+                  "lateral_jerk": (lat_jerk, lat_jerk, limits.j_lat_max)}
+    maxima: dict[str, float] = {}
+    ratios: dict[str, float] = {}
+    where: dict[str, float] = {}
+    excess = np.zeros(width.size, dtype=bool)
+    for name, (load, value, limit) in per_sample.items():
+        ratio_s = load / limit if name != "speed" else load
+        ratio_s = np.where(np.isfinite(ratio_s), ratio_s, np.inf) if np.isfinite(limit) else (
+            np.zeros_like(load))
+        k = int(np.argmax(ratio_s))
+        maxima[name] = float(np.max(value))
+        ratios[name] = float(ratio_s[k])
+        where[name] = float(glob[k])
+        excess |= (ratio_s.reshape(shape) > 1.0 + TOLERANCES[name]).any(axis=1)
+    a_top, a_bottom = ex["a"][1], ex["a"][2]
+    j_top, j_bottom = ex["jerk"][1], ex["jerk"][2]
+    j_abs = np.maximum(j_top, -j_bottom)
+    for name, per_piece, limit in (("accel", a_top, limits.a_max),
+                                   ("decel", -a_bottom, limits.a_decel),
+                                   ("jerk", j_abs, limits.j_max)):
+        per_piece = np.where(np.isfinite(per_piece), per_piece, np.inf)
+        k = int(np.argmax(per_piece))
+        maxima[name] = max(float(per_piece[k]), 0.0)
+        ratios[name] = max(float(per_piece[k]) / limit, 0.0) if np.isfinite(limit) else 0.0
+        where[name] = float(offset + 0.5 * (knots[k] + knots[k + 1]))
+        if np.isfinite(limit):
+            excess |= per_piece > limit * (1.0 + TOLERANCES[name])
+    order = {k: i for i, k in enumerate(LIMIT_NAMES)}
+    ratios = dict(sorted(ratios.items(), key=lambda kv: order[kv[0]]))
+    return LegCheck(Verification(maxima=maxima, ratios=ratios, where=where), excess, knots)

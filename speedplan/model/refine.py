@@ -1,0 +1,45 @@
+"""Local grid refinement where a planned law exceeds its limits."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.checks import FloatArray, grid_size
+from .grid import GRADING, graded_steps, nodes_from_steps
+
+__all__ = ["PAD_CELLS", "refined_grid"]
+
+#: Cells added on each side of a flagged stretch before halving the steps there.
+PAD_CELLS = 4
+
+
+def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray) -> FloatArray:
+    """The grid ``s`` with its steps halved around the law pieces flagged in ``excess``.
+
+    ``knots`` are the law's knots (nodes and cell midpoints) and ``excess`` flags each piece
+    between them. The steps are halved over the flagged cells padded by :data:`PAD_CELLS`
+    on each side, and graded back to the old steps at the rate :data:`~speedplan.model.grid
+    .GRADING`, so the new grid is as smooth as the old one.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.linspace(0.0, 10.0, 101)
+    >>> knots = np.sort(np.concatenate((s, s[:-1] + 0.05)))
+    >>> flag = np.zeros(knots.size - 1, dtype=bool); flag[100] = True  # around s = 5
+    >>> g = refined_grid(s, knots, flag)
+    >>> bool(g.size > s.size and np.diff(g).min() < 0.06 and g[0] == 0 and g[-1] == 10)
+    True
+    """
+    h = np.diff(s)
+    node_h = np.concatenate(([h[0]], 0.5 * (h[:-1] + h[1:]), [h[-1]]))
+    cell = (np.flatnonzero(excess) // 2).astype(np.intp)  # piece 2k, 2k+1 lie in cell k
+    flagged = np.zeros(s.size, dtype=bool)
+    for k in np.unique(cell):
+        lo, hi = max(k - PAD_CELLS, 0), min(k + 1 + PAD_CELLS, s.size - 1)
+        flagged[lo:hi + 1] = True
+    target = np.where(flagged, 0.5 * node_h, node_h)
+    target = graded_steps(s, target, np.full(s.size, GRADING))
+    grid = nodes_from_steps(s, target)
+    grid_size("n", grid.size)
+    return grid

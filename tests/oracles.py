@@ -1,0 +1,128 @@
+"""Independent oracles for the physics tests: ruckig and finite differences of sampled states.
+
+Nothing here calls speedplan's own checks (``verify()``, ``TOLERANCES``): the promised
+tolerances are written out, and the sampled trajectory is judged by its own numbers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from ruckig import InputParameter, Result, Ruckig, Trajectory
+
+#: What the README promises at the default resolution (fractions of each limit).
+PROMISED = {"speed": 0.001, "accel": 0.01, "lateral": 0.01, "jerk": 0.05}
+
+
+@dataclass(frozen=True)
+class RuckigAnswer:
+    """ruckig's time-optimal 1-D motion, or why there is none.
+
+    ``duration`` is ``None`` when ruckig finds no motion, or when the motion it returns
+    leaves ``0 <= v <= v_max`` (ruckig's braking pre-trajectory does, for states it cannot
+    keep within the limits: then no valid motion exists). ``error`` holds ruckig's own
+    failure message when it raised (a numerical failure of ruckig, not a verdict).
+    """
+
+    duration: float | None
+    error: str | None = None
+
+
+def ruckig_move(length, lim, v0=0.0, a0=0.0, vf=0.0, af=0.0):
+    """ruckig on the straight move, forward only (``min_velocity = 0``)."""
+    otg = Ruckig(1)
+    inp = InputParameter(1)
+    inp.current_position, inp.current_velocity, inp.current_acceleration = [0.0], [v0], [a0]
+    inp.target_position, inp.target_velocity, inp.target_acceleration = [length], [vf], [af]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [lim.v_max], [lim.a_max], [lim.j_max]
+    inp.min_acceleration = [-lim.a_decel]
+    inp.min_velocity = [0.0]
+    traj = Trajectory(1)
+    try:
+        result = otg.calculate(inp, traj)
+    except Exception as exc:  # ruckig.RuckigError: its own numerical failure
+        return RuckigAnswer(None, " ".join(str(exc).split())[:120])
+    if result != Result.Working:
+        return RuckigAnswer(None)
+    T = traj.duration
+    # Dense near both ends, where a braking pre-trajectory would leave the limits.
+    t = np.unique(np.concatenate((np.linspace(0, min(T, 5.0), 4001), np.linspace(0, T, 4001),
+                                  np.linspace(max(T - 5.0, 0.0), T, 4001))))
+    vel = np.array([traj.at_time(x)[1][0] for x in t])
+    if vel.min() < -1e-9 * lim.v_max or vel.max() > lim.v_max * (1 + 1e-9):
+        return RuckigAnswer(None)
+    return RuckigAnswer(T)
+
+
+def ruckig_duration(length, lim, **states):
+    """ruckig's exact optimum of a straight move (it must exist)."""
+    answer = ruckig_move(length, lim, **states)
+    assert answer.duration is not None, answer
+    return answer.duration
+
+
+@dataclass(frozen=True)
+class Measured:
+    """Largest ratios to the limits found by finite differences of a sampled trajectory."""
+
+    speed: float
+    accel: float
+    decel: float
+    jerk: float
+    lateral: float
+    samples: int
+
+
+def measure(profile, samples=20_000):
+    """Sample ``profile`` in time and finite-difference it.
+
+    Three uniform stretches of ``samples / 3`` each: the first and last ``T1`` seconds
+    (where a straight move changes speed; ``T1`` covers a full acceleration from rest:
+    ``3 (a/j + v_max/a)``) and the whole duration; each is differenced on its own. Speed
+    against the local bound ``sqrt(speed_bound(s))``; acceleration and jerk from differences
+    of the sampled speed (positions only confirm the speed: at long durations their rounding
+    would swamp a third difference); lateral acceleration from the sampled curvature.
+    """
+    lim = profile.limits
+    T = profile.duration
+    t1 = min(T, 3.0 * (max(lim.a_max, lim.a_decel) / lim.j_max + lim.v_max / min(lim.a_max,
+                                                                               lim.a_decel)))
+    per = max(samples // 3, 10)
+    worst = {"speed": 0.0, "accel": 0.0, "decel": 0.0, "jerk": 0.0, "lateral": 0.0}
+    count = 0
+    for lo, hi in ((0.0, t1), (max(T - t1, 0.0), T), (0.0, T)):
+        t = np.linspace(lo, hi, per)
+        dt = t[1] - t[0]
+        if not dt > 0:
+            continue
+        traj = profile.at(t)
+        v, s = traj.v, traj.s
+        bound = np.sqrt(profile.speed_bound(s))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            speed = np.where(bound > 0, v / bound, np.where(v > 0, np.inf, 0.0))
+        a_fd = np.diff(v) / dt
+        j_fd = np.diff(a_fd) / dt
+        v_fd = np.diff(s) / dt
+        v_mid = 0.5 * (v[1:] + v[:-1])
+        # Trapezoid rule: |Δs/dt - (v0 + v1)/2| <= j dt²/12 for any motion with |jerk| <= j.
+        # (plus the rounding of s(t), ~1e-15 of the duration and of the length).
+        noise = 4e-15 * (T * lim.v_max + max(s[-1], 1.0)) / dt
+        slack = 1.05 * lim.j_max * dt * dt / 12 + 1e-9 * lim.v_max + noise
+        assert np.abs(v_fd - v_mid).max() <= slack, "positions and speeds disagree"
+        lateral = np.abs(traj.curvature * v**2)
+        worst["speed"] = max(worst["speed"], float(speed.max()))
+        worst["accel"] = max(worst["accel"], float(max(a_fd.max(), 0.0) / lim.a_max))
+        worst["decel"] = max(worst["decel"], float(max(-a_fd.min(), 0.0) / lim.a_decel))
+        worst["jerk"] = max(worst["jerk"], float(np.abs(j_fd).max() / lim.j_max))
+        if np.isfinite(lim.a_lat_max):
+            worst["lateral"] = max(worst["lateral"], float(lateral.max() / lim.a_lat_max))
+        count += t.size
+    return Measured(samples=count, **worst)
+
+
+def within_promise(m: Measured) -> bool:
+    """Whether the measured ratios meet the README's tolerances."""
+    return (m.speed <= 1 + PROMISED["speed"] and m.accel <= 1 + PROMISED["accel"]
+            and m.decel <= 1 + PROMISED["accel"] and m.jerk <= 1 + PROMISED["jerk"]
+            and m.lateral <= 1 + PROMISED["lateral"])
