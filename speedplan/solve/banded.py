@@ -106,7 +106,8 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
         )
     )
     return ipm.Data(d0=d0 * cwp[:-2], d1=d1 * cw, d2=d2 * cwp[2:], jk=jk.astype(np.intp), cj=cj,
-                    lk=lk.astype(np.intp), ct=ct, cw=cw, b_lin=b_lin)
+                    lk=lk.astype(np.intp), ct=ct, cw=cw, b_lin=b_lin,
+                    lay=ipm.layout(m, jk.size, lk.size))
 
 
 # --- certificates -------------------------------------------------------------------------
@@ -179,11 +180,10 @@ def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, Flo
     w_hat = 0.5 * (min_feasible_w(p)[1:-1] / d.cw + 1.0)
     z_hat = 0.5 * np.sqrt(w_hat)
     # Jerk rows at t = 0: G x - b gives cj D̂ŵ plus the fixed ends' share.
-    rows = np.empty(d.b_lin.size)
+    rows = np.empty(d.lay.n_lin)
     ipm.g_lin_into(d, w_hat, np.zeros(w_hat.size), rows)
-    k = d.jk.size
     jerk = np.zeros(w_hat.size)
-    positive = slice(d.b_lin.size - 2 * k, d.b_lin.size - k)
+    positive = slice(d.lay.jp, d.lay.jm)
     jerk[d.jk] = np.abs(rows[positive] - d.b_lin[positive])
     t_hat = 2.0 * np.maximum(1.0 / z_hat, jerk) + 1.0
     return w_hat, t_hat, z_hat
@@ -191,16 +191,31 @@ def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, Flo
 
 def _row_multipliers(d: ipm.Data, yl: FloatArray) -> tuple[FloatArray, ...]:
     """Multipliers of the scaled problem's own rows (``t`` rescaled by ``ct``)."""
-    m, k = d.cw.size, d.jk.size
-    nl = m + 1
-    base = yl.size - 2 * k
-    nu_p, nu_m = np.zeros(m), np.zeros(m)
-    nu_p[d.jk] = yl[base : base + k] / d.ct[d.jk]
-    nu_m[d.jk] = yl[base + k :] / d.ct[d.jk]
-    return yl[:nl], yl[nl : 2 * nl], nu_p, nu_m
+    lay = d.lay
+    nu_p, nu_m = np.zeros(lay.m), np.zeros(lay.m)
+    nu_p[d.jk] = yl[lay.jp : lay.jm] / d.ct[d.jk]
+    nu_m[d.jk] = yl[lay.jm : lay.n_lin] / d.ct[d.jk]
+    return yl[: lay.dec], yl[lay.dec : lay.up], nu_p, nu_m
 
 
 # --- driver --------------------------------------------------------------------------------
+
+
+def _run_kernel(
+    d: ipm.Data, w0: FloatArray, t0: FloatArray, z0: FloatArray, tol: float, max_iter: int
+) -> tuple[FloatArray, FloatArray, int, int]:
+    """Allocate the kernel's arrays, check every size, iterate from ``(w0, t0, z0)``.
+
+    Returns ``(w, yl, iterations, status code)`` in internal units.
+    """
+    lay = d.lay
+    pt = ipm.Point.empty(lay)
+    pt.w[:], pt.t[:], pt.z[:] = w0, t0, z0
+    parts = (pt, ipm.Residual.empty(lay), ipm.Direction.empty(lay), ipm.Rhs.empty(lay),
+             ipm.Scaling.identity(lay), ipm.Factor.empty(lay), ipm.Work.empty(lay))
+    ipm.check_sizes(d, *parts)
+    iterations, code = ipm.iterate(d, *parts, tol, max_iter)
+    return pt.w, pt.yl, iterations, code
 
 
 def _scales(problem: DiscreteProblem, w_feasible: FloatArray) -> tuple[float, float]:
@@ -286,7 +301,7 @@ def solve_relaxation_banded(
     scaled = problem.scaled(s_scale, w_scale)
     d = _prepare(scaled, wmf[1:-1] / w_scale)
     t_setup = time.perf_counter()
-    w_int, yl, iterations, code = ipm.iterate(d, *_start(scaled, d), tol, max_iter)
+    w_int, yl, iterations, code = _run_kernel(d, *_start(scaled, d), tol, max_iter)
     obj_scale = s_scale / np.sqrt(w_scale)
     # Back to the scaled problem's units; clip rounding-level excursions past the bounds.
     w_low = np.zeros(d.cw.size) if scaled.w_min is None else scaled.w_min[1:-1]
