@@ -52,8 +52,13 @@ closed form over the box ``w_min <= w <= w_max``, node by node. The ``primal_obj
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import time
+from typing import Any
 
+import numba
 import numpy as np
 
 from ..core.checks import FloatArray
@@ -63,7 +68,7 @@ from .clarabel_ import RelaxationResult
 from .nojerk import check_reachable, max_feasible_w, min_feasible_w
 from .problem import DiscreteProblem
 
-__all__ = ["solve_relaxation_banded"]
+__all__ = ["compile_kernel", "kernel_for_auto", "kernel_ready", "solve_relaxation_banded"]
 
 
 def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
@@ -179,12 +184,13 @@ def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, Flo
     """
     w_hat = 0.5 * (min_feasible_w(p)[1:-1] / d.cw + 1.0)
     z_hat = 0.5 * np.sqrt(w_hat)
-    # Jerk rows at t = 0: G x - b gives cj D̂ŵ plus the fixed ends' share.
-    rows = np.empty(d.lay.n_lin)
-    ipm.g_lin_into(d, w_hat, np.zeros(w_hat.size), rows)
+    # Jerk rows at t = 0: G x - b gives cj D̂ŵ plus the fixed ends' share (the kernel's
+    # arithmetic, in numpy: the kernel itself is entered only once per solve).
+    left = np.concatenate(([0.0], w_hat[:-1]))
+    right = np.concatenate((w_hat[1:], [0.0]))
+    second = d.d0 * left + d.d1 * w_hat + d.d2 * right
     jerk = np.zeros(w_hat.size)
-    positive = slice(d.lay.jp, d.lay.jm)
-    jerk[d.jk] = np.abs(rows[positive] - d.b_lin[positive])
+    jerk[d.jk] = np.abs(d.cj * second[d.jk] - d.b_lin[d.lay.jp : d.lay.jm])
     t_hat = 2.0 * np.maximum(1.0 / z_hat, jerk) + 1.0
     return w_hat, t_hat, z_hat
 
@@ -201,21 +207,162 @@ def _row_multipliers(d: ipm.Data, yl: FloatArray) -> tuple[FloatArray, ...]:
 # --- driver --------------------------------------------------------------------------------
 
 
-def _run_kernel(
-    d: ipm.Data, w0: FloatArray, t0: FloatArray, z0: FloatArray, tol: float, max_iter: int
-) -> tuple[FloatArray, FloatArray, int, int]:
-    """Allocate the kernel's arrays, check every size, iterate from ``(w0, t0, z0)``.
-
-    Returns ``(w, yl, iterations, status code)`` in internal units.
-    """
+def _kernel_args(
+    d: ipm.Data, w0: FloatArray, t0: FloatArray, z0: FloatArray
+) -> tuple[ipm.Data, ipm.Point, ipm.Residual, ipm.Direction, ipm.Rhs, ipm.Scaling, ipm.Factor,
+           ipm.Work]:
+    """The kernel's arrays for ``d`` with the start ``(w0, t0, z0)``, sizes checked."""
     lay = d.lay
     pt = ipm.Point.empty(lay)
     pt.w[:], pt.t[:], pt.z[:] = w0, t0, z0
-    parts = (pt, ipm.Residual.empty(lay), ipm.Direction.empty(lay), ipm.Rhs.empty(lay),
-             ipm.Scaling.identity(lay), ipm.Factor.empty(lay), ipm.Work.empty(lay))
-    ipm.check_sizes(d, *parts)
-    iterations, code = ipm.iterate(d, *parts, tol, max_iter)
+    args = (d, pt, ipm.Residual.empty(lay), ipm.Direction.empty(lay), ipm.Rhs.empty(lay),
+            ipm.Scaling.identity(lay), ipm.Factor.empty(lay), ipm.Work.empty(lay))
+    ipm.check_sizes(*args)
+    return args
+
+
+def _run_kernel(
+    d: ipm.Data, w0: FloatArray, t0: FloatArray, z0: FloatArray, tol: float, max_iter: int
+) -> tuple[FloatArray, FloatArray, int, int]:
+    """Iterate from ``(w0, t0, z0)``; ``(w, yl, iterations, status code)``, internal units."""
+    args = _kernel_args(d, w0, t0, z0)
+    iterations, code = ipm.iterate(*args, tol, max_iter)
+    pt = args[1]
     return pt.w, pt.yl, iterations, code
+
+
+# --- first use: load, compile, or compile in the background ---------------------------------
+
+#: Environment variable: set to ``0`` to make ``backend="auto"`` wait for the kernel's first
+#: compilation instead of answering with Clarabel while a background process compiles it.
+BACKGROUND_COMPILE_ENV = "SPEEDPLAN_BACKGROUND_COMPILE"
+
+
+class _Kernel:
+    """Whether this process can call the compiled kernel without compiling it."""
+
+    ready = False
+    background: subprocess.Popen[bytes] | None = None
+    spawn_failed = False
+
+
+def _example_problem() -> DiscreteProblem:
+    n = 6
+    return DiscreteProblem(s=np.arange(n, dtype=float), w_max=np.full(n, 1.0),
+                           accel=np.full(n - 1, 0.5), decel=np.full(n - 1, 0.5),
+                           jerk=np.full(n - 2, 0.1), w_min=np.full(n, 0.0))
+
+
+def _load_from_disk_cache() -> bool:
+    """Load the compiled kernel from numba's on-disk cache if it is there; never compiles.
+
+    Mirrors what :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's
+    dispatcher offers no public "load but do not compile"); any failure means "not loaded".
+    """
+    disp: Any = ipm.iterate
+    p = _example_problem()
+    wmf = _check_feasible(p)
+    d = _prepare(p, wmf[1:-1])
+    args = (*_kernel_args(d, *_start(p, d)), 1e-8, 1)
+    try:
+        sig = tuple(numba.typeof(a) for a in args)  # type: ignore[no-untyped-call]
+        if sig in disp.overloads:
+            return True
+        from numba.core.compiler_lock import global_compiler_lock
+
+        with global_compiler_lock:
+            cres = disp._cache.load_overload(sig, disp.targetctx)
+            if cres is None:
+                return False
+            disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+            disp.add_overload(cres)
+        return True
+    except Exception:  # pragma: no cover - numba internals changed: behave as "not cached"
+        return False
+
+
+def compile_kernel() -> None:
+    """Make the compiled kernel available in this process now: load it, or compile it.
+
+    ``backend="auto"`` answers with Clarabel while the kernel is not available (see
+    :func:`kernel_ready`); call this first for runs whose backend must not depend on timing.
+
+    Examples
+    --------
+    >>> compile_kernel()
+    >>> kernel_ready()
+    True
+    """
+    if _Kernel.ready:
+        return
+    if _Kernel.background is not None:
+        _Kernel.background.wait()
+        _Kernel.background = None
+    solve_relaxation_banded(_example_problem())
+    _Kernel.ready = True
+
+
+def kernel_ready(*, start: bool = True) -> bool:
+    """Whether the banded kernel runs now without compiling; else compile it in the background.
+
+    The kernel is loaded from numba's on-disk cache when it is there (0.3-0.5 s). When it is
+    not (first use after installation, about 20-30 s to compile), and ``start`` is true, a
+    background Python process compiles it into the cache, unless the environment variable
+    ``SPEEDPLAN_BACKGROUND_COMPILE`` is ``0``; later calls load it once that process is done.
+    """
+    if _Kernel.ready:
+        return True
+    if _Kernel.background is not None:
+        code = _Kernel.background.poll()
+        if code is None:
+            return False
+        _Kernel.background = None
+        _Kernel.spawn_failed = code != 0  # never start a failing compilation twice
+    if _load_from_disk_cache():
+        _Kernel.ready = True
+        return True
+    if start and _background_allowed():
+        _Kernel.background = _spawn_compile()
+        _Kernel.spawn_failed = _Kernel.background is None
+    return False
+
+
+def _background_allowed() -> bool:
+    return not _Kernel.spawn_failed and os.environ.get(BACKGROUND_COMPILE_ENV) != "0"
+
+
+def kernel_for_auto(*, wait: bool) -> bool:
+    """Whether ``backend="auto"`` should use the banded kernel now.
+
+    True when it is available (:func:`kernel_ready`, which starts a background compilation
+    if needed), or after compiling it here when ``wait`` is true or background compilation
+    is off (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could be started).
+    """
+    if kernel_ready(start=not wait):
+        return True
+    if wait or not _background_allowed():
+        compile_kernel()
+        return True
+    return False
+
+
+def _spawn_compile() -> subprocess.Popen[bytes] | None:
+    """Start ``python -c "...compile_kernel()"`` on this very copy of speedplan."""
+    if not sys.executable:
+        return None
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
+    # Lowest priority: the compilation must not slow down the process that is waiting for
+    # answers (it uses Clarabel meanwhile).
+    code = ("import os; hasattr(os, 'nice') and os.nice(19); "
+            "from speedplan.solve.banded import compile_kernel; compile_kernel()")
+    try:
+        return subprocess.Popen([sys.executable, "-c", code], env=env,
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+    except OSError:
+        return None
 
 
 def _scales(problem: DiscreteProblem, w_feasible: FloatArray) -> tuple[float, float]:

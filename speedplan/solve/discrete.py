@@ -20,7 +20,7 @@ import numpy as np
 
 from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
 from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
-from .banded import solve_relaxation_banded
+from .banded import kernel_for_auto, solve_relaxation_banded
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .ipopt_ import refine_ipopt
 from .nojerk import check_reachable, max_feasible_w
@@ -38,6 +38,11 @@ RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = 
 #: 5-8x faster than Clarabel from 100 to 500 nodes, measured); below, both take a few
 #: milliseconds and Clarabel, the reference, is used.
 AUTO_BANDED_FROM = 100
+#: Until the banded kernel is compiled (first use after installation, 20-30 s; see
+#: :func:`~speedplan.solve.banded.kernel_ready`), ``"auto"`` answers with Clarabel below this
+#: many nodes while a background process compiles it; from this size on Clarabel would take
+#: about as long as the compilation (16 s at 10^5 nodes), so ``"auto"`` waits for it.
+AUTO_WAIT_FROM = 100_000
 BACKENDS = ("auto", *RELAXATION_BACKENDS)
 REFINE_MODES = ("auto", "always", "never")
 
@@ -60,6 +65,13 @@ def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArr
         return w
     c = float(min(1.0, np.min(problem.jerk[finite] / load[finite]) ** (2.0 / 3.0)))
     return w * (c * (1.0 - 1e-12))
+
+
+def _auto_backend(problem: DiscreteProblem) -> str:
+    """``backend="auto"``: banded from :data:`AUTO_BANDED_FROM` nodes on, once it is compiled."""
+    if problem.n < AUTO_BANDED_FROM or problem.has_lateral:
+        return "clarabel"
+    return "banded" if kernel_for_auto(wait=problem.n >= AUTO_WAIT_FROM) else "clarabel"
 
 
 def _relax_with_fallback(
@@ -99,8 +111,7 @@ def solve_problem(
     refine = choice("refine", refine, REFINE_MODES)
     backend = choice("backend", backend, BACKENDS)
     if backend == "auto":
-        banded_ok = problem.n >= AUTO_BANDED_FROM and not problem.has_lateral
-        backend = "banded" if banded_ok else "clarabel"
+        backend = _auto_backend(problem)
     elif backend == "banded" and problem.has_lateral:
         raise InvalidInputError(
             "backend='banded' does not handle lateral-jerk rows yet; use backend='clarabel' or "
