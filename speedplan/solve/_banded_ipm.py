@@ -54,6 +54,9 @@ ALMOST_GAP = 1e-6
 #: then falls back to Clarabel rather than spending ``max_iter`` iterations).
 NO_PROGRESS_ITERATIONS = 20
 
+#: Columns of :func:`iterate`'s log, one row per iteration.
+LOG_COLUMNS = ("pcost", "dcost", "relgap", "pres", "dres", "sigma", "step")
+
 #: Status codes returned by :func:`iterate`.
 SOLVED, MAX_ITERATIONS, STALLED, NUMERICAL_ERROR, NO_PROGRESS = 0, 1, 2, 3, 4
 STATUS_NAMES = ("Solved", "MaxIterations", "Stalled", "NumericalError", "NoProgress")
@@ -877,16 +880,16 @@ def corrector_into(
 
 
 @njit(cache=True, error_model="numpy")
-def step(pt: Point, dn: Direction) -> bool:
+def step(pt: Point, dn: Direction) -> float:
     """Move ``pt`` a fraction ``STEP`` of the way to the cone boundary along ``dn``.
 
     The closed-form step to the boundary can be off by rounding for nearly degenerate cones;
-    the step is halved until every cone is strictly interior. Returns False (nothing moved)
-    if no such step was found.
+    the step is halved until every cone is strictly interior. Returns the step taken, or 0
+    (nothing moved) if no such step was found.
     """
     alpha = min(1.0, STEP * _max_step(pt, dn))
     if not (math.isfinite(alpha) and alpha > 0.0):
-        return False
+        return 0.0
     inside = False
     for _ in range(30):
         if (_interior_after_step(pt.ss, alpha, dn.dss)
@@ -895,7 +898,7 @@ def step(pt: Point, dn: Direction) -> bool:
             break
         alpha *= 0.5
     if not inside:
-        return False
+        return 0.0
     for u, du in ((pt.ss, dn.dss), (pt.ys, dn.dys)):
         for c in range(u.shape[1]):
             u[0, c] = u[0, c] + alpha * du[0, c]
@@ -906,18 +909,19 @@ def step(pt: Point, dn: Direction) -> bool:
     _axpy(alpha, dn.dz, pt.z)
     _axpy(alpha, dn.dsl, pt.sl)
     _axpy(alpha, dn.dyl, pt.yl)
-    return True
+    return alpha
 
 
 @njit(cache=True, error_model="numpy")
 def iterate(
     d: Data, pt: Point, res: Residual, dn: Direction, rhs: Rhs, sc: Scaling, fac: Factor,
-    nw: Work, tol: float, max_iter: int,
+    nw: Work, log: FloatArray, tol: float, max_iter: int,
 ) -> tuple[int, int]:
     """Mehrotra predictor–corrector iterations from the primal point ``(w, t, z)`` in ``pt``.
 
     ``sc`` must be the identity scaling. The iterate is updated in place (internal units);
-    returns ``(iterations, status)`` with one of the module's status codes.
+    returns ``(iterations, status)`` with one of the module's status codes. Row ``k`` of
+    ``log`` (shape ``(max_iter + 1, len(LOG_COLUMNS))``) records iteration ``k``.
     """
     lay = d.lay
     start_into(d, sc, fac, nw, pt, dn)
@@ -936,6 +940,8 @@ def iterate(
         pres = math.sqrt(ry2) / res_y0
         dres = math.sqrt(rx2) / res_x0
         relgap = gap / max(min(abs(pcost), abs(dcost)), 1e-300)
+        log[it, 0], log[it, 1], log[it, 2], log[it, 3] = pcost, dcost, relgap, pres
+        log[it, 4] = dres
         if pres <= tol and dres <= tol and relgap <= tol:
             status = SOLVED
             break
@@ -968,7 +974,9 @@ def iterate(
         refine_above = REFINE_RESIDUAL * tol * res_x0 if relgap < REFINE_BELOW else np.inf
         sigma = predictor_into(d, sc, fac, nw, pt, res, rhs, refine_above, dn)
         corrector_into(d, sc, fac, nw, pt, res, rhs, refine_above, sigma * (gap / nu), dn)
-        if not step(pt, dn):
+        alpha = step(pt, dn)
+        log[it, 5], log[it, 6] = sigma, alpha
+        if alpha == 0.0:
             status = NUMERICAL_ERROR
             break
     return it, status

@@ -56,6 +56,7 @@ import os
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from typing import Any
 
 import numba
@@ -68,7 +69,10 @@ from .clarabel_ import RelaxationResult
 from .nojerk import check_reachable, max_feasible_w, min_feasible_w
 from .problem import DiscreteProblem
 
-__all__ = ["compile_kernel", "kernel_for_auto", "kernel_ready", "solve_relaxation_banded"]
+__all__ = [
+    "compile_kernel", "kernel_for_auto", "kernel_ready", "solve_relaxation_banded",
+    "solve_unit_relaxation", "unit_scales",
+]
 
 
 def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
@@ -226,7 +230,9 @@ def _run_kernel(
 ) -> tuple[FloatArray, FloatArray, int, int]:
     """Iterate from ``(w0, t0, z0)``; ``(w, yl, iterations, status code)``, internal units."""
     args = _kernel_args(d, w0, t0, z0)
-    iterations, code = ipm.iterate(*args, tol, max_iter)
+    log = np.full((max_iter + 1, len(ipm.LOG_COLUMNS)), np.nan)
+    iterations, code = ipm.iterate(*args, log, tol, max_iter)
+    _Kernel.last_log = log[: iterations + 1]
     pt = args[1]
     return pt.w, pt.yl, iterations, code
 
@@ -242,6 +248,9 @@ class _Kernel:
     """Whether this process can call the compiled kernel without compiling it."""
 
     ready = False
+    #: The iteration log of the last solve in this process (rows: iterations; columns:
+    #: :data:`~speedplan.solve._banded_ipm.LOG_COLUMNS`), for diagnostics and benchmarks.
+    last_log: FloatArray = np.zeros((0, len(ipm.LOG_COLUMNS)))
     background: subprocess.Popen[bytes] | None = None
     spawn_failed = False
 
@@ -261,9 +270,8 @@ def _load_from_disk_cache() -> bool:
     """
     disp: Any = ipm.iterate
     p = _example_problem()
-    wmf = _check_feasible(p)
-    d = _prepare(p, wmf[1:-1])
-    args = (*_kernel_args(d, *_start(p, d)), 1e-8, 1)
+    d = _prepare(p, _positive_feasible(p)[1:-1])
+    args = (*_kernel_args(d, *_start(p, d)), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
     try:
         sig = tuple(numba.typeof(a) for a in args)  # type: ignore[no-untyped-call]
         if sig in disp.overloads:
@@ -365,20 +373,22 @@ def _spawn_compile() -> subprocess.Popen[bytes] | None:
         return None
 
 
-def _scales(problem: DiscreteProblem, w_feasible: FloatArray) -> tuple[float, float]:
-    """Return ``(s_scale, w_scale)`` of the internal units: ``w`` up to 1 and unit mean step."""
-    w_scale = float(np.max(w_feasible))
-    s_scale = float(np.mean(problem.h))
-    return s_scale, w_scale
+def unit_scales(problem: DiscreteProblem) -> tuple[float, float]:
+    """``(s_scale, w_scale)`` of the relaxation's units: unit mean step and ``w_max <= 1``.
+
+    :func:`~speedplan.solve.solve_problem` hands every relaxation backend
+    ``problem.scaled(*unit_scales(problem))``.
+    """
+    return float(np.mean(problem.h)), float(np.max(problem.w_max))
 
 
-def _check_feasible(problem: DiscreteProblem) -> FloatArray:
-    """Raise :class:`InfeasibleError` unless some ``w`` with ``w_i > 0`` inside meets the rows.
+def _positive_feasible(problem: DiscreteProblem) -> FloatArray:
+    """The fastest feasible ``w``; :class:`InfeasibleError` unless it is positive inside.
 
     The jerk rows never make the relaxation infeasible (``t`` may grow), so feasibility is
     that of the linear rows with strictly positive interior ``w``: the O(n) no-jerk pass.
+    The boundary values are assumed reachable (:func:`~speedplan.solve.nojerk.check_reachable`).
     """
-    check_reachable(problem)
     wmf = max_feasible_w(problem)
     inner = wmf[1:-1]
     if inner.size and float(np.min(inner)) <= 0.0:
@@ -440,25 +450,44 @@ def solve_relaxation_banded(
 
     """
     t_start = time.perf_counter()
-    if problem.n < 3:
+    if problem.n >= 3:
+        check_reachable(problem)
+    s_scale, w_scale = unit_scales(problem)
+    res = solve_unit_relaxation(problem.scaled(s_scale, w_scale), tol=tol, max_iter=max_iter)
+    time_scale = s_scale / np.sqrt(w_scale)
+    w = res.w * w_scale
+    w[0], w[-1] = problem.w_start, problem.w_end
+    return replace(res, w=w, t=res.t * time_scale,
+                   primal_objective=res.primal_objective * time_scale,
+                   dual_objective=res.dual_objective * time_scale,
+                   setup_time=time.perf_counter() - t_start - res.solve_time)
+
+
+def solve_unit_relaxation(
+    unit: DiscreteProblem, *, tol: float = 1e-8, max_iter: int = 100
+) -> RelaxationResult:
+    """:func:`solve_relaxation_banded` of a problem already in units and checked.
+
+    ``unit`` is in the units of :func:`unit_scales` (``w_max <= 1``, unit mean step) and its
+    boundary values are reachable (:func:`~speedplan.solve.nojerk.check_reachable`), as
+    :func:`~speedplan.solve.solve_problem` hands it to every relaxation backend; results are
+    in the same units.
+    """
+    t_start = time.perf_counter()
+    if unit.n < 3:
         raise SolverError("the relaxation needs n >= 3 grid nodes", backend="banded",
                           status="InvalidProblem")
-    wmf = _check_feasible(problem)
-    s_scale, w_scale = _scales(problem, wmf[1:-1])
-    scaled = problem.scaled(s_scale, w_scale)
-    d = _prepare(scaled, wmf[1:-1] / w_scale)
+    wmf = _positive_feasible(unit)
+    d = _prepare(unit, wmf[1:-1])
     t_setup = time.perf_counter()
-    w_int, yl, iterations, code = _run_kernel(d, *_start(scaled, d), tol, max_iter)
-    obj_scale = s_scale / np.sqrt(w_scale)
-    # Back to the scaled problem's units; clip rounding-level excursions past the bounds.
-    w_low = np.zeros(d.cw.size) if scaled.w_min is None else scaled.w_min[1:-1]
-    w_sc = np.concatenate(([scaled.w_start], np.clip(w_int * d.cw, w_low, scaled.w_max[1:-1]),
-                           [scaled.w_end]))
-    t = _primal_t(scaled, w_sc)
-    w = w_sc * w_scale
-    w[0], w[-1] = problem.w_start, problem.w_end
-    primal = float(t.sum()) * obj_scale
-    dual = _lagrangian_bound(scaled, *_row_multipliers(d, yl)) * obj_scale
+    w_int, yl, iterations, code = _run_kernel(d, *_start(unit, d), tol, max_iter)
+    # Clip rounding-level excursions past the bounds; the ends are the given values.
+    w_low = np.zeros(d.lay.m) if unit.w_min is None else unit.w_min[1:-1]
+    w = np.concatenate(([unit.w_start], np.clip(w_int * d.cw, w_low, unit.w_max[1:-1]),
+                        [unit.w_end]))
+    t = _primal_t(unit, w)
+    primal = float(t.sum())
+    dual = _lagrangian_bound(unit, *_row_multipliers(d, yl))
     status = ipm.STATUS_NAMES[code]
     if status != "Solved":
         # Like Clarabel's AlmostSolved: accepted only with a certified gap and feasible w,
@@ -467,7 +496,8 @@ def solve_relaxation_banded(
         # certified gap is 3.6e-11 (paths/slow_zone.json, n = 20 000), or the next Newton
         # matrix fails to factor one step after a certified gap of 9.9e-8 (u_turn.json).
         cert_gap = (primal - dual) / max(abs(primal), 1e-300)
-        feasible = problem.linear_violation(w) <= ipm.ALMOST_GAP * max(1.0, w_scale)
+        feasible = (unit.linear_violation(w)
+                    <= ipm.ALMOST_GAP * max(1.0, float(np.max(unit.w_max))))
         if not (cert_gap <= ipm.ALMOST_GAP and feasible):
             raise SolverError(
                 f"banded interior-point method stopped with status {status} after "
@@ -479,7 +509,7 @@ def solve_relaxation_banded(
     t_end = time.perf_counter()
     return RelaxationResult(
         w=w,
-        t=t * obj_scale,
+        t=t,
         primal_objective=primal,
         dual_objective=dual,
         status=status,

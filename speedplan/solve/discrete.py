@@ -20,7 +20,7 @@ import numpy as np
 
 from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
 from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
-from .banded import kernel_for_auto, solve_relaxation_banded
+from .banded import kernel_for_auto, solve_unit_relaxation, unit_scales
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .ipopt_ import refine_ipopt
 from .nojerk import check_reachable, max_feasible_w
@@ -29,10 +29,11 @@ from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
 __all__ = ["BACKENDS", "REFINE_MODES", "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
 
-#: Relaxation backends by name; each maps a (normalised) problem to a RelaxationResult.
+#: Relaxation backends by name; each maps a problem in the units of
+#: :func:`~speedplan.solve.banded.unit_scales`, boundary values checked, to a RelaxationResult.
 RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = {
     "clarabel": solve_relaxation,
-    "banded": solve_relaxation_banded,
+    "banded": solve_unit_relaxation,
 }
 #: ``backend="auto"`` uses the banded interior-point method from this many nodes on (it is
 #: 5-8x faster than Clarabel from 100 to 500 nodes, measured); below, both take a few
@@ -128,8 +129,7 @@ def solve_problem(
         )
 
     # Solve in units where the mean step and the largest bound are 1: well-scaled cones.
-    s_scale = float(np.mean(problem.h))
-    w_scale = float(np.max(problem.w_max))
+    s_scale, w_scale = unit_scales(problem)
     time_scale = s_scale / np.sqrt(w_scale)
     unit = problem.scaled(s_scale, w_scale)
     relax, backend, fallback_reason = _relax_with_fallback(unit, backend)
