@@ -63,15 +63,16 @@ import numba
 import numpy as np
 
 from ..core.checks import FloatArray
-from ..core.errors import InfeasibleError, SolverError
+from ..core.errors import InfeasibleError, InvalidInputError, SolverError
 from . import _banded_ipm as ipm
 from .clarabel_ import RelaxationResult
 from .nojerk import check_reachable, max_feasible_w, min_feasible_w
 from .problem import DiscreteProblem
 
 __all__ = [
-    "compile_kernel", "kernel_for_auto", "kernel_ready", "solve_relaxation_banded",
-    "solve_unit_relaxation", "unit_scales",
+    "MAX_RAMP_STEPS", "check_grid_resolvable", "compile_kernel", "kernel_for_auto",
+    "kernel_ready", "ramp_steps", "solve_relaxation_banded", "solve_unit_relaxation",
+    "unit_scales",
 ]
 
 
@@ -371,6 +372,69 @@ def _spawn_compile() -> subprocess.Popen[bytes] | None:
                                 stderr=subprocess.DEVNULL)
     except OSError:
         return None
+
+
+#: Longest jerk-limited change of acceleration, in grid steps, that the relaxation resolves.
+#: The reduced Newton matrix carries the fourth difference ``D̂'D̂`` over such a stretch of
+#: active jerk rows, whose condition number grows like its length to the fourth power; in
+#: double precision both backends lose the dual equations beyond a few thousand steps
+#: (measured on straights with steps of 0.17-2 mm, ``benchmarks/bench_fine_grids.py``: every
+#: case up to 4 000 steps solved; from 5 000 on some stalled, a 10 m straight already at
+#: 5 000, a 30 m one at 8 000; docs/banded-ipm.md). The grid is refused above this count.
+MAX_RAMP_STEPS = 4000
+
+
+def ramp_steps(problem: DiscreteProblem) -> float:
+    """Most grid steps a jerk-limited change of ``w'`` by its bound can take, over all nodes.
+
+    Node ``i``'s jerk row lets ``w'`` change by at most ``r_i = J_i τ_i / sqrt(w_i)`` per
+    step (``|w''| sqrt(w) <= J``), fewest at the fastest feasible ``w``. From node ``i`` on,
+    count the steps until the ``r`` add up to ``max(A, D)`` there; a node without a jerk row
+    ends the count. Invariant under :meth:`DiscreteProblem.scaled`.
+    """
+    finite = np.isfinite(problem.jerk)
+    if problem.n < 3 or not finite.any():
+        return 0.0
+    w = np.maximum(max_feasible_w(problem)[1:-1], 1e-300)
+    a = np.maximum.reduce([problem.accel[:-1], problem.accel[1:], problem.decel[:-1],
+                           problem.decel[1:]])
+    rate = np.where(finite, problem.jerk * problem.tau / np.sqrt(w), np.inf)
+    reached = np.concatenate(([0.0], np.cumsum(rate)))
+    end = np.searchsorted(reached, reached[:-1] + a, side="left")
+    return float(np.max(end - np.arange(rate.size)))
+
+
+def check_grid_resolvable(problem: DiscreteProblem) -> None:
+    """Raise :class:`InvalidInputError` if the grid is too fine for the relaxation to resolve.
+
+    See :data:`MAX_RAMP_STEPS`; the message gives the finest step supported for these bounds.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.solve.problem import DiscreteProblem
+    >>> n = 12_000
+    >>> p = DiscreteProblem(s=np.arange(n) * 1e-3, w_max=np.full(n, 4.0),
+    ...                     accel=np.full(n - 1, 2.0), decel=np.full(n - 1, 2.0),
+    ...                     jerk=np.full(n - 2, 0.5))
+    >>> check_grid_resolvable(p)
+    Traceback (most recent call last):
+    ...
+    speedplan.core.errors.InvalidInputError: the grid is too fine for the jerk bounds: ...
+    """
+    steps = ramp_steps(problem)
+    if steps <= MAX_RAMP_STEPS + 1:  # one step of slack: the count rounds up
+        return
+    h = float(np.mean(problem.h))
+    h_min = h * steps / MAX_RAMP_STEPS
+    length = float(problem.s[-1] - problem.s[0])
+    n_max = int(length / h_min) + 1
+    raise InvalidInputError(
+        f"the grid is too fine for the jerk bounds: a jerk-limited change of acceleration "
+        f"spans up to {steps:.0f} grid steps of {h:.3g}, more than the {MAX_RAMP_STEPS} the "
+        f"relaxation resolves in double precision; use steps of at least {h_min:.3g} "
+        f"(plan(): n <= {n_max} for this length {length:.6g}, or ds >= {h_min:.3g})"
+    )
 
 
 def unit_scales(problem: DiscreteProblem) -> tuple[float, float]:

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
 from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
-from .banded import kernel_for_auto, solve_unit_relaxation, unit_scales
+from .banded import check_grid_resolvable, kernel_for_auto, solve_unit_relaxation, unit_scales
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .ipopt_ import refine_ipopt
 from .nojerk import check_reachable, max_feasible_w
@@ -103,6 +103,9 @@ def solve_problem(
 
     Raises
     ------
+    InvalidInputError
+        If the grid is finer than the relaxation can resolve for these jerk bounds
+        (:func:`~speedplan.solve.banded.check_grid_resolvable`).
     InfeasibleError
         If the boundary values cannot be met.
     SolverError
@@ -128,6 +131,7 @@ def solve_problem(
             solve_time=time.perf_counter() - t_start, backend="pass",
         )
 
+    check_grid_resolvable(problem)  # before any solver spends a minute on it
     # Solve in units where the mean step and the largest bound are 1: well-scaled cones.
     s_scale, w_scale = unit_scales(problem)
     time_scale = s_scale / np.sqrt(w_scale)
