@@ -198,7 +198,7 @@ def _newton_state(seed: int):
     inst = paper_instance("rnd", "cnst", "cnst", n=60, seed=seed)
     p = _problem(inst.w_max, inst.A, inst.J)
     unit = p.scaled(*unit_scales(p))
-    d = _prepare(unit, _positive_feasible(unit)[1:-1])
+    d, _ = _prepare(unit, _positive_feasible(unit)[1:-1])
     lay = d.lay
     rng = np.random.default_rng(seed)
 
@@ -231,7 +231,7 @@ def test_newton_refines_only_above_its_residual_threshold(seed):
         dn = ipm.Direction.empty(lay)
         ipm.newton_into(d, sc, fac, ipm.Work.empty(lay), pt, res, rhs, refine_above, dn)
         gx = (np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m))
-        ipm.g_adjoint_into(d, dn.dyl, dn.dys, *gx, np.zeros(lay.m))
+        ipm.g_adjoint_into(d, dn.dyl, dn.dys, *gx)
         residual = np.sqrt(sum(float(np.sum((b - g) ** 2))
                                for b, g in zip((res.gw, res.gt, res.gz), gx, strict=True)))
         return dn, residual

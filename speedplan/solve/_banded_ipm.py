@@ -69,7 +69,7 @@ class Layout(NamedTuple):
     """Sizes and row-block offsets of one problem, computed once by :func:`layout`."""
 
     m: int  # interior nodes
-    k: int  # jerk rows of each sign
+    k: int  # stencil (jerk-type) rows of each sign, all families
     kl: int  # lower-bound rows
     dec: int  # first braking row (the acceleration rows start at 0)
     up: int  # first upper-bound row
@@ -94,7 +94,8 @@ def layout(m: int, k: int, kl: int) -> Layout:
 def _shape(kind: str, lay: Layout) -> tuple[int, ...]:
     """Shape of an array of ``kind``: per node, linear row, cone (3, nc), cone, jerk row, floor."""
     return {"node": (lay.m,), "lin": (lay.n_lin,), "cone": (3, lay.nc), "cones": (lay.nc,),
-            "jerk": (lay.k,), "low": (lay.kl,)}[kind]
+            "jerk": (lay.k,), "stencil": (3, lay.k), "start": (lay.m + 1,),
+            "low": (lay.kl,)}[kind]
 
 
 def _empty(cls: type[_T], lay: Layout) -> _T:
@@ -110,7 +111,7 @@ def _check(obj: tuple[Any, ...], lay: Layout) -> None:
         if name not in kinds:
             continue
         want = _shape(kinds[name], lay)
-        dtype = np.intp if name in ("jk", "lk") else np.float64
+        dtype = np.intp if name in ("jk", "lk", "jstart") else np.float64
         if not (isinstance(arr, np.ndarray) and arr.shape == want and arr.dtype == dtype
                 and arr.flags.c_contiguous):
             got = getattr(arr, "shape", type(arr).__name__)
@@ -119,13 +120,17 @@ def _check(obj: tuple[Any, ...], lay: Layout) -> None:
 
 
 class Data(NamedTuple):
-    """Problem data in internal units (see :func:`speedplan.solve.banded._prepare`)."""
+    """Problem data in internal units (see :func:`speedplan.solve.banded._prepare`).
 
-    d0: FloatArray  # second-difference weights of w_{i-1}, w_i, w_{i+1}, shape (m,)
-    d1: FloatArray
-    d2: FloatArray
-    jk: IntArray  # interior nodes with finite J, increasing
-    cj: FloatArray  # coefficient of the second difference in their jerk rows
+    The stencil rows of every family (jerk, lateral jerk) are listed together, ordered by
+    node: row ``r`` reads ``±cj_r (jc_r · ŵ_{i-1:i+2}) - t̂_i <= b`` at node ``i = jk_r``, and the
+    rows of node ``i`` are ``jstart[i]:jstart[i + 1]``.
+    """
+
+    jk: IntArray  # node of each stencil row, non-decreasing
+    jstart: IntArray  # first row of each node, shape (m + 1,)
+    jc: FloatArray  # stencil of each row over ŵ_{i-1}, ŵ_i, ŵ_{i+1}, shape (3, k)
+    cj: FloatArray  # coefficient of the stencil in its rows
     lk: IntArray  # interior nodes with a positive lower bound
     ct: FloatArray  # objective coefficients of t
     cw: FloatArray  # coefficients of w in the acceleration rows
@@ -135,8 +140,10 @@ class Data(NamedTuple):
     def check(self) -> None:
         """Raise :class:`ValueError` unless every array has its shape for ``self.lay``."""
         _check(self, self.lay)
-        if self.jk.size and not bool(np.all(np.diff(self.jk) > 0)):
-            raise ValueError("Data.jk must be increasing")
+        if self.jk.size and not bool(np.all(np.diff(self.jk) >= 0)):
+            raise ValueError("Data.jk must be non-decreasing")
+        if not np.array_equal(self.jstart, np.searchsorted(self.jk, np.arange(self.lay.m + 1))):
+            raise ValueError("Data.jstart must index the rows of each node")
 
 
 class Point(NamedTuple):
@@ -226,13 +233,18 @@ class Factor(NamedTuple):
     l1: FloatArray  # L[i, i-1]
     l2: FloatArray  # L[i, i-2]
     dd: FloatArray  # D
-    a: FloatArray  # coupling of t_i to D̂_i w, zero where J = inf
+    alpha: FloatArray  # per stencil row: coupling of t_i to (jc_r · ŵ) in G'HG
     bwz: FloatArray  # coupling of z_i to w_i
     p: FloatArray  # inverse of the (t, z) block: [[p, q], [q, r]]
     q: FloatArray
     r: FloatArray
-    e: FloatArray  # weight of (D̂ w)_i after eliminating t_i
     dg: FloatArray  # diagonal weight of w_i from its own rows (bound, floor, node cone)
+    m00: FloatArray  # node i's stencil rows after eliminating (t_i, z_i): a symmetric
+    m01: FloatArray  # 3 x 3 block over w_{i-1}, w_i, w_{i+1}
+    m02: FloatArray
+    m11: FloatArray
+    m12: FloatArray
+    m22: FloatArray
 
     @classmethod
     def empty(cls, lay: Layout) -> Factor:
@@ -241,12 +253,11 @@ class Factor(NamedTuple):
 
 
 class Work(NamedTuple):
-    """Scratch of one Newton solve: the refinement's right-hand side and a node vector."""
+    """Scratch of one Newton solve: the right-hand side of its refinement."""
 
     rw: FloatArray
     rt: FloatArray
     rz: FloatArray
-    u: FloatArray
 
     @classmethod
     def empty(cls, lay: Layout) -> Work:
@@ -255,7 +266,7 @@ class Work(NamedTuple):
 
 
 _KINDS: dict[type, dict[str, str]] = {
-    Data: {"d0": "node", "d1": "node", "d2": "node", "jk": "jerk", "cj": "jerk", "lk": "low",
+    Data: {"jk": "jerk", "jstart": "start", "jc": "stencil", "cj": "jerk", "lk": "low",
            "ct": "node", "cw": "node", "b_lin": "lin"},
     Point: {"w": "node", "t": "node", "z": "node", "sl": "lin", "yl": "lin", "ss": "cone",
             "ys": "cone"},
@@ -264,7 +275,7 @@ _KINDS: dict[type, dict[str, str]] = {
                 "dss": "cone", "dys": "cone"},
     Rhs: {"bsl": "lin", "bss": "cone"},
     Scaling: {"beta": "cones", "v": "cone", "lam_s": "cone"},
-    Factor: dict.fromkeys(Factor._fields, "node"),
+    Factor: {**dict.fromkeys(Factor._fields, "node"), "alpha": "jerk"},
     Work: dict.fromkeys(Work._fields, "node"),
 }
 
@@ -288,21 +299,21 @@ def _pad(w: FloatArray, i: int) -> float:
 
 
 @njit(cache=True, error_model="numpy")
-def _second_diff(d: Data, w: FloatArray, i: int) -> float:
-    """``(D̂ w)_i``, the scaled second difference at node ``i``."""
-    return float(d.d0[i] * _pad(w, i - 1) + d.d1[i] * w[i] + d.d2[i] * _pad(w, i + 1))
+def _stencil_dot(d: Data, w: FloatArray, r: int) -> float:
+    """``jc_r · w_{i-1:i+2}`` for stencil row ``r`` at node ``i`` (zero outside the nodes)."""
+    i = d.jk[r]
+    return float(d.jc[0, r] * _pad(w, i - 1) + d.jc[1, r] * w[i] + d.jc[2, r] * _pad(w, i + 1))
 
 
 @njit(cache=True, error_model="numpy")
-def _second_diff_t(d: Data, u: FloatArray, i: int) -> float:
-    """``(D̂' u)_i`` for node values ``u``."""
-    m = u.size
-    acc = d.d1[i] * u[i]
-    if i + 1 < m:
-        acc += d.d0[i + 1] * u[i + 1]
+def _scatter_stencil(d: Data, r: int, value: float, out: FloatArray) -> None:
+    """``out += value * jc_r`` at ``w_{i-1:i+2}`` (the adjoint of :func:`_stencil_dot`)."""
+    i = d.jk[r]
     if i > 0:
-        acc += d.d2[i - 1] * u[i - 1]
-    return float(acc)
+        out[i - 1] += value * d.jc[0, r]
+    out[i] += value * d.jc[1, r]
+    if i + 1 < out.size:
+        out[i + 1] += value * d.jc[2, r]
 
 
 @njit(cache=True, error_model="numpy")
@@ -395,7 +406,7 @@ def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
         out[lay.low + r] = -w[d.lk[r]]
     for r in range(k):
         i = d.jk[r]
-        jw = d.cj[r] * _second_diff(d, w, i)
+        jw = d.cj[r] * _stencil_dot(d, w, r)
         out[lay.jp + r] = jw - t[i]
         out[lay.jm + r] = -jw - t[i]
 
@@ -416,29 +427,23 @@ def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> 
 @njit(cache=True, error_model="numpy")
 def g_adjoint_into(
     d: Data, yl: FloatArray, ys: FloatArray, gw: FloatArray, gt: FloatArray, gz: FloatArray,
-    u: FloatArray,
 ) -> None:
-    """``G' y`` split into its ``w``, ``t`` and ``z`` parts (``u`` is scratch)."""
+    """``G' y`` split into its ``w``, ``t`` and ``z`` parts."""
     lay = d.lay
     m, k = lay.m, lay.k
     for i in range(m):
-        u[i] = 0.0
-        gt[i] = -(ys[0, m + i] + ys[1, m + i])
-        gz[i] = -2.0 * ys[1, i] - ys[0, m + i] + ys[1, m + i]
-    for r in range(k):
-        i = d.jk[r]
-        jp, jm = yl[lay.jp + r], yl[lay.jm + r]
-        u[i] = d.cj[r] * (jp - jm)
-        gt[i] -= jp + jm
-    for i in range(m):
-        gw[i] = _second_diff_t(d, u, i)
-    for i in range(m):
         acc_i = yl[i] - yl[lay.dec + i]
         acc_n = yl[i + 1] - yl[lay.dec + i + 1]
-        gw[i] += (d.cw[i] * (acc_i - acc_n) + yl[lay.up + i]
-                  - ys[0, i] - ys[2, i])
+        gw[i] = (d.cw[i] * (acc_i - acc_n) + yl[lay.up + i]
+                 - ys[0, i] - ys[2, i])
+        gt[i] = -(ys[0, m + i] + ys[1, m + i])
+        gz[i] = -2.0 * ys[1, i] - ys[0, m + i] + ys[1, m + i]
     for r in range(lay.kl):
         gw[d.lk[r]] -= yl[lay.low + r]
+    for r in range(k):
+        jp, jm = yl[lay.jp + r], yl[lay.jm + r]
+        _scatter_stencil(d, r, d.cj[r] * (jp - jm), gw)
+        gt[d.jk[r]] -= jp + jm
 
 
 # --- cones: steps, interiority, scaling --------------------------------------------------------
@@ -523,34 +528,65 @@ def _eliminate_tz_into(
 ) -> None:
     """Per node, the ``(t, z)`` block of ``G' H G``, its inverse and its couplings to ``w``.
 
-    The linear rows are weighted by ``yl / sl`` (computed where used), the cones by ``H``.
+    The linear rows are weighted by ``H = yl / sl`` (computed where used), the cones by their
+    ``H``. Node ``i``'s stencil rows ``±c_r (a_r · ŵ) - t̂_i`` (weights ``H⁺_r``, ``H⁻_r``)
+    add ``σ_r c_r² a_r a_r'`` to the ``w`` block, ``α_r a_r`` with ``α_r = -c_r (H⁺_r - H⁻_r)``
+    to the coupling of ``t_i`` and ``σ_r = H⁺_r + H⁻_r`` to its diagonal. Eliminating
+    ``(t_i, z_i)`` leaves, over ``w_{i-1:i+2}``, the block
+    ``M_i = Σ_rs E_rs a_r a_s' + Σ_r φ_r (a_r e' + e a_r')`` (``e`` the middle unit vector,
+    ``E = diag(σ c²) - p α α'``, ``φ_r = -q α_r b_wz``), stored in ``m00 ... m22``.
     """
     lay = d.lay
-    m, k = lay.m, lay.k
-    r = 0  # next jerk row; d.jk is increasing
+    m = lay.m
     for i in range(m):
         h00, h01, h02, h11, h12, h22 = _h_entries(sc, i)
         g00, g01, _, g11, _, _ = _h_entries(sc, m + i)
         mtt = g00 + 2.0 * g01 + g11
         mzz = 4.0 * h11 + g00 - 2.0 * g01 + g11
         mtz = g00 - g11
-        fac.bwz[i] = 2.0 * (h01 + h12)
+        bwz = 2.0 * (h01 + h12)
+        fac.bwz[i] = bwz
         fac.dg[i] = yl[lay.up + i] / sl[lay.up + i] + (h00 + 2.0 * h02 + h22)
-        fac.a[i] = 0.0
-        fac.e[i] = 0.0
-        if r < k and d.jk[r] == i:
+        r0, r1 = d.jstart[i], d.jstart[i + 1]
+        hsum = 0.0
+        for r in range(r0, r1):
             hp = yl[lay.jp + r] / sl[lay.jp + r]
             hm = yl[lay.jm + r] / sl[lay.jm + r]
-            # Jerk weight after eliminating t: c²(H⁺ + H⁻) - p a², written without
-            # cancellation as c² (4 H⁺H⁻ + κ (H⁺ + H⁻)) / (H⁺ + H⁻ + κ), κ the cones' weight.
-            kappa = mtt - mtz * mtz / mzz
-            hsum = hp + hm
-            fac.e[i] = d.cj[r] ** 2 * (4.0 * hp * hm + kappa * hsum) / (hsum + kappa)
-            fac.a[i] = -d.cj[r] * (hp - hm)
-            mtt += hsum
-            r += 1
+            fac.alpha[r] = -d.cj[r] * (hp - hm)
+            hsum += hp + hm
+        # κ: the cones' own weight of t once z is eliminated; p = 1 / (κ + Σσ).
+        kappa = mtt - mtz * mtz / mzz
+        mtt += hsum
         det = mtt * mzz - mtz * mtz
-        fac.p[i], fac.q[i], fac.r[i] = mzz / det, -mtz / det, mtt / det
+        p, q, rr = mzz / det, -mtz / det, mtt / det
+        fac.p[i], fac.q[i], fac.r[i] = p, q, rr
+        m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+        for r in range(r0, r1):
+            hp = yl[lay.jp + r] / sl[lay.jp + r]
+            hm = yl[lay.jm + r] / sl[lay.jm + r]
+            sig = hp + hm
+            # E_rr = c² σ - p α², written without cancellation as
+            # c² (σ (κ + Σσ - σ) + 4 H⁺H⁻) / (κ + Σσ).
+            err = d.cj[r] ** 2 * (sig * (kappa + hsum - sig) + 4.0 * hp * hm) / (hsum + kappa)
+            a0, a1, a2 = d.jc[0, r], d.jc[1, r], d.jc[2, r]
+            phi = -q * fac.alpha[r] * bwz
+            m00 += err * a0 * a0
+            m01 += err * a0 * a1 + phi * a0
+            m02 += err * a0 * a2
+            m11 += err * a1 * a1 + 2.0 * phi * a1
+            m12 += err * a1 * a2 + phi * a2
+            m22 += err * a2 * a2
+            for s_ in range(r + 1, r1):  # pairs of rows at one node (several families)
+                ers = -p * fac.alpha[r] * fac.alpha[s_]
+                b0, b1, b2 = d.jc[0, s_], d.jc[1, s_], d.jc[2, s_]
+                m00 += 2.0 * ers * a0 * b0
+                m01 += ers * (a0 * b1 + a1 * b0)
+                m02 += ers * (a0 * b2 + a2 * b0)
+                m11 += 2.0 * ers * a1 * b1
+                m12 += ers * (a1 * b2 + a2 * b1)
+                m22 += 2.0 * ers * a2 * b2
+        fac.m00[i], fac.m01[i], fac.m02[i] = m00, m01, m02
+        fac.m11[i], fac.m12[i], fac.m22[i] = m11, m12, m22
     for r in range(lay.kl):
         j = lay.low + r
         fac.dg[d.lk[r]] += yl[j] / sl[j]
@@ -561,33 +597,29 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
     """Assemble the Schur complement in ``w`` of ``G' H G`` and factor it.
 
     The linear rows are weighted by ``yl / sl`` and the cones by ``H`` of ``sc``.
-    Eliminating ``(t_i, z_i)`` node by node leaves a pentadiagonal matrix, factored as
-    ``L D L'`` with a unit lower triangular ``L`` of bandwidth 2. Returns False if the
-    matrix is not numerically positive definite.
+    Eliminating ``(t_i, z_i)`` node by node leaves a pentadiagonal matrix (every stencil
+    spans three nodes), factored as ``L D L'`` with a unit lower triangular ``L`` of
+    bandwidth 2. Returns False if the matrix is not numerically positive definite.
     """
     _eliminate_tz_into(d, sc, yl, sl, fac)
     lay = d.lay
     m, dec = lay.m, lay.dec
-    e, a, l1, l2, dd = fac.e, fac.a, fac.l1, fac.l2, fac.dd
+    l1, l2, dd = fac.l1, fac.l2, fac.dd
     ok = True
     for i in range(m):
         gacc_i = yl[i] / sl[i] + yl[dec + i] / sl[dec + i]
         gacc_n = yl[i + 1] / sl[i + 1] + yl[dec + i + 1] / sl[dec + i + 1]
-        f_i = -fac.q[i] * a[i] * fac.bwz[i]
-        di = (e[i] * d.d1[i] ** 2 + 2.0 * f_i * d.d1[i] + fac.dg[i]
-              - fac.r[i] * fac.bwz[i] ** 2 + d.cw[i] ** 2 * (gacc_i + gacc_n))
+        # S[i, i] gathers M_i's middle, M_{i+1}'s first and M_{i-1}'s last entry.
+        di = (fac.m11[i] + fac.dg[i] - fac.r[i] * fac.bwz[i] ** 2
+              + d.cw[i] ** 2 * (gacc_i + gacc_n))
         off1 = 0.0
         if i + 1 < m:
-            di += e[i + 1] * d.d0[i + 1] ** 2
+            di += fac.m00[i + 1]
         if i > 0:
-            f_p = -fac.q[i - 1] * a[i - 1] * fac.bwz[i - 1]
-            di += e[i - 1] * d.d2[i - 1] ** 2
-            off1 = (d.d0[i] * (e[i] * d.d1[i] + f_i)
-                    + d.d2[i - 1] * (e[i - 1] * d.d1[i - 1] + f_p)
-                    - d.cw[i - 1] * d.cw[i] * gacc_i)
+            di += fac.m22[i - 1]
+            off1 = fac.m01[i] + fac.m12[i - 1] - d.cw[i - 1] * d.cw[i] * gacc_i
         if i > 1:
-            off2 = e[i - 1] * d.d0[i - 1] * d.d2[i - 1]
-            l2[i] = off2 / dd[i - 2]
+            l2[i] = fac.m02[i - 1] / dd[i - 2]
             di -= l2[i] * l2[i] * dd[i - 2]
         else:
             l2[i] = 0.0
@@ -624,24 +656,26 @@ def solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
 
 @njit(cache=True, error_model="numpy")
 def solve_normal_inplace(
-    d: Data, fac: Factor, xw: FloatArray, xt: FloatArray, xz: FloatArray, u: FloatArray
+    d: Data, fac: Factor, xw: FloatArray, xt: FloatArray, xz: FloatArray
 ) -> None:
     """Overwrite ``(xw, xt, xz)`` with the solution of ``G' H G Δx = (xw, xt, xz)``.
 
     ``(t, z)`` are eliminated node by node, the pentadiagonal system in ``w`` is solved,
-    and ``(t, z)`` are recovered (``u`` is scratch).
+    and ``(t, z)`` are recovered.
     """
     m = xw.size
     for i in range(m):
         rt, rz = xt[i], xz[i]
         xt[i] = fac.p[i] * rt + fac.q[i] * rz
         xz[i] = fac.q[i] * rt + fac.r[i] * rz
-        u[i] = fac.a[i] * xt[i]
-    for i in range(m):
-        xw[i] = xw[i] - _second_diff_t(d, u, i) - fac.bwz[i] * xz[i]
+        xw[i] -= fac.bwz[i] * xz[i]
+    for r in range(d.lay.k):
+        _scatter_stencil(d, r, -fac.alpha[r] * xt[d.jk[r]], xw)
     solve_banded_inplace(fac, xw)
     for i in range(m):
-        ct = fac.a[i] * _second_diff(d, xw, i)
+        ct = 0.0
+        for r in range(d.jstart[i], d.jstart[i + 1]):
+            ct += fac.alpha[r] * _stencil_dot(d, xw, r)
         cz = fac.bwz[i] * xw[i]
         xt[i] -= fac.p[i] * ct + fac.q[i] * cz
         xz[i] -= fac.q[i] * ct + fac.r[i] * cz
@@ -703,19 +737,19 @@ def newton_into(
     """
     # With v = H by - W⁻¹ u (λ ∘ u = bs): (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
     _v_into(sc, pt, res, rhs, dn.dyl, dn.dys)
-    g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz, nw.u)
+    g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz)
     for i in range(dn.dw.size):
         dn.dw[i] += res.gw[i]
         dn.dt[i] += res.gt[i]
         dn.dz[i] += res.gz[i]
-    solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz, nw.u)
+    solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
     _ds_dy_into(d, sc, pt, res, dn)
     # The last two equations hold by construction; only G'Δy = bx inherits the rounding of
     # the reduced solve, which grows as H becomes ill-conditioned near the optimum. A round
     # of iterative refinement with the same factor restores it.
     if refine_above < np.inf:
         rw, rt, rz = nw.rw, nw.rt, nw.rz
-        g_adjoint_into(d, dn.dyl, dn.dys, rw, rt, rz, nw.u)
+        g_adjoint_into(d, dn.dyl, dn.dys, rw, rt, rz)
         res2 = 0.0
         for i in range(rw.size):
             rw[i] = res.gw[i] - rw[i]
@@ -724,7 +758,7 @@ def newton_into(
             res2 += rw[i] * rw[i] + rt[i] * rt[i] + rz[i] * rz[i]
         if not math.sqrt(res2) > refine_above:
             return
-        solve_normal_inplace(d, fac, rw, rt, rz, nw.u)
+        solve_normal_inplace(d, fac, rw, rt, rz)
         for i in range(rw.size):
             dn.dw[i] += rw[i]
             dn.dt[i] += rt[i]
@@ -793,7 +827,7 @@ def start_into(d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, dn: Direc
         dn.dw[i] = 0.0
         dn.dt[i] = -d.ct[i]
         dn.dz[i] = 0.0
-    solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz, nw.u)
+    solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
     g_lin_into(d, dn.dw, dn.dt, pt.yl)
     g_soc_into(dn.dw, dn.dt, dn.dz, pt.ys)
     _shift_into_cone(pt.sl, pt.ss)
@@ -802,11 +836,11 @@ def start_into(d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, dn: Direc
 
 @njit(cache=True, error_model="numpy")
 def residuals_into(
-    d: Data, pt: Point, res: Residual, u: FloatArray
+    d: Data, pt: Point, res: Residual
 ) -> tuple[float, float, float, float, float]:
     """Residuals (negated) into ``res``; returns ``(pcost, dcost, gap, |r_y|², |r_x|²)``."""
     m = d.lay.m
-    g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz, u)
+    g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz)
     g_lin_into(d, pt.w, pt.t, res.ryl)
     g_soc_into(pt.w, pt.t, pt.z, res.rys)
     for i in range(m):
@@ -936,7 +970,7 @@ def iterate(
     it = 0
     best_gap, stalled = np.inf, 0
     for it in range(max_iter + 1):
-        pcost, dcost, gap, ry2, rx2 = residuals_into(d, pt, res, nw.u)
+        pcost, dcost, gap, ry2, rx2 = residuals_into(d, pt, res)
         pres = math.sqrt(ry2) / res_y0
         dres = math.sqrt(rx2) / res_x0
         relgap = gap / max(min(abs(pcost), abs(dcost)), 1e-300)

@@ -57,12 +57,12 @@ import subprocess
 import sys
 import time
 from dataclasses import replace
-from typing import Any
+from typing import Any, NamedTuple
 
 import numba
 import numpy as np
 
-from ..core.checks import FloatArray
+from ..core.checks import FloatArray, IntArray
 from ..core.errors import InfeasibleError, InvalidInputError, SolverError
 from . import _banded_ipm as ipm
 from .clarabel_ import RelaxationResult
@@ -76,35 +76,52 @@ __all__ = [
 ]
 
 
-def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
+class _Rows(NamedTuple):
+    """Which family and node each stencil row of :class:`~speedplan.solve._banded_ipm.Data` is."""
+
+    family: IntArray
+    node: IntArray
+
+
+def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> tuple[ipm.Data, _Rows]:
     """Flatten the (already scaled) problem into the arrays the iteration uses.
 
     Variables are scaled per node, ``w = cw ŵ``, ``z = sqrt(cw) ẑ``, ``t = ct t̂`` with
     ``cw = w_ref`` and ``ct = τ / sqrt(cw)``, which turns both cones of every node into the
     same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``; the acceleration rows get the coefficients
-    ``cw`` and the jerk rows are divided by ``ct``. The rows are not normalised further:
+    ``cw``, the stencil rows (every finite row of every family of
+    :meth:`~speedplan.solve.problem.DiscreteProblem.stencil_families`) the stencil times
+    ``cw`` and are divided by ``ct``. The rows are not normalised further:
     normalising the jerk rows to unit norm (as an earlier version did) made the method jam on
     grids finer than about 7 mm, e.g. ``paths/u_turn.json`` at ``n = 5000`` (NoProgress after
     36 iterations; without it, a certified gap below 1e-6 after 34), with no gain elsewhere.
     """
     n = p.n
     m = n - 2
-    h0, h1 = p.h[:-1], p.h[1:]
-    d0 = 2.0 / (h0 * (h0 + h1))
-    d1 = -2.0 / (h0 * h1)
-    d2 = 2.0 / (h1 * (h0 + h1))
     cw = w_ref
     ct = p.tau / np.sqrt(cw)
     cwp = np.concatenate(([0.0], cw, [0.0]))
-    jk = np.flatnonzero(np.isfinite(p.jerk))
-    cj = p.tau[jk] / p.jerk[jk] / ct[jk]
-    w_min = np.zeros(m) if p.w_min is None else p.w_min[1:-1]
-    lk = np.flatnonzero(w_min > 0)
     w_const = np.zeros(n)
     w_const[0], w_const[-1] = p.w_start, p.w_end
+    nodes, fams, stencils, coefs, consts = [], [], [], [], []
+    for f, family in enumerate(p.stencil_families()):
+        rows = np.flatnonzero(np.isfinite(family.bound))
+        c = np.asarray(family.coef)[rows]
+        nodes.append(rows)
+        fams.append(np.full(rows.size, f))
+        stencils.append(c * np.column_stack((cwp[rows], cw[rows], cwp[rows + 2])))
+        cj = p.tau[rows] / family.bound[rows] / ct[rows]
+        coefs.append(cj)
+        # The fixed ends' share of the row, moved to the right-hand side.
+        consts.append((c[:, 0] * w_const[rows] + c[:, 1] * w_const[rows + 1]
+                       + c[:, 2] * w_const[rows + 2]) * cj)
+    order = np.argsort(np.concatenate(nodes), kind="stable")  # by node, families in order
+    jk = np.concatenate(nodes)[order].astype(np.intp)
+    jconst = np.concatenate(consts)[order]
+    w_min = np.zeros(m) if p.w_min is None else p.w_min[1:-1]
+    lk = np.flatnonzero(w_min > 0)
     # G x + s = b with the fixed ends moved to b: b = bound - (row applied to the fixed ends).
     dconst = np.diff(w_const)
-    jconst = (d0 * w_const[:-2] + d1 * w_const[1:-1] + d2 * w_const[2:])[jk] * cj
     b_lin = np.concatenate(
         (
             p.accel * p.h - dconst,
@@ -115,9 +132,13 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
             jconst,
         )
     )
-    return ipm.Data(d0=d0 * cwp[:-2], d1=d1 * cw, d2=d2 * cwp[2:], jk=jk.astype(np.intp), cj=cj,
-                    lk=lk.astype(np.intp), ct=ct, cw=cw, b_lin=b_lin,
-                    lay=ipm.layout(m, jk.size, lk.size))
+    data = ipm.Data(
+        jk=jk, jstart=np.searchsorted(jk, np.arange(m + 1)).astype(np.intp),
+        jc=np.ascontiguousarray(np.concatenate(stencils)[order].T),
+        cj=np.concatenate(coefs)[order], lk=lk.astype(np.intp), ct=ct, cw=cw, b_lin=b_lin,
+        lay=ipm.layout(m, jk.size, lk.size),
+    )
+    return data, _Rows(family=np.concatenate(fams)[order], node=jk)
 
 
 # --- certificates -------------------------------------------------------------------------
@@ -126,40 +147,48 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
 def _primal_t(p: DiscreteProblem, w: FloatArray) -> FloatArray:
     """Smallest feasible ``t`` for the full ``w`` (interior ``w > 0``)."""
     t: FloatArray = p.tau / np.sqrt(w[1:-1])
-    finite = np.isfinite(p.jerk)
-    wpp = p.second_difference @ w
-    t[finite] = np.maximum(t[finite], p.tau[finite] * np.abs(wpp[finite]) / p.jerk[finite])
+    for family in p.stencil_families():
+        finite = np.isfinite(family.bound)
+        load = p.stencil_matrix(family.coef) @ w
+        t[finite] = np.maximum(t[finite],
+                               p.tau[finite] * np.abs(load[finite]) / family.bound[finite])
     return t
 
 
 def _lagrangian_bound(
-    p: DiscreteProblem, mu_acc: FloatArray, mu_dec: FloatArray, nu_p: FloatArray,
-    nu_m: FloatArray,
+    p: DiscreteProblem, mu_acc: FloatArray, mu_dec: FloatArray,
+    nu: list[tuple[FloatArray, FloatArray]],
 ) -> float:
-    """Lower bound from multipliers of the acceleration and jerk rows (weak duality).
+    """Lower bound from multipliers of the acceleration and stencil rows (weak duality).
 
-    With ``μ >= 0`` on the rows ``±(w_{k+1} - w_k) <= A_k h_k`` and ``ν± >= 0`` (per node,
-    zero where ``J = inf``) on ``±τ w'' / J - t <= 0``, the multiplier ``λ = 1 - ν⁺ - ν⁻ >= 0``
-    of ``t >= τ / sqrt(w)`` makes the Lagrangian free of ``t``; its minimum over the box
-    ``w_min <= w <= w_max`` is separable and closed-form (the minimiser of the convex
-    ``g w + c / sqrt(w)`` clipped to the box). Any such multipliers give a valid bound;
-    non-finite ones (an iterate that broke down) give none, ``-inf``.
+    With ``μ >= 0`` on the rows ``±(w_{k+1} - w_k) <= A_k h_k`` and ``ν±_f >= 0`` (per node,
+    zero where the bound is ``inf``) on the rows ``±τ (c_f · w) / B_f - t <= 0`` of every
+    family ``f``, scaled so that ``Σ_f (ν⁺_f + ν⁻_f) <= 1`` at every node, the multiplier
+    ``λ = 1 - Σ_f (ν⁺_f + ν⁻_f) >= 0`` of ``t >= τ / sqrt(w)`` makes the Lagrangian free of
+    ``t``; its minimum over the box ``w_min <= w <= w_max`` is separable and closed-form (the
+    minimiser of the convex ``g w + c / sqrt(w)`` clipped to the box). Any such multipliers
+    give a valid bound; non-finite ones (an iterate that broke down) give none, ``-inf``.
     """
-    if not all(np.all(np.isfinite(x)) for x in (mu_acc, mu_dec, nu_p, nu_m)):
+    arrays = [mu_acc, mu_dec, *(x for pair in nu for x in pair)]
+    if not all(np.all(np.isfinite(x)) for x in arrays):
         return -np.inf
     mu_acc, mu_dec = np.maximum(mu_acc, 0.0), np.maximum(mu_dec, 0.0)
-    nu_p, nu_m = np.maximum(nu_p, 0.0), np.maximum(nu_m, 0.0)
-    excess = np.maximum(nu_p + nu_m, 1.0)  # λ >= 0 needs ν⁺ + ν⁻ <= 1
-    nu_p, nu_m = nu_p / excess, nu_m / excess
-    lam = np.maximum(1.0 - nu_p - nu_m, 0.0)  # >= 0 up to rounding; c / g below stays >= 0
-    finite = np.isfinite(p.jerk)
-    coef = np.where(finite, (nu_p - nu_m) * p.tau / np.where(finite, p.jerk, 1.0), 0.0)
+    nu = [(np.maximum(a, 0.0), np.maximum(b, 0.0)) for a, b in nu]
+    excess = np.maximum(sum((a + b for a, b in nu), np.zeros(p.n - 2)), 1.0)  # λ >= 0
+    nu = [(a / excess, b / excess) for a, b in nu]
+    lam = np.ones(p.n - 2)
+    for a, b in nu:
+        lam = lam - a - b
+    lam = np.maximum(lam, 0.0)  # >= 0 up to rounding; c / g below stays >= 0
     # Linear coefficient of the full w in the Lagrangian.
     net = mu_acc - mu_dec
     g = np.zeros(p.n)
     g[1:] += net
     g[:-1] -= net
-    g += p.second_difference.T @ coef
+    for family, (a, b) in zip(p.stencil_families(), nu, strict=True):
+        finite = np.isfinite(family.bound)
+        coef = np.where(finite, (a - b) * p.tau / np.where(finite, family.bound, 1.0), 0.0)
+        g += p.stencil_matrix(family.coef).T @ coef
     const = (g[0] * p.w_start + g[-1] * p.w_end
              - float(mu_acc @ (p.accel * p.h)) - float(mu_dec @ (p.decel * p.h)))
     gi, c, wmax = g[1:-1], lam * p.tau, p.w_max[1:-1]
@@ -182,31 +211,41 @@ def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, Flo
     ``w`` is the mean of the fastest feasible profile ``w_ref`` and the slowest one
     (:func:`~speedplan.solve.nojerk.min_feasible_w`); both meet every acceleration row, so
     their mean does too, strictly inside the speed bounds wherever they differ. ``z`` and
-    ``t`` are then strictly inside their cones and above the jerk rows. Measured on ``plan()``
-    grids (with the jerk-row normalisation of the time) this more than halved the iterations of
-    CVXOPT's least-squares start (55 -> 20 on ``paths/u_turn.json``), whose point ignores the
-    chain of acceleration rows and spends iterations propagating it along the path.
+    ``t`` are then strictly inside their cones and above the stencil rows. Measured on
+    ``plan()`` grids (with the jerk-row normalisation of the time) this more than halved the
+    iterations of CVXOPT's least-squares start (55 -> 20 on ``paths/u_turn.json``), whose point
+    ignores the chain of acceleration rows and spends iterations propagating it along the path.
     """
     w_hat = 0.5 * (min_feasible_w(p)[1:-1] / d.cw + 1.0)
     z_hat = 0.5 * np.sqrt(w_hat)
-    # Jerk rows at t = 0: G x - b gives cj D̂ŵ plus the fixed ends' share (the kernel's
-    # arithmetic, in numpy: the kernel itself is entered only once per solve).
-    left = np.concatenate(([0.0], w_hat[:-1]))
-    right = np.concatenate((w_hat[1:], [0.0]))
-    second = d.d0 * left + d.d1 * w_hat + d.d2 * right
-    jerk = np.zeros(w_hat.size)
-    jerk[d.jk] = np.abs(d.cj * second[d.jk] - d.b_lin[d.lay.jp : d.lay.jm])
-    t_hat = 2.0 * np.maximum(1.0 / z_hat, jerk) + 1.0
+    # Stencil rows at t = 0: G x - b gives cj (jc · ŵ) plus the fixed ends' share (the
+    # kernel's arithmetic, in numpy: the kernel itself is entered only once per solve).
+    padded = np.concatenate(([0.0], w_hat, [0.0]))
+    i = d.jk
+    rows = d.cj * (d.jc[0] * padded[i] + d.jc[1] * padded[i + 1] + d.jc[2] * padded[i + 2])
+    load = np.zeros(w_hat.size)
+    np.maximum.at(load, i, np.abs(rows - d.b_lin[d.lay.jp : d.lay.jm]))
+    t_hat = 2.0 * np.maximum(1.0 / z_hat, load) + 1.0
     return w_hat, t_hat, z_hat
 
 
-def _row_multipliers(d: ipm.Data, yl: FloatArray) -> tuple[FloatArray, ...]:
-    """Multipliers of the scaled problem's own rows (``t`` rescaled by ``ct``)."""
+def _row_multipliers(
+    p: DiscreteProblem, d: ipm.Data, rows: _Rows, yl: FloatArray
+) -> tuple[FloatArray, FloatArray, list[tuple[FloatArray, FloatArray]]]:
+    """Multipliers of the problem's own rows (stencil rows: ``t`` rescaled by ``ct``).
+
+    Returns ``(μ_acc, μ_dec, [(ν⁺_f, ν⁻_f) per family, per node]``).
+    """
     lay = d.lay
-    nu_p, nu_m = np.zeros(lay.m), np.zeros(lay.m)
-    nu_p[d.jk] = yl[lay.jp : lay.jm] / d.ct[d.jk]
-    nu_m[d.jk] = yl[lay.jm : lay.n_lin] / d.ct[d.jk]
-    return yl[: lay.dec], yl[lay.dec : lay.up], nu_p, nu_m
+    nu = []
+    for f in range(len(p.stencil_families())):
+        mine = rows.family == f
+        node = rows.node[mine]
+        nu_p, nu_m = np.zeros(lay.m), np.zeros(lay.m)
+        nu_p[node] = yl[lay.jp : lay.jm][mine] / d.ct[node]
+        nu_m[node] = yl[lay.jm : lay.n_lin][mine] / d.ct[node]
+        nu.append((nu_p, nu_m))
+    return yl[: lay.dec], yl[lay.dec : lay.up], nu
 
 
 # --- driver --------------------------------------------------------------------------------
@@ -271,7 +310,7 @@ def _load_from_disk_cache() -> bool:
     """
     disp: Any = ipm.iterate
     p = _example_problem()
-    d = _prepare(p, _positive_feasible(p)[1:-1])
+    d, _ = _prepare(p, _positive_feasible(p)[1:-1])
     args = (*_kernel_args(d, *_start(p, d)), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
     try:
         sig = tuple(numba.typeof(a) for a in args)  # type: ignore[no-untyped-call]
@@ -542,7 +581,7 @@ def solve_unit_relaxation(
         raise SolverError("the relaxation needs n >= 3 grid nodes", backend="banded",
                           status="InvalidProblem")
     wmf = _positive_feasible(unit)
-    d = _prepare(unit, wmf[1:-1])
+    d, rows = _prepare(unit, wmf[1:-1])
     t_setup = time.perf_counter()
     w_int, yl, iterations, code = _run_kernel(d, *_start(unit, d), tol, max_iter)
     # Clip rounding-level excursions past the bounds; the ends are the given values.
@@ -551,7 +590,7 @@ def solve_unit_relaxation(
                         [unit.w_end]))
     t = _primal_t(unit, w)
     primal = float(t.sum())
-    dual = _lagrangian_bound(unit, *_row_multipliers(d, yl))
+    dual = _lagrangian_bound(unit, *_row_multipliers(unit, d, rows, yl))
     status = ipm.STATUS_NAMES[code]
     if status != "Solved":
         # Like Clarabel's AlmostSolved: accepted only with a certified gap and feasible w,

@@ -70,7 +70,7 @@ def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArr
 
 def _auto_backend(problem: DiscreteProblem) -> str:
     """``backend="auto"``: banded from :data:`AUTO_BANDED_FROM` nodes on, once it is compiled."""
-    if problem.n < AUTO_BANDED_FROM or problem.has_lateral:
+    if problem.n < AUTO_BANDED_FROM:
         return "clarabel"
     return "banded" if kernel_for_auto(wait=problem.n >= AUTO_WAIT_FROM) else "clarabel"
 
@@ -116,11 +116,6 @@ def solve_problem(
     backend = choice("backend", backend, BACKENDS)
     if backend == "auto":
         backend = _auto_backend(problem)
-    elif backend == "banded" and problem.has_lateral:
-        raise InvalidInputError(
-            "backend='banded' does not handle lateral-jerk rows yet; use backend='clarabel' or "
-            "'auto'"
-        )
     check_reachable(problem)
     if not problem.has_jerk or problem.n < 3:
         w = max_feasible_w(problem)
