@@ -211,12 +211,12 @@ class Scaling(NamedTuple):
     """Nesterov–Todd scaling ``W`` of the cones at the current ``(s, y)``.
 
     The linear rows' scaling ``W = diag(sqrt(s / y))`` is never formed: only ``W² = s / y``
-    and ``λ² = s y`` enter the Newton system, computed where they are used.
+    and ``λ² = s y`` enter the Newton system. The scaled point ``λ = W y = W⁻¹ s`` is
+    computed where it is used (:func:`_lambda`).
     """
 
     beta: FloatArray  # cones: W = β (2 v v' - J)
     v: FloatArray
-    lam_s: FloatArray  # scaled point λ = W y = W⁻¹ s
 
     @classmethod
     def identity(cls, lay: Layout) -> Scaling:
@@ -233,18 +233,12 @@ class Factor(NamedTuple):
     l1: FloatArray  # L[i, i-1]
     l2: FloatArray  # L[i, i-2]
     dd: FloatArray  # D
+    hl: FloatArray  # linear rows' weights y / s, shape (n_lin,)
     alpha: FloatArray  # per stencil row: coupling of t_i to (jc_r · ŵ) in G'HG
     bwz: FloatArray  # coupling of z_i to w_i
     p: FloatArray  # inverse of the (t, z) block: [[p, q], [q, r]]
     q: FloatArray
     r: FloatArray
-    dg: FloatArray  # diagonal weight of w_i from its own rows (bound, floor, node cone)
-    m00: FloatArray  # node i's stencil rows after eliminating (t_i, z_i): a symmetric
-    m01: FloatArray  # 3 x 3 block over w_{i-1}, w_i, w_{i+1}
-    m02: FloatArray
-    m11: FloatArray
-    m12: FloatArray
-    m22: FloatArray
 
     @classmethod
     def empty(cls, lay: Layout) -> Factor:
@@ -274,8 +268,8 @@ _KINDS: dict[type, dict[str, str]] = {
     Direction: {"dw": "node", "dt": "node", "dz": "node", "dsl": "lin", "dyl": "lin",
                 "dss": "cone", "dys": "cone"},
     Rhs: {"bsl": "lin", "bss": "cone"},
-    Scaling: {"beta": "cones", "v": "cone", "lam_s": "cone"},
-    Factor: {**dict.fromkeys(Factor._fields, "node"), "alpha": "jerk"},
+    Scaling: {"beta": "cones", "v": "cone"},
+    Factor: {**dict.fromkeys(Factor._fields, "node"), "hl": "lin", "alpha": "jerk"},
     Work: dict.fromkeys(Work._fields, "node"),
 }
 
@@ -515,111 +509,124 @@ def scaling_into(ss: FloatArray, ys: FloatArray, sc: Scaling) -> None:
         nv = math.sqrt(2.0 * (wb0 + 1.0))
         sc.beta[c] = bt
         sc.v[0, c], sc.v[1, c], sc.v[2, c] = (wb0 + 1.0) / nv, wb1 / nv, wb2 / nv
-        sc.lam_s[0, c], sc.lam_s[1, c], sc.lam_s[2, c] = _apply_w(
-            sc, ys[0, c], ys[1, c], ys[2, c], c)
+
+
+@njit(cache=True, error_model="numpy")
+def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
+    """The scaled point ``λ = W y`` of cone ``c`` (equal to ``W⁻¹ s``)."""
+    return _apply_w(sc, ys[0, c], ys[1, c], ys[2, c], c)
 
 
 # --- the reduced (pentadiagonal) Newton system --------------------------------------------
 
 
 @njit(cache=True, error_model="numpy")
-def _eliminate_tz_into(
-    d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor
-) -> None:
-    """Per node, the ``(t, z)`` block of ``G' H G``, its inverse and its couplings to ``w``.
+def _eliminate_tz(
+    d: Data, sc: Scaling, fac: Factor, i: int
+) -> tuple[float, float, float, float, float, float, float]:
+    """Eliminate ``(t_i, z_i)`` from node ``i``'s rows of ``G' H G``; returns ``M_i`` and more.
 
-    The linear rows are weighted by ``H = yl / sl`` (computed where used), the cones by their
-    ``H``. Node ``i``'s stencil rows ``±c_r (a_r · ŵ) - t̂_i`` (weights ``H⁺_r``, ``H⁻_r``)
-    add ``σ_r c_r² a_r a_r'`` to the ``w`` block, ``α_r a_r`` with ``α_r = -c_r (H⁺_r - H⁻_r)``
-    to the coupling of ``t_i`` and ``σ_r = H⁺_r + H⁻_r`` to its diagonal. Eliminating
-    ``(t_i, z_i)`` leaves, over ``w_{i-1:i+2}``, the block
+    Writes the inverse ``[[p, q], [q, r]]`` of the ``(t_i, z_i)`` block, the coupling
+    ``b_wz`` of ``z_i`` to ``w_i`` and, per stencil row ``r`` of the node, the coupling
+    ``α_r = -c_r (H⁺_r - H⁻_r)`` of ``t_i`` to ``a_r · ŵ`` (``H = y / s`` in ``fac.hl``).
+    Each stencil row ``±c_r (a_r · ŵ) - t̂_i`` adds ``σ_r c_r² a_r a_r'`` (``σ_r = H⁺_r + H⁻_r``)
+    to the ``w`` block and ``σ_r`` to the diagonal of ``t_i``. Returns the six entries
+    00, 01, 02, 11, 12, 22 of the block over ``w_{i-1:i+2}`` left by the elimination,
     ``M_i = Σ_rs E_rs a_r a_s' + Σ_r φ_r (a_r e' + e a_r')`` (``e`` the middle unit vector,
-    ``E = diag(σ c²) - p α α'``, ``φ_r = -q α_r b_wz``), stored in ``m00 ... m22``.
+    ``E = diag(σ c²) - p α α'``, ``φ_r = -q α_r b_wz``), and the diagonal weight of ``w_i``
+    from its own bound and node cone (docs/banded-ipm.md).
     """
     lay = d.lay
-    m = lay.m
-    for i in range(m):
-        h00, h01, h02, h11, h12, h22 = _h_entries(sc, i)
-        g00, g01, _, g11, _, _ = _h_entries(sc, m + i)
-        mtt = g00 + 2.0 * g01 + g11
-        mzz = 4.0 * h11 + g00 - 2.0 * g01 + g11
-        mtz = g00 - g11
-        bwz = 2.0 * (h01 + h12)
-        fac.bwz[i] = bwz
-        fac.dg[i] = yl[lay.up + i] / sl[lay.up + i] + (h00 + 2.0 * h02 + h22)
-        r0, r1 = d.jstart[i], d.jstart[i + 1]
-        hsum = 0.0
-        for r in range(r0, r1):
-            hp = yl[lay.jp + r] / sl[lay.jp + r]
-            hm = yl[lay.jm + r] / sl[lay.jm + r]
-            fac.alpha[r] = -d.cj[r] * (hp - hm)
-            hsum += hp + hm
-        # κ: the cones' own weight of t once z is eliminated; p = 1 / (κ + Σσ).
-        kappa = mtt - mtz * mtz / mzz
-        mtt += hsum
-        det = mtt * mzz - mtz * mtz
-        p, q, rr = mzz / det, -mtz / det, mtt / det
-        fac.p[i], fac.q[i], fac.r[i] = p, q, rr
-        m00 = m01 = m02 = m11 = m12 = m22 = 0.0
-        for r in range(r0, r1):
-            hp = yl[lay.jp + r] / sl[lay.jp + r]
-            hm = yl[lay.jm + r] / sl[lay.jm + r]
-            sig = hp + hm
-            # E_rr = c² σ - p α², written without cancellation as
-            # c² (σ (κ + Σσ - σ) + 4 H⁺H⁻) / (κ + Σσ).
-            err = d.cj[r] ** 2 * (sig * (kappa + hsum - sig) + 4.0 * hp * hm) / (hsum + kappa)
-            a0, a1, a2 = d.jc[0, r], d.jc[1, r], d.jc[2, r]
-            phi = -q * fac.alpha[r] * bwz
-            m00 += err * a0 * a0
-            m01 += err * a0 * a1 + phi * a0
-            m02 += err * a0 * a2
-            m11 += err * a1 * a1 + 2.0 * phi * a1
-            m12 += err * a1 * a2 + phi * a2
-            m22 += err * a2 * a2
-            for s_ in range(r + 1, r1):  # pairs of rows at one node (several families)
-                ers = -p * fac.alpha[r] * fac.alpha[s_]
-                b0, b1, b2 = d.jc[0, s_], d.jc[1, s_], d.jc[2, s_]
-                m00 += 2.0 * ers * a0 * b0
-                m01 += ers * (a0 * b1 + a1 * b0)
-                m02 += ers * (a0 * b2 + a2 * b0)
-                m11 += 2.0 * ers * a1 * b1
-                m12 += ers * (a1 * b2 + a2 * b1)
-                m22 += 2.0 * ers * a2 * b2
-        fac.m00[i], fac.m01[i], fac.m02[i] = m00, m01, m02
-        fac.m11[i], fac.m12[i], fac.m22[i] = m11, m12, m22
-    for r in range(lay.kl):
-        j = lay.low + r
-        fac.dg[d.lk[r]] += yl[j] / sl[j]
+    m, hl = lay.m, fac.hl
+    h00, h01, h02, h11, h12, h22 = _h_entries(sc, i)
+    g00, g01, _, g11, _, _ = _h_entries(sc, m + i)
+    mtt = g00 + 2.0 * g01 + g11
+    mzz = 4.0 * h11 + g00 - 2.0 * g01 + g11
+    mtz = g00 - g11
+    bwz = 2.0 * (h01 + h12)
+    fac.bwz[i] = bwz
+    dg = hl[lay.up + i] + (h00 + 2.0 * h02 + h22)
+    r0, r1 = d.jstart[i], d.jstart[i + 1]
+    hsum = 0.0
+    for r in range(r0, r1):
+        hp, hm = hl[lay.jp + r], hl[lay.jm + r]
+        fac.alpha[r] = -d.cj[r] * (hp - hm)
+        hsum += hp + hm
+    # κ: the cones' own weight of t once z is eliminated; p = 1 / (κ + Σσ).
+    kappa = mtt - mtz * mtz / mzz
+    mtt += hsum
+    det = mtt * mzz - mtz * mtz
+    p, q = mzz / det, -mtz / det
+    fac.p[i], fac.q[i], fac.r[i] = p, q, mtt / det
+    m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+    for r in range(r0, r1):
+        hp, hm = hl[lay.jp + r], hl[lay.jm + r]
+        sig = hp + hm
+        # E_rr = c² σ - p α², written without cancellation as
+        # c² (σ (κ + Σσ - σ) + 4 H⁺H⁻) / (κ + Σσ).
+        err = d.cj[r] ** 2 * (sig * (kappa + hsum - sig) + 4.0 * hp * hm) / (hsum + kappa)
+        a0, a1, a2 = d.jc[0, r], d.jc[1, r], d.jc[2, r]
+        phi = -q * fac.alpha[r] * bwz
+        m00 += err * a0 * a0
+        m01 += err * a0 * a1 + phi * a0
+        m02 += err * a0 * a2
+        m11 += err * a1 * a1 + 2.0 * phi * a1
+        m12 += err * a1 * a2 + phi * a2
+        m22 += err * a2 * a2
+        for s_ in range(r + 1, r1):  # pairs of rows at one node (several families)
+            ers = -p * fac.alpha[r] * fac.alpha[s_]
+            b0, b1, b2 = d.jc[0, s_], d.jc[1, s_], d.jc[2, s_]
+            m00 += 2.0 * ers * a0 * b0
+            m01 += ers * (a0 * b1 + a1 * b0)
+            m02 += ers * (a0 * b2 + a2 * b0)
+            m11 += 2.0 * ers * a1 * b1
+            m12 += ers * (a1 * b2 + a2 * b1)
+            m22 += 2.0 * ers * a2 * b2
+    return m00, m01, m02, m11, m12, m22, dg
 
 
 @njit(cache=True, error_model="numpy")
 def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor) -> bool:
     """Assemble the Schur complement in ``w`` of ``G' H G`` and factor it.
 
-    The linear rows are weighted by ``yl / sl`` and the cones by ``H`` of ``sc``.
+    The linear rows are weighted by ``H = yl / sl`` and the cones by ``H`` of ``sc``.
     Eliminating ``(t_i, z_i)`` node by node leaves a pentadiagonal matrix (every stencil
     spans three nodes), factored as ``L D L'`` with a unit lower triangular ``L`` of
-    bandwidth 2. Returns False if the matrix is not numerically positive definite.
+    bandwidth 2, in the same pass: row ``i`` needs the blocks ``M_{i-1}, M_i, M_{i+1}``,
+    so node ``i + 1`` is eliminated one step ahead. Returns False if the matrix is not
+    numerically positive definite.
     """
-    _eliminate_tz_into(d, sc, yl, sl, fac)
     lay = d.lay
     m, dec = lay.m, lay.dec
-    l1, l2, dd = fac.l1, fac.l2, fac.dd
+    hl, l1, l2, dd = fac.hl, fac.l1, fac.l2, fac.dd
+    for j in range(hl.size):
+        hl[j] = yl[j] / sl[j]
+    p02 = p12 = p22 = 0.0  # the entries of M_{i-1} that row i needs
+    _, c01, c02, c11, c12, c22, cdg = _eliminate_tz(d, sc, fac, 0)
+    rl = 0
+    while rl < lay.kl and d.lk[rl] == 0:
+        cdg += hl[lay.low + rl]
+        rl += 1
     ok = True
     for i in range(m):
-        gacc_i = yl[i] / sl[i] + yl[dec + i] / sl[dec + i]
-        gacc_n = yl[i + 1] / sl[i + 1] + yl[dec + i + 1] / sl[dec + i + 1]
+        n00 = n01 = n02 = n11 = n12 = n22 = ndg = 0.0
+        if i + 1 < m:
+            n00, n01, n02, n11, n12, n22, ndg = _eliminate_tz(d, sc, fac, i + 1)
+            while rl < lay.kl and d.lk[rl] == i + 1:
+                ndg += hl[lay.low + rl]
+                rl += 1
+        gacc_i = hl[i] + hl[dec + i]
+        gacc_n = hl[i + 1] + hl[dec + i + 1]
         # S[i, i] gathers M_i's middle, M_{i+1}'s first and M_{i-1}'s last entry.
-        di = (fac.m11[i] + fac.dg[i] - fac.r[i] * fac.bwz[i] ** 2
-              + d.cw[i] ** 2 * (gacc_i + gacc_n))
+        di = c11 + cdg - fac.r[i] * fac.bwz[i] ** 2 + d.cw[i] ** 2 * (gacc_i + gacc_n)
         off1 = 0.0
         if i + 1 < m:
-            di += fac.m00[i + 1]
+            di += n00
         if i > 0:
-            di += fac.m22[i - 1]
-            off1 = fac.m01[i] + fac.m12[i - 1] - d.cw[i - 1] * d.cw[i] * gacc_i
+            di += p22
+            off1 = c01 + p12 - d.cw[i - 1] * d.cw[i] * gacc_i
         if i > 1:
-            l2[i] = fac.m02[i - 1] / dd[i - 2]
+            l2[i] = p02 / dd[i - 2]
             di -= l2[i] * l2[i] * dd[i - 2]
         else:
             l2[i] = 0.0
@@ -635,6 +642,8 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
             ok = False
             di = 1.0
         dd[i] = di
+        p02, p12, p22 = c02, c12, c22
+        c01, c02, c11, c12, c22, cdg = n01, n02, n11, n12, n22, ndg
     return ok
 
 
@@ -683,29 +692,30 @@ def solve_normal_inplace(
 
 @njit(cache=True, error_model="numpy")
 def _v_into(
-    sc: Scaling, pt: Point, res: Residual, rhs: Rhs, vl: FloatArray, vs: FloatArray
+    sc: Scaling, fac: Factor, pt: Point, res: Residual, rhs: Rhs, vl: FloatArray,
+    vs: FloatArray,
 ) -> None:
     """``v = H by - W⁻¹ u`` with ``λ ∘ u = bs`` (``H = y / s`` on the linear rows)."""
-    sl, yl = pt.sl, pt.yl
+    sl, hl = pt.sl, fac.hl
     for j in range(vl.size):
-        vl[j] = yl[j] / sl[j] * res.ryl[j] - rhs.bsl[j] / sl[j]
+        vl[j] = hl[j] * res.ryl[j] - rhs.bsl[j] / sl[j]
     bys, bss = res.rys, rhs.bss
     for c in range(bys.shape[1]):
-        u0, u1, u2 = _jordan_solve(sc.lam_s[0, c], sc.lam_s[1, c], sc.lam_s[2, c],
-                                   bss[0, c], bss[1, c], bss[2, c])
+        l0, l1, l2 = _lambda(sc, pt.ys, c)
+        u0, u1, u2 = _jordan_solve(l0, l1, l2, bss[0, c], bss[1, c], bss[2, c])
         w0, w1, w2 = _apply_winv(sc, u0, u1, u2, c)
         h0, h1, h2 = _apply_h(sc, bys[0, c], bys[1, c], bys[2, c], c)
         vs[0, c], vs[1, c], vs[2, c] = h0 - w0, h1 - w1, h2 - w2
 
 
 @njit(cache=True, error_model="numpy")
-def _ds_dy_into(d: Data, sc: Scaling, pt: Point, res: Residual, dn: Direction) -> None:
+def _ds_dy_into(d: Data, sc: Scaling, fac: Factor, res: Residual, dn: Direction) -> None:
     """``Δs = by - G Δx`` and ``Δy = H G Δx - v``, with ``v`` on entry in ``(dyl, dys)``."""
     g_lin_into(d, dn.dw, dn.dt, dn.dsl)  # G Δx, linear rows, kept in dsl until replaced
-    sl, yl = pt.sl, pt.yl
-    for j in range(sl.size):
+    hl = fac.hl
+    for j in range(hl.size):
         g = dn.dsl[j]
-        dn.dyl[j] = yl[j] / sl[j] * g - dn.dyl[j]
+        dn.dyl[j] = hl[j] * g - dn.dyl[j]
         dn.dsl[j] = res.ryl[j] - g
     m = dn.dw.size
     dw, dt, dz, dss, dys, bys = dn.dw, dn.dt, dn.dz, dn.dss, dn.dys, res.rys
@@ -736,14 +746,14 @@ def newton_into(
     (``inf``: no refinement, and the residual is not computed).
     """
     # With v = H by - W⁻¹ u (λ ∘ u = bs): (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
-    _v_into(sc, pt, res, rhs, dn.dyl, dn.dys)
+    _v_into(sc, fac, pt, res, rhs, dn.dyl, dn.dys)
     g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz)
     for i in range(dn.dw.size):
         dn.dw[i] += res.gw[i]
         dn.dt[i] += res.gt[i]
         dn.dz[i] += res.gz[i]
     solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
-    _ds_dy_into(d, sc, pt, res, dn)
+    _ds_dy_into(d, sc, fac, res, dn)
     # The last two equations hold by construction; only G'Δy = bx inherits the rounding of
     # the reduced solve, which grows as H becomes ill-conditioned near the optimum. A round
     # of iterative refinement with the same factor restores it.
@@ -763,8 +773,8 @@ def newton_into(
             dn.dw[i] += rw[i]
             dn.dt[i] += rt[i]
             dn.dz[i] += rz[i]
-        _v_into(sc, pt, res, rhs, dn.dyl, dn.dys)  # the same v, recomputed
-        _ds_dy_into(d, sc, pt, res, dn)
+        _v_into(sc, fac, pt, res, rhs, dn.dyl, dn.dys)  # the same v, recomputed
+        _ds_dy_into(d, sc, fac, res, dn)
 
 
 # --- the iteration, step by step ------------------------------------------------------------
@@ -882,11 +892,11 @@ def predictor_into(
     """Affine-scaling direction (right-hand side ``-λ∘λ``); returns Mehrotra's ``σ``."""
     for j in range(rhs.bsl.size):  # λ∘λ = s y on the linear rows
         rhs.bsl[j] = -pt.sl[j] * pt.yl[j]
-    lam = sc.lam_s
-    for c in range(lam.shape[1]):
-        rhs.bss[0, c] = -(lam[0, c] ** 2 + lam[1, c] ** 2 + lam[2, c] ** 2)
-        rhs.bss[1, c] = -2.0 * lam[0, c] * lam[1, c]
-        rhs.bss[2, c] = -2.0 * lam[0, c] * lam[2, c]
+    for c in range(rhs.bss.shape[1]):
+        l0, l1, l2 = _lambda(sc, pt.ys, c)
+        rhs.bss[0, c] = -(l0 ** 2 + l1 ** 2 + l2 ** 2)
+        rhs.bss[1, c] = -2.0 * l0 * l1
+        rhs.bss[2, c] = -2.0 * l0 * l2
     newton_into(d, sc, fac, nw, pt, res, rhs, refine_above, dn)
     alpha = _max_step(pt, dn)
     return float((1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT)
