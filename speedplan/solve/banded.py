@@ -5,7 +5,8 @@ The relaxation (paper eq. ``relax``, our :func:`~speedplan.solve.clarabel_.build
     minimise   Σ t_i
     subject to (w_{i+1} - w_i) <= A_i h_i,   (w_i - w_{i+1}) <= D_i h_i,   w_i <= w_max_i,
                w_i >= w_min_i                           (where ``w_min`` is given),
-               ±(τ_i / J_i) w''_i - t_i <= 0            (rows with finite ``J_i`` only),
+               ±τ_i (c_fi · w_{i-1:i+2}) / B_fi - t_i <= 0   (every finite row of every
+                                        stencil family f: jerk rows, lateral-jerk rows),
                z_i² <= w_i,   t_i z_i >= τ_i            (two 3-D second-order cones),
                w_0 = w_start,   w_{n-1} = w_end,
 
@@ -16,38 +17,42 @@ CVXOPT's ``coneqp``: ``G x + s = b``, ``s ∈ K``, ``G' y + c = 0``, ``y ∈ K``
 
 Every Newton step reduces to the normal equations ``G' W⁻² G Δx = r``. Their matrix couples
 node ``i`` only with ``i ± 1`` through the acceleration rows and with ``i ± 2`` through the
-second difference of the jerk rows; ``t_i`` and ``z_i`` appear only in rows of node ``i``. So
-we eliminate the 2×2 block of ``(t_i, z_i)`` per node (a closed-form Schur complement) and are
-left with a pentadiagonal symmetric positive-definite system in ``w``, factored once per
-iteration as ``L D L'`` and solved twice (predictor and corrector). The iteration itself
-is compiled (:mod:`speedplan.solve._banded_ipm`, numba): an iteration costs O(n) time and
-memory with no per-operation interpreter overhead.
+three-point stencils; ``t_i`` and ``z_i`` appear only in rows of node ``i``. So we eliminate
+the 2×2 block of ``(t_i, z_i)`` per node (a closed-form Schur complement) and are left with a
+pentadiagonal symmetric positive-definite system in ``w``, factored once per iteration as
+``L D L'`` and solved twice (predictor and corrector); ``docs/banded-ipm.md`` derives it.
+The iteration itself is compiled (:mod:`speedplan.solve._banded_ipm`, numba): an iteration
+costs O(n) time and memory with no per-operation interpreter overhead.
 
-The problem is solved in internal units (``w`` scaled to at most 1, ``s`` to unit mean step),
+The problem is solved in the units of :func:`unit_scales` (``w_max <= 1``, unit mean step),
 with every variable further scaled per node from the O(n) no-jerk profile ``w_ref``
 (``w = w_ref ŵ``, ``z = sqrt(w_ref) ẑ``, ``t = τ / sqrt(w_ref) t̂``) so that every node's cones
 become the same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``. The
 primal start is the midpoint of the slowest and fastest feasible profiles (see
 :func:`_start`), the dual start CVXOPT's default (least-norm, shifted into the cones);
-each Newton solve gets one round of iterative refinement once the gap is small.
+each Newton solve gets one round of iterative refinement once the gap is small and the
+solve's own residual could matter.
 
 Near the optimum the NT scaling becomes ill-conditioned and rounding can stop progress a
 little short of ``tol`` (seen with strongly varying ``J``, at ``tol`` = 1e-9 on some of
-the paper's families, and on very fine grids, where the reduced matrix inherits the
-conditioning of the fourth difference ``D̂'D̂``). Whatever stopped the iteration (a stall,
-a matrix that no longer factors, the iteration limit), the method reports
-``status="AlmostSolved"`` (as Clarabel does) if the certified relative gap below is at most
-1e-6 and ``w`` is feasible, and raises :class:`~speedplan.errors.SolverError` otherwise.
-On very fine grids (steps of a few millimetres) the iteration can also jam far from the
-optimum; after 20 iterations without halving the gap it stops with ``status="NoProgress"`` so
-that :func:`~speedplan.solve_discrete` falls back to Clarabel quickly (docs/performance.md).
+the paper's families, and on fine grids, where the reduced matrix inherits the conditioning
+of the fourth difference ``D̂'D̂``). Whatever stopped the iteration (a stall, a matrix that
+no longer factors, the iteration limit), the method reports ``status="AlmostSolved"`` (as
+Clarabel does) if the certified relative gap below is at most 1e-6 and ``w`` is feasible,
+and raises :class:`~speedplan.errors.SolverError` otherwise. Grids finer than double
+precision resolves (:func:`check_grid_resolvable`) are refused by
+:func:`~speedplan.solve.solve_problem` before any solver runs.
 
 The returned ``dual_objective`` is a rigorous lower bound, independent of how well the
 iterates satisfy the dual equations: the Lagrangian of the relaxation with the solver's
-multipliers of the acceleration and jerk rows (scaled so that the jerk multipliers of each
-node sum to at most 1, which makes the Lagrangian independent of ``t``) is minimised in
+multipliers of the acceleration and stencil rows (scaled so that the stencil multipliers of
+each node sum to at most 1, which makes the Lagrangian independent of ``t``) is minimised in
 closed form over the box ``w_min <= w <= w_max``, node by node. The ``primal_objective`` is
-``Σ max(τ_i / sqrt(w_i), τ_i |w''_i| / J_i)`` at the returned ``w``, i.e. the best ``t`` for it.
+``Σ max(τ_i / sqrt(w_i), max_f τ_i |c_fi · w| / B_fi)`` at the returned ``w``, i.e. the best
+``t`` for it.
+
+The kernel is compiled on first use after installation; until then ``backend="auto"``
+answers with Clarabel while a background process compiles it (:func:`kernel_ready`).
 """
 
 from __future__ import annotations
