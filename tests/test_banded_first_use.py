@@ -38,9 +38,10 @@ class _FakeCompile:
 
 
 @pytest.fixture
-def cold(monkeypatch):
+def cold(monkeypatch, tmp_path):
     """A process whose kernel is neither compiled nor cached; spawns are recorded."""
     state = {"cached": False, "spawned": [], "compiled": 0}
+    monkeypatch.setattr(banded, "_lock_path", lambda: str(tmp_path / "compile.lock"))
     monkeypatch.setattr(banded._Kernel, "ready", False)
     monkeypatch.setattr(banded._Kernel, "background", None)
     monkeypatch.setattr(banded._Kernel, "spawn_failed", False)
@@ -48,6 +49,7 @@ def cold(monkeypatch):
     monkeypatch.setattr(banded, "_load_from_disk_cache", lambda: state["cached"])
 
     def spawn():
+        (tmp_path / "compile.lock").unlink()  # as the real process does when it is done
         proc = _FakeCompile()
         state["spawned"].append(proc)
         return proc
@@ -95,6 +97,20 @@ def test_background_compilation_can_be_switched_off(cold, monkeypatch):
     monkeypatch.setenv(banded.BACKGROUND_COMPILE_ENV, "0")
     assert discrete.solve_problem(_problem(200), backend="auto").backend == "banded"
     assert cold["compiled"] == 1 and not cold["spawned"]
+
+
+def test_only_one_process_compiles(cold, tmp_path, monkeypatch):
+    # Another process (a plan_many worker) holds a fresh lock: answer with Clarabel, start
+    # nothing; a lock older than COMPILE_LOCK_STALE is taken over.
+    lock = tmp_path / "compile.lock"
+    lock.touch()
+    p = _problem(200)
+    assert discrete.solve_problem(p, backend="auto").backend == "clarabel"
+    assert not cold["spawned"] and cold["compiled"] == 0
+    old = lock.stat().st_mtime - banded.COMPILE_LOCK_STALE - 1
+    os.utime(lock, (old, old))
+    assert discrete.solve_problem(p, backend="auto").backend == "clarabel"
+    assert len(cold["spawned"]) == 1
 
 
 def test_small_grids_never_need_the_kernel(cold):

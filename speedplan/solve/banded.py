@@ -57,9 +57,11 @@ answers with Clarabel while a background process compiles it (:func:`kernel_read
 
 from __future__ import annotations
 
+import hashlib
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import replace
 from typing import Any, NamedTuple
@@ -75,14 +77,14 @@ from .nojerk import check_reachable, max_feasible_w, min_feasible_w
 from .problem import DiscreteProblem
 
 __all__ = [
-    "MAX_RAMP_STEPS", "check_grid_resolvable", "compile_kernel", "kernel_for_auto",
-    "kernel_ready", "ramp_steps", "solve_relaxation_banded", "solve_unit_relaxation",
+    "COMPILE_LOCK_STALE", "MAX_RAMP_STEPS", "check_grid_resolvable", "compile_kernel",
+    "kernel_for_auto", "kernel_ready", "ramp_steps", "solve_relaxation_banded", "solve_unit_relaxation",
     "unit_scales",
 ]
 
 
 class _Rows(NamedTuple):
-    """Which family and node each stencil row of :class:`~speedplan.solve._banded_ipm.Data` is."""
+    """Family and node of each stencil row of :class:`~speedplan.solve._banded_ipm.Data`."""
 
     family: IntArray
     node: IntArray
@@ -374,9 +376,44 @@ def kernel_ready(*, start: bool = True) -> bool:
     if _load_from_disk_cache():
         _Kernel.ready = True
         return True
-    if start and _background_allowed():
+    if start and _background_allowed() and _claim_compile_lock():
         _Kernel.background = _spawn_compile()
         _Kernel.spawn_failed = _Kernel.background is None
+    return False
+
+
+#: A compile lock older than this [s] is taken to be left by a process that died.
+COMPILE_LOCK_STALE = 600.0
+
+
+def _lock_path() -> str:
+    """One lock per copy of speedplan, numba version, cache directory and interpreter."""
+    key = "|".join((os.path.abspath(ipm.__file__), numba.__version__,
+                    os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
+    digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+    return os.path.join(tempfile.gettempdir(), f"speedplan-kernel-{digest}.lock")
+
+
+def _claim_compile_lock() -> bool:
+    """Whether this process may start the background compilation (no other one is running).
+
+    Worker processes of :func:`~speedplan.plan_many` all start cold; the lock file makes one
+    of them compile while the others answer with Clarabel until the cache has the kernel.
+    """
+    path = _lock_path()
+    for _ in range(2):
+        try:
+            os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+            return True
+        except FileExistsError:
+            try:
+                if time.time() - os.path.getmtime(path) < COMPILE_LOCK_STALE:
+                    return False
+                os.remove(path)  # stale: its compiling process died
+            except OSError:
+                return False
+        except OSError:
+            return True  # no usable temporary directory: compile without a lock
     return False
 
 
@@ -408,10 +445,12 @@ def _spawn_compile() -> subprocess.Popen[bytes] | None:
     env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
     # Lowest priority: the compilation must not slow down the process that is waiting for
     # answers (it uses Clarabel meanwhile).
-    code = ("import os; hasattr(os, 'nice') and os.nice(19); "
-            "from speedplan.solve.banded import compile_kernel; compile_kernel()")
+    code = ("import os, sys; hasattr(os, 'nice') and os.nice(19)\n"
+            "from speedplan.solve.banded import compile_kernel\n"
+            "try:\n    compile_kernel()\nfinally:\n"
+            "    os.path.exists(sys.argv[1]) and os.remove(sys.argv[1])\n")
     try:
-        return subprocess.Popen([sys.executable, "-c", code], env=env,
+        return subprocess.Popen([sys.executable, "-c", code, _lock_path()], env=env,
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
     except OSError:
