@@ -78,8 +78,8 @@ from .problem import DiscreteProblem
 
 __all__ = [
     "COMPILE_LOCK_STALE", "MAX_RAMP_STEPS", "check_grid_resolvable", "compile_kernel",
-    "kernel_for_auto", "kernel_ready", "ramp_steps", "solve_relaxation_banded", "solve_unit_relaxation",
-    "unit_scales",
+    "kernel_for_auto", "kernel_ready", "ramp_steps", "solve_relaxation_banded",
+    "solve_unit_relaxation", "unit_scales",
 ]
 
 
