@@ -137,3 +137,14 @@ def test_the_cached_kernel_is_found_without_compiling(tmp_path):
     assert ready == "True"
     ready, seconds = _ready_in_fresh_process(str(tmp_path)).split()
     assert ready == "False" and float(seconds) < 5.0
+
+
+def test_problems_without_jerk_rows_start_no_compilation(cold, monkeypatch):
+    # The no-jerk pass needs no solver: "auto" must not start (or wait for) a compilation.
+    monkeypatch.setattr(discrete, "AUTO_WAIT_FROM", 300)
+    for n in (200, 400):
+        p = _problem(n)
+        free = DiscreteProblem(s=p.s, w_max=p.w_max, accel=p.accel, decel=p.decel,
+                               jerk=np.full(n - 2, np.inf))
+        assert discrete.solve_problem(free, backend="auto").backend == "pass"
+    assert not cold["spawned"] and cold["compiled"] == 0

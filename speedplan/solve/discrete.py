@@ -114,8 +114,6 @@ def solve_problem(
     t_start = time.perf_counter()
     refine = choice("refine", refine, REFINE_MODES)
     backend = choice("backend", backend, BACKENDS)
-    if backend == "auto":
-        backend = _auto_backend(problem)
     check_reachable(problem)
     if not problem.has_jerk or problem.n < 3:
         w = max_feasible_w(problem)
@@ -127,6 +125,8 @@ def solve_problem(
         )
 
     check_grid_resolvable(problem)  # before any solver spends a minute on it
+    if backend == "auto":  # only now: the pass above needs no solver (and no compilation)
+        backend = _auto_backend(problem)
     # Solve in units where the mean step and the largest bound are 1: well-scaled cones.
     s_scale, w_scale = unit_scales(problem)
     time_scale = s_scale / np.sqrt(w_scale)
@@ -251,7 +251,9 @@ def solve_discrete(
         warns).
     backend : {"auto", "clarabel", "banded"}
         Relaxation backend: Clarabel (reference), the structure-exploiting banded
-        interior-point method, or ``"auto"`` (banded from :data:`AUTO_BANDED_FROM` nodes on).
+        interior-point method, or ``"auto"`` (banded from :data:`AUTO_BANDED_FROM` nodes on;
+        Clarabel while the banded kernel is being compiled on first use, see
+        :func:`~speedplan.solve.banded.kernel_ready`).
 
     Returns
     -------
