@@ -177,9 +177,9 @@ def test_banded_stop_is_accepted_on_its_certificate_whatever_stopped_it(monkeypa
     assert ref.status == "Solved"
     real = ipm.iterate
 
-    def relabelled(d, w0, t0, z0, tol, max_iter):
-        w, yl, it, _ = real(d, w0, t0, z0, tol, max_iter)
-        return w, yl, it, getattr(ipm, code)
+    def relabelled(*args):
+        it, _ = real(*args)
+        return it, getattr(ipm, code)
 
     monkeypatch.setattr(ipm, "iterate", relabelled)
     res = solve_relaxation_banded(problem)
@@ -193,49 +193,48 @@ def test_banded_stop_is_accepted_on_its_certificate_whatever_stopped_it(monkeypa
 def _newton_state(seed: int):
     """A Newton system of the kernel at a random interior point (sizes of an n=60 problem)."""
     from speedplan.solve import _banded_ipm as ipm
-    from speedplan.solve.banded import _check_feasible, _prepare, _scales
+    from speedplan.solve.banded import _positive_feasible, _prepare, unit_scales
 
     inst = paper_instance("rnd", "cnst", "cnst", n=60, seed=seed)
     p = _problem(inst.w_max, inst.A, inst.J)
-    wmf = _check_feasible(p)
-    s_scale, w_scale = _scales(p, wmf[1:-1])
-    d = _prepare(p.scaled(s_scale, w_scale), wmf[1:-1] / w_scale)
-    m, n_lin = d.cw.size, d.b_lin.size
+    unit = p.scaled(*unit_scales(p))
+    d, _ = _prepare(unit, _positive_feasible(unit)[1:-1])
+    lay = d.lay
     rng = np.random.default_rng(seed)
 
     def cone_interior():
-        u = rng.normal(size=(3, 2 * m))
-        u[0] = np.hypot(u[1], u[2]) * (1.0 + 10.0 ** rng.uniform(-2, 0, 2 * m))
+        u = rng.normal(size=(3, lay.nc))
+        u[0] = np.hypot(u[1], u[2]) * (1.0 + 10.0 ** rng.uniform(-2, 0, lay.nc))
         return u
 
-    sl, yl = 10.0 ** rng.uniform(-2, 2, n_lin), 10.0 ** rng.uniform(-2, 2, n_lin)
-    sc = ipm.Scaling(np.ones(2 * m), np.zeros((3, 2 * m)), np.zeros((3, 2 * m)))
-    ipm.scaling_into(cone_interior(), cone_interior(), sc)
-    fac = ipm.Factor(*(np.zeros(n_lin) if f == "hl" else np.zeros(m) for f in ipm.Factor._fields))
-    assert ipm.factor_into(d, sc, yl, sl, fac)
-    rhs = (*rng.normal(size=(3, m)), rng.normal(size=n_lin), rng.normal(size=(3, 2 * m)),
-           rng.normal(size=n_lin), rng.normal(size=(3, 2 * m)))
-    return ipm, d, sc, fac, sl, rhs
+    pt = ipm.Point.empty(lay)
+    pt.sl[:], pt.yl[:] = 10.0 ** rng.uniform(-2, 2, (2, lay.n_lin))
+    pt.ss[:], pt.ys[:] = cone_interior(), cone_interior()
+    sc = ipm.Scaling.identity(lay)
+    ipm.scaling_into(pt.ss, pt.ys, sc)
+    fac = ipm.Factor.empty(lay)
+    assert ipm.factor_into(d, sc, pt.yl, pt.sl, fac)
+    res, rhs = ipm.Residual.empty(lay), ipm.Rhs.empty(lay)
+    for arr in (*res, *rhs):
+        arr[:] = rng.normal(size=arr.shape)
+    return ipm, d, sc, fac, pt, res, rhs
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_newton_refines_only_above_its_residual_threshold(seed):
     # One round of iterative refinement runs iff the residual of G'Δy = bx exceeds
     # refine_above; below the threshold the unrefined direction is returned as it is.
-    ipm, d, sc, fac, sl, rhs = _newton_state(seed)
-    m, n_lin, nc = d.cw.size, d.b_lin.size, 2 * d.cw.size
+    ipm, d, sc, fac, pt, res, rhs = _newton_state(seed)
+    lay = d.lay
 
     def direction(refine_above):
-        nw = ipm.Work(np.zeros(n_lin), np.zeros(n_lin), np.zeros((3, nc)),
-                      *(np.zeros(m) for _ in range(7)))
-        out = (np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(n_lin), np.zeros((3, nc)),
-               np.zeros(n_lin), np.zeros((3, nc)))
-        ipm.newton_into(d, sc, fac, nw, sl, *rhs, refine_above, *out)
-        gx = (np.zeros(m), np.zeros(m), np.zeros(m))
-        ipm.g_adjoint_into(d, out[5], out[6], *gx, np.zeros(m))
+        dn = ipm.Direction.empty(lay)
+        ipm.newton_into(d, sc, fac, ipm.Work.empty(lay), pt, res, rhs, refine_above, dn)
+        gx = (np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m))
+        ipm.g_adjoint_into(d, dn.dyl, dn.dys, *gx)
         residual = np.sqrt(sum(float(np.sum((b - g) ** 2))
-                               for b, g in zip(rhs[:3], gx, strict=True)))
-        return out, residual
+                               for b, g in zip((res.gw, res.gt, res.gz), gx, strict=True)))
+        return dn, residual
 
     plain, residual = direction(np.inf)
     refined, _ = direction(0.0)

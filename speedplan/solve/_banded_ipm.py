@@ -3,32 +3,36 @@
 Everything here runs under :func:`numba.njit`. One interior-point iteration at ``n = 1000``
 is a few hundred small vector operations, which as separate numpy calls cost more than the
 arithmetic itself; written as loops over nodes they compile to a few passes over memory.
-Every array is allocated once per solve and updated in place: at ``n >= 10^4`` a fresh
-multi-megabyte temporary per operation costs more in page faults than its arithmetic (a
-third of the run time, measured). Compiled code is cached on disk (``cache=True``), so only
-the first use after installation pays the compilation. Arithmetic follows numpy's error
-model (division by zero gives ``inf``/``nan``, which the iteration detects and reports as a
+Every array is allocated once per solve, by the Python driver, with the named constructors
+below (``Point.empty(lay)``, ``Factor.empty(lay)``, ...), whose shapes :func:`check_sizes`
+verifies before the kernel runs: with bounds checks off, a wrongly sized array would be
+silent memory corruption. Compiled code is cached on disk (``cache=True``), so only the
+first use after installation pays the compilation. Arithmetic follows numpy's error model
+(division by zero gives ``inf``/``nan``, which the iteration detects and reports as a
 numerical breakdown) rather than raising inside compiled code.
 
 Notation follows CVXOPT's ``coneqp``: ``G x + s = b``, ``s ∈ K``, ``G' y + c = 0``, ``y ∈ K``
 with ``x = (w, t, z)`` over the ``m`` interior nodes. ``K`` is a product of nonnegative
 orthants (the linear rows) and ``2 m`` three-dimensional second-order cones, stored
 column-wise in arrays of shape ``(3, 2 m)``: first the node cones ``z² <= w``, then the
-cones ``t z >= 1``. Linear rows are ordered: acceleration (``m + 1``), braking (``m + 1``),
-upper bounds (``m``), lower bounds (``kl``, nodes ``lk``), positive jerk rows (``k``, nodes
-``jk``), negative jerk rows (``k``). Functions named ``*_into`` write their result into the
-trailing array arguments.
+cones ``t z >= 1``. The linear rows are ordered in blocks whose offsets :class:`Layout`
+holds: acceleration (``m + 1``), braking (``m + 1``), upper bounds (``m``), lower bounds
+(``kl``, nodes ``lk``), positive jerk rows (``k``, nodes ``jk``), negative jerk rows
+(``k``). Functions named ``*_into`` write their result into the trailing array arguments.
+The reduced Newton system is derived in ``docs/banded-ipm.md``.
 """
 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 from numba import njit
 
 from ..core.checks import FloatArray, IntArray
+
+_T = TypeVar("_T")
 
 #: Fraction of the step to the cone boundary taken per iteration.
 STEP = 0.99
@@ -50,77 +54,237 @@ ALMOST_GAP = 1e-6
 #: then falls back to Clarabel rather than spending ``max_iter`` iterations).
 NO_PROGRESS_ITERATIONS = 20
 
+#: Columns of :func:`iterate`'s log, one row per iteration.
+LOG_COLUMNS = ("pcost", "dcost", "relgap", "pres", "dres", "sigma", "step")
+
 #: Status codes returned by :func:`iterate`.
 SOLVED, MAX_ITERATIONS, STALLED, NUMERICAL_ERROR, NO_PROGRESS = 0, 1, 2, 3, 4
 STATUS_NAMES = ("Solved", "MaxIterations", "Stalled", "NumericalError", "NoProgress")
 
 
-class Data(NamedTuple):
-    """Problem data in internal units (see :func:`speedplan.solve.banded._prepare`)."""
+# --- layout and storage ---------------------------------------------------------------------
 
-    d0: FloatArray  # second-difference weights of w_{i-1}, w_i, w_{i+1}, shape (m,)
-    d1: FloatArray
-    d2: FloatArray
-    jk: IntArray  # interior nodes with finite J
-    cj: FloatArray  # coefficient of the second difference in their jerk rows
+
+class Layout(NamedTuple):
+    """Sizes and row-block offsets of one problem, computed once by :func:`layout`."""
+
+    m: int  # interior nodes
+    k: int  # stencil (jerk-type) rows of each sign, all families
+    kl: int  # lower-bound rows
+    dec: int  # first braking row (the acceleration rows start at 0)
+    up: int  # first upper-bound row
+    low: int  # first lower-bound row
+    jp: int  # first positive jerk row
+    jm: int  # first negative jerk row
+    n_lin: int  # linear rows in all
+    nc: int  # second-order cones (2 m)
+
+
+def layout(m: int, k: int, kl: int) -> Layout:
+    """Offsets of the linear row blocks for ``m`` interior nodes, ``k`` jerk and ``kl`` floors."""
+    nl = m + 1
+    up = 2 * nl
+    low = up + m
+    jp = low + kl
+    jm = jp + k
+    return Layout(m=m, k=k, kl=kl, dec=nl, up=up, low=low, jp=jp, jm=jm, n_lin=jm + k,
+                  nc=2 * m)
+
+
+def _shape(kind: str, lay: Layout) -> tuple[int, ...]:
+    """Shape of an array of ``kind``: per node, linear row, cone (3, nc), cone, jerk row, floor."""
+    return {"node": (lay.m,), "lin": (lay.n_lin,), "cone": (3, lay.nc), "cones": (lay.nc,),
+            "jerk": (lay.k,), "stencil": (3, lay.k), "start": (lay.m + 1,),
+            "low": (lay.kl,)}[kind]
+
+
+def _empty(cls: type[_T], lay: Layout) -> _T:
+    """Zero-filled arrays of the shapes ``lay`` asks for, one per field of ``cls``."""
+    kinds = _KINDS[cls]
+    return cls(*(np.zeros(_shape(kinds[f], lay)) for f in cls._fields))  # type: ignore[attr-defined]
+
+
+def _check(obj: tuple[Any, ...], lay: Layout) -> None:
+    """Raise :class:`ValueError` unless every array of ``obj`` has its shape for ``lay``."""
+    kinds = _KINDS[type(obj)]
+    for name, arr in zip(obj._fields, obj, strict=True):  # type: ignore[attr-defined]
+        if name not in kinds:
+            continue
+        want = _shape(kinds[name], lay)
+        dtype = np.intp if name in ("jk", "lk", "jstart") else np.float64
+        if not (isinstance(arr, np.ndarray) and arr.shape == want and arr.dtype == dtype
+                and arr.flags.c_contiguous):
+            got = getattr(arr, "shape", type(arr).__name__)
+            raise ValueError(f"{type(obj).__name__}.{name}: expected shape {want} of "
+                             f"{np.dtype(dtype)}, got {got} {getattr(arr, 'dtype', '')}")
+
+
+class Data(NamedTuple):
+    """Problem data in internal units (see :func:`speedplan.solve.banded._prepare`).
+
+    The stencil rows of every family (jerk, lateral jerk) are listed together, ordered by
+    node: row ``r`` reads ``±cj_r (jc_r · ŵ_{i-1:i+2}) - t̂_i <= b`` at node ``i = jk_r``, and the
+    rows of node ``i`` are ``jstart[i]:jstart[i + 1]``.
+    """
+
+    jk: IntArray  # node of each stencil row, non-decreasing
+    jstart: IntArray  # first row of each node, shape (m + 1,)
+    jc: FloatArray  # stencil of each row over ŵ_{i-1}, ŵ_i, ŵ_{i+1}, shape (3, k)
+    cj: FloatArray  # coefficient of the stencil in its rows
     lk: IntArray  # interior nodes with a positive lower bound
     ct: FloatArray  # objective coefficients of t
     cw: FloatArray  # coefficients of w in the acceleration rows
     b_lin: FloatArray  # right-hand side of the linear rows
+    lay: Layout
+
+    def check(self) -> None:
+        """Raise :class:`ValueError` unless every array has its shape for ``self.lay``."""
+        _check(self, self.lay)
+        if self.jk.size and not bool(np.all(np.diff(self.jk) >= 0)):
+            raise ValueError("Data.jk must be non-decreasing")
+        if not np.array_equal(self.jstart, np.searchsorted(self.jk, np.arange(self.lay.m + 1))):
+            raise ValueError("Data.jstart must index the rows of each node")
+
+
+class Point(NamedTuple):
+    """Primal–dual iterate: ``x = (w, t, z)``, slacks ``s`` and multipliers ``y``."""
+
+    w: FloatArray
+    t: FloatArray
+    z: FloatArray
+    sl: FloatArray  # linear rows
+    yl: FloatArray
+    ss: FloatArray  # cones (3, nc)
+    ys: FloatArray
+
+    @classmethod
+    def empty(cls, lay: Layout) -> Point:
+        """Zero arrays for ``lay``."""
+        return _empty(cls, lay)
+
+
+class Residual(NamedTuple):
+    """Residuals, negated: the right-hand sides ``-(G'y + c)`` and ``-(Gx + s - b)``."""
+
+    gw: FloatArray
+    gt: FloatArray
+    gz: FloatArray
+    ryl: FloatArray
+    rys: FloatArray
+
+    @classmethod
+    def empty(cls, lay: Layout) -> Residual:
+        """Zero arrays for ``lay``."""
+        return _empty(cls, lay)
+
+
+class Direction(NamedTuple):
+    """A Newton direction ``(Δx, Δs, Δy)``."""
+
+    dw: FloatArray
+    dt: FloatArray
+    dz: FloatArray
+    dsl: FloatArray
+    dyl: FloatArray
+    dss: FloatArray
+    dys: FloatArray
+
+    @classmethod
+    def empty(cls, lay: Layout) -> Direction:
+        """Zero arrays for ``lay``."""
+        return _empty(cls, lay)
+
+
+class Rhs(NamedTuple):
+    """Right-hand side of the complementarity equation ``λ ∘ (WΔy + W⁻¹Δs) = bs``."""
+
+    bsl: FloatArray
+    bss: FloatArray
+
+    @classmethod
+    def empty(cls, lay: Layout) -> Rhs:
+        """Zero arrays for ``lay``."""
+        return _empty(cls, lay)
 
 
 class Scaling(NamedTuple):
     """Nesterov–Todd scaling ``W`` of the cones at the current ``(s, y)``.
 
     The linear rows' scaling ``W = diag(sqrt(s / y))`` is never formed: only ``W² = s / y``
-    and ``λ² = s y`` enter the Newton system.
+    and ``λ² = s y`` enter the Newton system. The scaled point ``λ = W y = W⁻¹ s`` is
+    computed where it is used (:func:`_lambda`).
     """
 
     beta: FloatArray  # cones: W = β (2 v v' - J)
     v: FloatArray
-    lam_s: FloatArray  # scaled point λ = W y = W⁻¹ s
+
+    @classmethod
+    def identity(cls, lay: Layout) -> Scaling:
+        """``W = I`` (``β = 1``, ``v = e``): the scaling of the starting point."""
+        sc = _empty(cls, lay)
+        sc.beta[:] = 1.0
+        sc.v[0] = 1.0
+        return sc
 
 
 class Factor(NamedTuple):
-    """``L D L'`` factor of the reduced matrix, per-node elimination data and scratch."""
+    """``L D L'`` factor of the reduced matrix and the per-node elimination of ``(t, z)``."""
 
     l1: FloatArray  # L[i, i-1]
     l2: FloatArray  # L[i, i-2]
     dd: FloatArray  # D
-    hl: FloatArray  # linear-row weights y / s
-    a: FloatArray  # coupling of t_i to D̂_i w, zero where J = inf
+    hl: FloatArray  # linear rows' weights y / s, shape (n_lin,)
+    alpha: FloatArray  # per stencil row: coupling of t_i to (jc_r · ŵ) in G'HG
     bwz: FloatArray  # coupling of z_i to w_i
     p: FloatArray  # inverse of the (t, z) block: [[p, q], [q, r]]
     q: FloatArray
     r: FloatArray
-    mtt: FloatArray  # scratch of the assembly, shape (m,) each
-    mzz: FloatArray
-    mtz: FloatArray
-    dg: FloatArray
-    e: FloatArray
-    off1: FloatArray
-    off2: FloatArray
+
+    @classmethod
+    def empty(cls, lay: Layout) -> Factor:
+        """Zero arrays for ``lay``."""
+        return _empty(cls, lay)
 
 
 class Work(NamedTuple):
-    """Scratch arrays of one Newton solve."""
+    """Scratch of one Newton solve: the right-hand side of its refinement."""
 
-    vl: FloatArray  # (n_lin,)
-    gl: FloatArray
-    vs: FloatArray  # (3, 2 m)
-    rw: FloatArray  # (m,) each
+    rw: FloatArray
     rt: FloatArray
     rz: FloatArray
-    cw: FloatArray
-    ct: FloatArray
-    cz: FloatArray
-    u: FloatArray
+
+    @classmethod
+    def empty(cls, lay: Layout) -> Work:
+        """Zero arrays for ``lay``."""
+        return _empty(cls, lay)
 
 
-# --- per-cone and per-node scalar kernels (inlined) ----------------------------------------
+_KINDS: dict[type, dict[str, str]] = {
+    Data: {"jk": "jerk", "jstart": "start", "jc": "stencil", "cj": "jerk", "lk": "low",
+           "ct": "node", "cw": "node", "b_lin": "lin"},
+    Point: {"w": "node", "t": "node", "z": "node", "sl": "lin", "yl": "lin", "ss": "cone",
+            "ys": "cone"},
+    Residual: {"gw": "node", "gt": "node", "gz": "node", "ryl": "lin", "rys": "cone"},
+    Direction: {"dw": "node", "dt": "node", "dz": "node", "dsl": "lin", "dyl": "lin",
+                "dss": "cone", "dys": "cone"},
+    Rhs: {"bsl": "lin", "bss": "cone"},
+    Scaling: {"beta": "cones", "v": "cone"},
+    Factor: {**dict.fromkeys(Factor._fields, "node"), "hl": "lin", "alpha": "jerk"},
+    Work: dict.fromkeys(Work._fields, "node"),
+}
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+def check_sizes(d: Data, *parts: tuple[Any, ...]) -> None:
+    """Check ``d`` and every array tuple against ``d.lay`` (once, before the kernel runs)."""
+    d.check()
+    for part in parts:
+        _check(part, d.lay)
+
+
+# --- per-cone and per-node scalar kernels ------------------------------------------------------
+
+
+@njit(cache=True, error_model="numpy")
 def _pad(w: FloatArray, i: int) -> float:
     """``w[i]`` with zero outside ``0 <= i < len(w)`` (the eliminated end values)."""
     if i < 0 or i >= w.size:
@@ -128,9 +292,22 @@ def _pad(w: FloatArray, i: int) -> float:
     return float(w[i])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def _second_diff(d: Data, w: FloatArray, i: int) -> float:
-    return float(d.d0[i] * _pad(w, i - 1) + d.d1[i] * w[i] + d.d2[i] * _pad(w, i + 1))
+@njit(cache=True, error_model="numpy")
+def _stencil_dot(d: Data, w: FloatArray, r: int) -> float:
+    """``jc_r · w_{i-1:i+2}`` for stencil row ``r`` at node ``i`` (zero outside the nodes)."""
+    i = d.jk[r]
+    return float(d.jc[0, r] * _pad(w, i - 1) + d.jc[1, r] * w[i] + d.jc[2, r] * _pad(w, i + 1))
+
+
+@njit(cache=True, error_model="numpy")
+def _scatter_stencil(d: Data, r: int, value: float, out: FloatArray) -> None:
+    """``out += value * jc_r`` at ``w_{i-1:i+2}`` (the adjoint of :func:`_stencil_dot`)."""
+    i = d.jk[r]
+    if i > 0:
+        out[i - 1] += value * d.jc[0, r]
+    out[i] += value * d.jc[1, r]
+    if i + 1 < out.size:
+        out[i + 1] += value * d.jc[2, r]
 
 
 @njit(cache=True, error_model="numpy")
@@ -146,7 +323,7 @@ def _jnorm2(u0: float, u1: float, u2: float) -> float:
     return (u0 - big) * (u0 + big) - small * small
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _h_entries(sc: Scaling, c: int) -> tuple[float, float, float, float, float, float]:
     """Entries 00, 01, 02, 11, 12, 22 of cone ``c``'s ``H = W⁻² = (2 ŵ ŵ' - J) / β²``.
 
@@ -159,7 +336,7 @@ def _h_entries(sc: Scaling, c: int) -> tuple[float, float, float, float, float, 
             (2.0 * u1 * u1 + 1.0) * ib2, 2.0 * u1 * u2 * ib2, (2.0 * u2 * u2 + 1.0) * ib2)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _apply_h(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[float, float, float]:
     """``H u`` for cone ``c``."""
     h00, h01, h02, h11, h12, h22 = _h_entries(sc, c)
@@ -167,7 +344,7 @@ def _apply_h(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[floa
             h02 * u0 + h12 * u1 + h22 * u2)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _apply_w(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[float, float, float]:
     """``W u`` for cone ``c``: ``W = β (2 v v' - J)``."""
     v0, v1, v2, bt = sc.v[0, c], sc.v[1, c], sc.v[2, c], sc.beta[c]
@@ -175,7 +352,7 @@ def _apply_w(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[floa
     return bt * (2.0 * vu * v0 - u0), bt * (2.0 * vu * v1 + u1), bt * (2.0 * vu * v2 + u2)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _apply_winv(
     sc: Scaling, u0: float, u1: float, u2: float, c: int
 ) -> tuple[float, float, float]:
@@ -185,7 +362,7 @@ def _apply_winv(
     return (2.0 * vu * j0 - u0) / bt, (2.0 * vu * j1 + u1) / bt, (2.0 * vu * j2 + u2) / bt
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _jordan_solve(
     l0: float, l1: float, l2: float, b0: float, b1: float, b2: float
 ) -> tuple[float, float, float]:
@@ -194,30 +371,38 @@ def _jordan_solve(
     return u0, (b1 - u0 * l1) / l0, (b2 - u0 * l2) / l0
 
 
+@njit(cache=True, error_model="numpy")
+def _b_soc(r: int, c: int, m: int) -> float:
+    """Constant part of the cone rows: ``(1, 0, -1)`` for node cones, ``(0, 0, 2)`` for t-z."""
+    if r == 1:
+        return 0.0
+    if c < m:
+        return 1.0 if r == 0 else -1.0
+    return 0.0 if r == 0 else 2.0
+
+
 # --- the constraint map G and its adjoint -------------------------------------------------
 
 
 @njit(cache=True, error_model="numpy")
 def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
     """Linear rows of ``G x`` (no constants)."""
-    m, k, kl = w.size, d.jk.size, d.lk.size
-    nl = m + 1
-    for j in range(nl):
+    lay = d.lay
+    m, k = lay.m, lay.k
+    for j in range(lay.dec):
         right = d.cw[j] * w[j] if j < m else 0.0
         left = d.cw[j - 1] * w[j - 1] if j > 0 else 0.0
         out[j] = right - left
-        out[nl + j] = left - right
+        out[lay.dec + j] = left - right
     for i in range(m):
-        out[2 * nl + i] = w[i]
-    base = 2 * nl + m
-    for r in range(kl):
-        out[base + r] = -w[d.lk[r]]
-    base += kl
+        out[lay.up + i] = w[i]
+    for r in range(lay.kl):
+        out[lay.low + r] = -w[d.lk[r]]
     for r in range(k):
         i = d.jk[r]
-        jw = d.cj[r] * _second_diff(d, w, i)
-        out[base + r] = jw - t[i]
-        out[base + k + r] = -jw - t[i]
+        jw = d.cj[r] * _stencil_dot(d, w, r)
+        out[lay.jp + r] = jw - t[i]
+        out[lay.jm + r] = -jw - t[i]
 
 
 @njit(cache=True, error_model="numpy")
@@ -234,44 +419,25 @@ def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> 
 
 
 @njit(cache=True, error_model="numpy")
-def _second_diff_t_into(d: Data, u: FloatArray, out: FloatArray) -> None:
-    """``D̂' u`` for node values ``u``."""
-    m = u.size
-    for i in range(m):
-        acc = d.d1[i] * u[i]
-        if i + 1 < m:
-            acc += d.d0[i + 1] * u[i + 1]
-        if i > 0:
-            acc += d.d2[i - 1] * u[i - 1]
-        out[i] = acc
-
-
-@njit(cache=True, error_model="numpy")
 def g_adjoint_into(
     d: Data, yl: FloatArray, ys: FloatArray, gw: FloatArray, gt: FloatArray, gz: FloatArray,
-    u: FloatArray,
 ) -> None:
-    """``G' y`` split into its ``w``, ``t`` and ``z`` parts (``u`` is scratch)."""
-    m, k, kl = d.cw.size, d.jk.size, d.lk.size
-    nl = m + 1
-    base_j = 2 * nl + m + kl
+    """``G' y`` split into its ``w``, ``t`` and ``z`` parts."""
+    lay = d.lay
+    m, k = lay.m, lay.k
     for i in range(m):
-        u[i] = 0.0
+        acc_i = yl[i] - yl[lay.dec + i]
+        acc_n = yl[i + 1] - yl[lay.dec + i + 1]
+        gw[i] = (d.cw[i] * (acc_i - acc_n) + yl[lay.up + i]
+                 - ys[0, i] - ys[2, i])
         gt[i] = -(ys[0, m + i] + ys[1, m + i])
         gz[i] = -2.0 * ys[1, i] - ys[0, m + i] + ys[1, m + i]
+    for r in range(lay.kl):
+        gw[d.lk[r]] -= yl[lay.low + r]
     for r in range(k):
-        i = d.jk[r]
-        jp, jm = yl[base_j + r], yl[base_j + k + r]
-        u[i] = d.cj[r] * (jp - jm)
-        gt[i] -= jp + jm
-    _second_diff_t_into(d, u, gw)
-    for i in range(m):
-        acc_i = yl[i] - yl[nl + i]
-        acc_n = yl[i + 1] - yl[nl + i + 1]
-        gw[i] += (d.cw[i] * (acc_i - acc_n) + yl[2 * nl + i]
-                  - ys[0, i] - ys[2, i])
-    for r in range(kl):
-        gw[d.lk[r]] -= yl[2 * nl + m + r]
+        jp, jm = yl[lay.jp + r], yl[lay.jm + r]
+        _scatter_stencil(d, r, d.cj[r] * (jp - jm), gw)
+        gt[d.jk[r]] -= jp + jm
 
 
 # --- cones: steps, interiority, scaling --------------------------------------------------------
@@ -316,17 +482,15 @@ def max_step_lin(u: FloatArray, du: FloatArray) -> float:
 
 
 @njit(cache=True, error_model="numpy")
-def _step_into_cones(u: FloatArray, alpha: float, du: FloatArray, out: FloatArray) -> bool:
-    """``out = u + α du``; whether every cone of ``out`` is strictly interior."""
-    inside = True
+def _interior_after_step(u: FloatArray, alpha: float, du: FloatArray) -> bool:
+    """Whether every cone of ``u + α du`` is strictly interior (nothing is written)."""
     for c in range(u.shape[1]):
         o0 = u[0, c] + alpha * du[0, c]
         o1 = u[1, c] + alpha * du[1, c]
         o2 = u[2, c] + alpha * du[2, c]
-        out[0, c], out[1, c], out[2, c] = o0, o1, o2
         if not (o0 > 0.0 and _jnorm2(o0, o1, o2) > 0.0):
-            inside = False
-    return inside
+            return False
+    return True
 
 
 @njit(cache=True, error_model="numpy")
@@ -345,81 +509,129 @@ def scaling_into(ss: FloatArray, ys: FloatArray, sc: Scaling) -> None:
         nv = math.sqrt(2.0 * (wb0 + 1.0))
         sc.beta[c] = bt
         sc.v[0, c], sc.v[1, c], sc.v[2, c] = (wb0 + 1.0) / nv, wb1 / nv, wb2 / nv
-        sc.lam_s[0, c], sc.lam_s[1, c], sc.lam_s[2, c] = _apply_w(
-            sc, ys[0, c], ys[1, c], ys[2, c], c)
+
+
+@njit(cache=True, error_model="numpy")
+def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
+    """The scaled point ``λ = W y`` of cone ``c`` (equal to ``W⁻¹ s``)."""
+    return _apply_w(sc, ys[0, c], ys[1, c], ys[2, c], c)
 
 
 # --- the reduced (pentadiagonal) Newton system --------------------------------------------
 
 
 @njit(cache=True, error_model="numpy")
+def _eliminate_tz(
+    d: Data, sc: Scaling, fac: Factor, i: int
+) -> tuple[float, float, float, float, float, float, float]:
+    """Eliminate ``(t_i, z_i)`` from node ``i``'s rows of ``G' H G``; returns ``M_i`` and more.
+
+    Writes the inverse ``[[p, q], [q, r]]`` of the ``(t_i, z_i)`` block, the coupling
+    ``b_wz`` of ``z_i`` to ``w_i`` and, per stencil row ``r`` of the node, the coupling
+    ``α_r = -c_r (H⁺_r - H⁻_r)`` of ``t_i`` to ``a_r · ŵ`` (``H = y / s`` in ``fac.hl``).
+    Each stencil row ``±c_r (a_r · ŵ) - t̂_i`` adds ``σ_r c_r² a_r a_r'`` (``σ_r = H⁺_r + H⁻_r``)
+    to the ``w`` block and ``σ_r`` to the diagonal of ``t_i``. Returns the six entries
+    00, 01, 02, 11, 12, 22 of the block over ``w_{i-1:i+2}`` left by the elimination,
+    ``M_i = Σ_rs E_rs a_r a_s' + Σ_r φ_r (a_r e' + e a_r')`` (``e`` the middle unit vector,
+    ``E = diag(σ c²) - p α α'``, ``φ_r = -q α_r b_wz``), and the diagonal weight of ``w_i``
+    from its own bound and node cone (docs/banded-ipm.md).
+    """
+    lay = d.lay
+    m, hl = lay.m, fac.hl
+    h00, h01, h02, h11, h12, h22 = _h_entries(sc, i)
+    g00, g01, _, g11, _, _ = _h_entries(sc, m + i)
+    mtt = g00 + 2.0 * g01 + g11
+    mzz = 4.0 * h11 + g00 - 2.0 * g01 + g11
+    mtz = g00 - g11
+    bwz = 2.0 * (h01 + h12)
+    fac.bwz[i] = bwz
+    dg = hl[lay.up + i] + (h00 + 2.0 * h02 + h22)
+    r0, r1 = d.jstart[i], d.jstart[i + 1]
+    hsum = 0.0
+    for r in range(r0, r1):
+        hp, hm = hl[lay.jp + r], hl[lay.jm + r]
+        fac.alpha[r] = -d.cj[r] * (hp - hm)
+        hsum += hp + hm
+    # κ: the cones' own weight of t once z is eliminated; p = 1 / (κ + Σσ).
+    kappa = mtt - mtz * mtz / mzz
+    mtt += hsum
+    det = mtt * mzz - mtz * mtz
+    p, q = mzz / det, -mtz / det
+    fac.p[i], fac.q[i], fac.r[i] = p, q, mtt / det
+    m00 = m01 = m02 = m11 = m12 = m22 = 0.0
+    for r in range(r0, r1):
+        hp, hm = hl[lay.jp + r], hl[lay.jm + r]
+        sig = hp + hm
+        # E_rr = c² σ - p α², written without cancellation as
+        # c² (σ (κ + Σσ - σ) + 4 H⁺H⁻) / (κ + Σσ).
+        err = d.cj[r] ** 2 * (sig * (kappa + hsum - sig) + 4.0 * hp * hm) / (hsum + kappa)
+        a0, a1, a2 = d.jc[0, r], d.jc[1, r], d.jc[2, r]
+        phi = -q * fac.alpha[r] * bwz
+        m00 += err * a0 * a0
+        m01 += err * a0 * a1 + phi * a0
+        m02 += err * a0 * a2
+        m11 += err * a1 * a1 + 2.0 * phi * a1
+        m12 += err * a1 * a2 + phi * a2
+        m22 += err * a2 * a2
+        for s_ in range(r + 1, r1):  # pairs of rows at one node (several families)
+            ers = -p * fac.alpha[r] * fac.alpha[s_]
+            b0, b1, b2 = d.jc[0, s_], d.jc[1, s_], d.jc[2, s_]
+            m00 += 2.0 * ers * a0 * b0
+            m01 += ers * (a0 * b1 + a1 * b0)
+            m02 += ers * (a0 * b2 + a2 * b0)
+            m11 += 2.0 * ers * a1 * b1
+            m12 += ers * (a1 * b2 + a2 * b1)
+            m22 += 2.0 * ers * a2 * b2
+    return m00, m01, m02, m11, m12, m22, dg
+
+
+@njit(cache=True, error_model="numpy")
 def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor) -> bool:
     """Assemble the Schur complement in ``w`` of ``G' H G`` and factor it.
 
-    The linear rows are weighted by ``yl / sl`` and the cones by ``H`` of ``sc``.
-    Eliminating ``(t_i, z_i)`` node by node leaves a pentadiagonal matrix, factored as
-    ``L D L'`` with a unit lower triangular ``L`` of bandwidth 2. Returns False if the
-    matrix is not numerically positive definite.
+    The linear rows are weighted by ``H = yl / sl`` and the cones by ``H`` of ``sc``.
+    Eliminating ``(t_i, z_i)`` node by node leaves a pentadiagonal matrix (every stencil
+    spans three nodes), factored as ``L D L'`` with a unit lower triangular ``L`` of
+    bandwidth 2, in the same pass: row ``i`` needs the blocks ``M_{i-1}, M_i, M_{i+1}``,
+    so node ``i + 1`` is eliminated one step ahead. Returns False if the matrix is not
+    numerically positive definite.
     """
-    m, k, kl = d.cw.size, d.jk.size, d.lk.size
-    nl = m + 1
-    hl = fac.hl
+    lay = d.lay
+    m, dec = lay.m, lay.dec
+    hl, l1, l2, dd = fac.hl, fac.l1, fac.l2, fac.dd
     for j in range(hl.size):
         hl[j] = yl[j] / sl[j]
-    base_j = 2 * nl + m + kl
-    mtt, mzz, mtz, dg, e, a = fac.mtt, fac.mzz, fac.mtz, fac.dg, fac.e, fac.a
-    for i in range(m):
-        h00, h01, h02, h11, h12, h22 = _h_entries(sc, i)
-        g00, g01, _, g11, _, _ = _h_entries(sc, m + i)
-        mtt[i] = g00 + 2.0 * g01 + g11
-        mzz[i] = 4.0 * h11 + g00 - 2.0 * g01 + g11
-        mtz[i] = g00 - g11
-        fac.bwz[i] = 2.0 * (h01 + h12)
-        dg[i] = hl[2 * nl + i] + (h00 + 2.0 * h02 + h22)
-        a[i] = 0.0
-        e[i] = 0.0
-    for r in range(kl):
-        j = 2 * nl + m + r
-        dg[d.lk[r]] += hl[j]
-    for r in range(k):
-        i = d.jk[r]
-        hp = hl[base_j + r]
-        hm = hl[base_j + k + r]
-        # Jerk weight after eliminating t: c²(H⁺ + H⁻) - p a², written without cancellation
-        # as c² (4 H⁺H⁻ + κ (H⁺ + H⁻)) / (H⁺ + H⁻ + κ) with κ the cones' own weight of t.
-        kappa = mtt[i] - mtz[i] * mtz[i] / mzz[i]
-        hsum = hp + hm
-        e[i] = d.cj[r] ** 2 * (4.0 * hp * hm + kappa * hsum) / (hsum + kappa)
-        a[i] = -d.cj[r] * (hp - hm)
-        mtt[i] += hsum
-    for i in range(m):
-        det = mtt[i] * mzz[i] - mtz[i] * mtz[i]
-        fac.p[i], fac.q[i], fac.r[i] = mzz[i] / det, -mtz[i] / det, mtt[i] / det
-    # Pentadiagonal S: diagonal (kept in dg), S[i-1, i] and S[i-2, i]; then L D L'.
-    off1, off2, l1, l2, dd = fac.off1, fac.off2, fac.l1, fac.l2, fac.dd
+    p02 = p12 = p22 = 0.0  # the entries of M_{i-1} that row i needs
+    _, c01, c02, c11, c12, c22, cdg = _eliminate_tz(d, sc, fac, 0)
+    rl = 0
+    while rl < lay.kl and d.lk[rl] == 0:
+        cdg += hl[lay.low + rl]
+        rl += 1
     ok = True
     for i in range(m):
-        gacc_i = hl[i] + hl[nl + i]
-        gacc_n = hl[i + 1] + hl[nl + i + 1]
-        f_i = -fac.q[i] * a[i] * fac.bwz[i]
-        di = (e[i] * d.d1[i] ** 2 + 2.0 * f_i * d.d1[i] + dg[i] - fac.r[i] * fac.bwz[i] ** 2
-              + d.cw[i] ** 2 * (gacc_i + gacc_n))
+        n00 = n01 = n02 = n11 = n12 = n22 = ndg = 0.0
         if i + 1 < m:
-            di += e[i + 1] * d.d0[i + 1] ** 2
+            n00, n01, n02, n11, n12, n22, ndg = _eliminate_tz(d, sc, fac, i + 1)
+            while rl < lay.kl and d.lk[rl] == i + 1:
+                ndg += hl[lay.low + rl]
+                rl += 1
+        gacc_i = hl[i] + hl[dec + i]
+        gacc_n = hl[i + 1] + hl[dec + i + 1]
+        # S[i, i] gathers M_i's middle, M_{i+1}'s first and M_{i-1}'s last entry.
+        di = c11 + cdg - fac.r[i] * fac.bwz[i] ** 2 + d.cw[i] ** 2 * (gacc_i + gacc_n)
+        off1 = 0.0
+        if i + 1 < m:
+            di += n00
         if i > 0:
-            f_p = -fac.q[i - 1] * a[i - 1] * fac.bwz[i - 1]
-            di += e[i - 1] * d.d2[i - 1] ** 2
-            off1[i] = (d.d0[i] * (e[i] * d.d1[i] + f_i)
-                       + d.d2[i - 1] * (e[i - 1] * d.d1[i - 1] + f_p)
-                       - d.cw[i - 1] * d.cw[i] * gacc_i)
+            di += p22
+            off1 = c01 + p12 - d.cw[i - 1] * d.cw[i] * gacc_i
         if i > 1:
-            off2[i] = e[i - 1] * d.d0[i - 1] * d.d2[i - 1]
-            l2[i] = off2[i] / dd[i - 2]
+            l2[i] = p02 / dd[i - 2]
             di -= l2[i] * l2[i] * dd[i - 2]
         else:
             l2[i] = 0.0
         if i > 0:
-            b = off1[i]
+            b = off1
             if i > 1:
                 b -= l2[i] * l1[i - 1] * dd[i - 2]
             l1[i] = b / dd[i - 1]
@@ -430,11 +642,14 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
             ok = False
             di = 1.0
         dd[i] = di
+        p02, p12, p22 = c02, c12, c22
+        c01, c02, c11, c12, c22, cdg = n01, n02, n11, n12, n22, ndg
     return ok
 
 
 @njit(cache=True, error_model="numpy")
-def _solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
+def solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
+    """Overwrite ``x`` with ``(L D L')⁻¹ x``."""
     m = x.size
     for i in range(1, m):
         x[i] -= fac.l1[i] * x[i - 1]
@@ -449,41 +664,61 @@ def _solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
 
 
 @njit(cache=True, error_model="numpy")
-def solve_normal_into(
-    d: Data, fac: Factor, rw: FloatArray, rt: FloatArray, rz: FloatArray,
-    dw: FloatArray, dt: FloatArray, dz: FloatArray, u: FloatArray,
+def solve_normal_inplace(
+    d: Data, fac: Factor, xw: FloatArray, xt: FloatArray, xz: FloatArray
 ) -> None:
-    """Solve ``G' H G Δx = r`` by eliminating ``(t, z)`` node by node (``u`` is scratch)."""
-    m = rw.size
+    """Overwrite ``(xw, xt, xz)`` with the solution of ``G' H G Δx = (xw, xt, xz)``.
+
+    ``(t, z)`` are eliminated node by node, the pentadiagonal system in ``w`` is solved,
+    and ``(t, z)`` are recovered.
+    """
+    m = xw.size
     for i in range(m):
-        dt[i] = fac.p[i] * rt[i] + fac.q[i] * rz[i]
-        dz[i] = fac.q[i] * rt[i] + fac.r[i] * rz[i]
-        u[i] = fac.a[i] * dt[i]
-    _second_diff_t_into(d, u, dw)
+        rt, rz = xt[i], xz[i]
+        xt[i] = fac.p[i] * rt + fac.q[i] * rz
+        xz[i] = fac.q[i] * rt + fac.r[i] * rz
+        xw[i] -= fac.bwz[i] * xz[i]
+    for r in range(d.lay.k):
+        _scatter_stencil(d, r, -fac.alpha[r] * xt[d.jk[r]], xw)
+    solve_banded_inplace(fac, xw)
     for i in range(m):
-        dw[i] = rw[i] - dw[i] - fac.bwz[i] * dz[i]
-    _solve_banded_inplace(fac, dw)
-    for i in range(m):
-        ct = fac.a[i] * _second_diff(d, dw, i)
-        cz = fac.bwz[i] * dw[i]
-        dt[i] -= fac.p[i] * ct + fac.q[i] * cz
-        dz[i] -= fac.q[i] * ct + fac.r[i] * cz
+        ct = 0.0
+        for r in range(d.jstart[i], d.jstart[i + 1]):
+            ct += fac.alpha[r] * _stencil_dot(d, xw, r)
+        cz = fac.bwz[i] * xw[i]
+        xt[i] -= fac.p[i] * ct + fac.q[i] * cz
+        xz[i] -= fac.q[i] * ct + fac.r[i] * cz
 
 
 @njit(cache=True, error_model="numpy")
-def _dy_into(
-    d: Data, sc: Scaling, fac: Factor, nw: Work, dw: FloatArray, dt: FloatArray,
-    dz: FloatArray, byl: FloatArray, bys: FloatArray,
-    dsl: FloatArray, dss: FloatArray, dyl: FloatArray, dys: FloatArray,
+def _v_into(
+    sc: Scaling, fac: Factor, pt: Point, res: Residual, rhs: Rhs, vl: FloatArray,
+    vs: FloatArray,
 ) -> None:
-    """``Δs = by - G Δx`` and ``Δy = H G Δx - v``, linear and cone parts."""
-    gl = nw.gl
-    g_lin_into(d, dw, dt, gl)
-    for j in range(gl.size):
-        dyl[j] = fac.hl[j] * gl[j] - nw.vl[j]
-        dsl[j] = byl[j] - gl[j]
-    m = dw.size
-    vs = nw.vs
+    """``v = H by - W⁻¹ u`` with ``λ ∘ u = bs`` (``H = y / s`` on the linear rows)."""
+    sl, hl = pt.sl, fac.hl
+    for j in range(vl.size):
+        vl[j] = hl[j] * res.ryl[j] - rhs.bsl[j] / sl[j]
+    bys, bss = res.rys, rhs.bss
+    for c in range(bys.shape[1]):
+        l0, l1, l2 = _lambda(sc, pt.ys, c)
+        u0, u1, u2 = _jordan_solve(l0, l1, l2, bss[0, c], bss[1, c], bss[2, c])
+        w0, w1, w2 = _apply_winv(sc, u0, u1, u2, c)
+        h0, h1, h2 = _apply_h(sc, bys[0, c], bys[1, c], bys[2, c], c)
+        vs[0, c], vs[1, c], vs[2, c] = h0 - w0, h1 - w1, h2 - w2
+
+
+@njit(cache=True, error_model="numpy")
+def _ds_dy_into(d: Data, sc: Scaling, fac: Factor, res: Residual, dn: Direction) -> None:
+    """``Δs = by - G Δx`` and ``Δy = H G Δx - v``, with ``v`` on entry in ``(dyl, dys)``."""
+    g_lin_into(d, dn.dw, dn.dt, dn.dsl)  # G Δx, linear rows, kept in dsl until replaced
+    hl = fac.hl
+    for j in range(hl.size):
+        g = dn.dsl[j]
+        dn.dyl[j] = hl[j] * g - dn.dyl[j]
+        dn.dsl[j] = res.ryl[j] - g
+    m = dn.dw.size
+    dw, dt, dz, dss, dys, bys = dn.dw, dn.dt, dn.dz, dn.dss, dn.dys, res.rys
     for c in range(2 * m):
         if c < m:
             g0, g1, g2 = -dw[c], -2.0 * dz[c], -dw[c]
@@ -494,64 +729,55 @@ def _dy_into(
         dss[1, c] = bys[1, c] - g1
         dss[2, c] = bys[2, c] - g2
         h0, h1, h2 = _apply_h(sc, g0, g1, g2, c)
-        dys[0, c] = h0 - vs[0, c]
-        dys[1, c] = h1 - vs[1, c]
-        dys[2, c] = h2 - vs[2, c]
+        dys[0, c] = h0 - dys[0, c]
+        dys[1, c] = h1 - dys[1, c]
+        dys[2, c] = h2 - dys[2, c]
 
 
 @njit(cache=True, error_model="numpy")
 def newton_into(
-    d: Data, sc: Scaling, fac: Factor, nw: Work,
-    sl: FloatArray, bw: FloatArray, bt: FloatArray, bz: FloatArray, byl: FloatArray,
-    bys: FloatArray, bsl: FloatArray, bss: FloatArray, refine_above: float,
-    dw: FloatArray, dt: FloatArray, dz: FloatArray,
-    dsl: FloatArray, dss: FloatArray, dyl: FloatArray, dys: FloatArray,
+    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rhs: Rhs,
+    refine_above: float, dn: Direction,
 ) -> None:
-    """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs``.
+    """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs`` into ``dn``.
 
-    ``sl`` is the linear slack (``λ W = s`` on the linear rows). One round of iterative
+    ``(bx, by)`` are the residuals ``res``, ``bs`` is ``rhs``. One round of iterative
     refinement follows if the 2-norm of the residual ``bx - G'Δy`` exceeds ``refine_above``
     (``inf``: no refinement, and the residual is not computed).
     """
-    # v = H by - W⁻¹ u with λ ∘ u = bs; then (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
-    for j in range(bsl.size):
-        nw.vl[j] = fac.hl[j] * byl[j] - bsl[j] / sl[j]
-    for c in range(bys.shape[1]):
-        u0, u1, u2 = _jordan_solve(sc.lam_s[0, c], sc.lam_s[1, c], sc.lam_s[2, c],
-                                   bss[0, c], bss[1, c], bss[2, c])
-        w0, w1, w2 = _apply_winv(sc, u0, u1, u2, c)
-        h0, h1, h2 = _apply_h(sc, bys[0, c], bys[1, c], bys[2, c], c)
-        nw.vs[0, c], nw.vs[1, c], nw.vs[2, c] = h0 - w0, h1 - w1, h2 - w2
-    rw, rt, rz = nw.rw, nw.rt, nw.rz
-    g_adjoint_into(d, nw.vl, nw.vs, rw, rt, rz, nw.u)
-    for i in range(rw.size):
-        rw[i] += bw[i]
-        rt[i] += bt[i]
-        rz[i] += bz[i]
-    solve_normal_into(d, fac, rw, rt, rz, dw, dt, dz, nw.u)
-    _dy_into(d, sc, fac, nw, dw, dt, dz, byl, bys, dsl, dss, dyl, dys)
+    # With v = H by - W⁻¹ u (λ ∘ u = bs): (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
+    _v_into(sc, fac, pt, res, rhs, dn.dyl, dn.dys)
+    g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz)
+    for i in range(dn.dw.size):
+        dn.dw[i] += res.gw[i]
+        dn.dt[i] += res.gt[i]
+        dn.dz[i] += res.gz[i]
+    solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
+    _ds_dy_into(d, sc, fac, res, dn)
     # The last two equations hold by construction; only G'Δy = bx inherits the rounding of
     # the reduced solve, which grows as H becomes ill-conditioned near the optimum. A round
     # of iterative refinement with the same factor restores it.
     if refine_above < np.inf:
-        g_adjoint_into(d, dyl, dys, rw, rt, rz, nw.u)
+        rw, rt, rz = nw.rw, nw.rt, nw.rz
+        g_adjoint_into(d, dn.dyl, dn.dys, rw, rt, rz)
         res2 = 0.0
         for i in range(rw.size):
-            rw[i] = bw[i] - rw[i]
-            rt[i] = bt[i] - rt[i]
-            rz[i] = bz[i] - rz[i]
+            rw[i] = res.gw[i] - rw[i]
+            rt[i] = res.gt[i] - rt[i]
+            rz[i] = res.gz[i] - rz[i]
             res2 += rw[i] * rw[i] + rt[i] * rt[i] + rz[i] * rz[i]
         if not math.sqrt(res2) > refine_above:
             return
-        solve_normal_into(d, fac, rw, rt, rz, nw.cw, nw.ct, nw.cz, nw.u)
+        solve_normal_inplace(d, fac, rw, rt, rz)
         for i in range(rw.size):
-            dw[i] += nw.cw[i]
-            dt[i] += nw.ct[i]
-            dz[i] += nw.cz[i]
-        _dy_into(d, sc, fac, nw, dw, dt, dz, byl, bys, dsl, dss, dyl, dys)
+            dn.dw[i] += rw[i]
+            dn.dt[i] += rt[i]
+            dn.dz[i] += rz[i]
+        _v_into(sc, fac, pt, res, rhs, dn.dyl, dn.dys)  # the same v, recomputed
+        _ds_dy_into(d, sc, fac, res, dn)
 
 
-# --- driver ----------------------------------------------------------------------------------
+# --- the iteration, step by step ------------------------------------------------------------
 
 
 @njit(cache=True, error_model="numpy")
@@ -583,94 +809,183 @@ def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
     ts = -worst
     nrm = math.sqrt(_dot(ul, ul) + _dot(us, us))
     if ts >= -1e-8 * max(nrm, 1.0):
-        ul += 1.0 + ts
-        us[0] += 1.0 + ts
+        for i in range(ul.size):
+            ul[i] += 1.0 + ts
+        for c in range(us.shape[1]):
+            us[0, c] += 1.0 + ts
+
+
+@njit(cache=True, error_model="numpy")
+def start_into(d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, dn: Direction) -> None:
+    """Slacks and multipliers of the start, given the primal point ``(w, t, z)`` in ``pt``.
+
+    ``s = b - G x`` and CVXOPT's default dual start (least-norm ``y`` of ``G' y = -c``, with
+    ``W = I``), both shifted into the cones. ``sc`` must be the identity scaling.
+    """
+    m = d.lay.m
+    pt.sl[:] = 1.0  # W = I on the linear rows: y / s = 1
+    pt.yl[:] = 1.0
+    factor_into(d, sc, pt.yl, pt.sl, fac)
+    g_lin_into(d, pt.w, pt.t, pt.sl)
+    g_soc_into(pt.w, pt.t, pt.z, pt.ss)
+    for j in range(pt.sl.size):
+        pt.sl[j] = d.b_lin[j] - pt.sl[j]
+    for r in range(3):
+        for c in range(2 * m):
+            pt.ss[r, c] = _b_soc(r, c, m) - pt.ss[r, c]
+    for i in range(m):
+        dn.dw[i] = 0.0
+        dn.dt[i] = -d.ct[i]
+        dn.dz[i] = 0.0
+    solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
+    g_lin_into(d, dn.dw, dn.dt, pt.yl)
+    g_soc_into(dn.dw, dn.dt, dn.dz, pt.ys)
+    _shift_into_cone(pt.sl, pt.ss)
+    _shift_into_cone(pt.yl, pt.ys)
+
+
+@njit(cache=True, error_model="numpy")
+def residuals_into(
+    d: Data, pt: Point, res: Residual
+) -> tuple[float, float, float, float, float]:
+    """Residuals (negated) into ``res``; returns ``(pcost, dcost, gap, |r_y|², |r_x|²)``."""
+    m = d.lay.m
+    g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz)
+    g_lin_into(d, pt.w, pt.t, res.ryl)
+    g_soc_into(pt.w, pt.t, pt.z, res.rys)
+    for i in range(m):
+        res.gw[i] = -res.gw[i]
+        res.gt[i] = -(res.gt[i] + d.ct[i])
+        res.gz[i] = -res.gz[i]
+    for j in range(res.ryl.size):
+        res.ryl[j] = d.b_lin[j] - res.ryl[j] - pt.sl[j]
+    rys, ss, ys = res.rys, pt.ss, pt.ys
+    for c in range(2 * m):
+        for r in range(3):
+            rys[r, c] = -rys[r, c] - ss[r, c]
+    ys_b = 0.0  # ys · b_soc with the constant part of the cone rows spelled out
+    for i in range(m):
+        rys[0, i] += 1.0
+        rys[2, i] -= 1.0
+        rys[2, m + i] += 2.0
+        ys_b += ys[0, i] - ys[2, i] + 2.0 * ys[2, m + i]
+    pcost = _dot(d.ct, pt.t)
+    dcost = -_dot(pt.yl, d.b_lin) - ys_b
+    gap = _dot(pt.sl, pt.yl) + _dot(ss, ys)
+    ry2 = _dot(res.ryl, res.ryl) + _dot(rys, rys)
+    rx2 = _dot(res.gw, res.gw) + _dot(res.gt, res.gt) + _dot(res.gz, res.gz)
+    return pcost, dcost, gap, ry2, rx2
+
+
+@njit(cache=True, error_model="numpy")
+def _max_step(pt: Point, dn: Direction) -> float:
+    """Largest step along ``dn`` keeping ``s`` and ``y`` in their cones."""
+    return min(max_step_lin(pt.sl, dn.dsl), max_step_lin(pt.yl, dn.dyl),
+               max_step_soc(pt.ss, dn.dss), max_step_soc(pt.ys, dn.dys))
+
+
+@njit(cache=True, error_model="numpy")
+def predictor_into(
+    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rhs: Rhs,
+    refine_above: float, dn: Direction,
+) -> float:
+    """Affine-scaling direction (right-hand side ``-λ∘λ``); returns Mehrotra's ``σ``."""
+    for j in range(rhs.bsl.size):  # λ∘λ = s y on the linear rows
+        rhs.bsl[j] = -pt.sl[j] * pt.yl[j]
+    for c in range(rhs.bss.shape[1]):
+        l0, l1, l2 = _lambda(sc, pt.ys, c)
+        rhs.bss[0, c] = -(l0 ** 2 + l1 ** 2 + l2 ** 2)
+        rhs.bss[1, c] = -2.0 * l0 * l1
+        rhs.bss[2, c] = -2.0 * l0 * l2
+    newton_into(d, sc, fac, nw, pt, res, rhs, refine_above, dn)
+    alpha = _max_step(pt, dn)
+    return float((1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT)
+
+
+@njit(cache=True, error_model="numpy")
+def corrector_into(
+    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rhs: Rhs,
+    refine_above: float, sigma_mu: float, dn: Direction,
+) -> None:
+    """Combined direction: the predictor's second-order term and centring ``σ μ``.
+
+    On entry ``dn`` holds the predictor's direction and ``rhs`` its right-hand side.
+    """
+    for j in range(rhs.bsl.size):
+        rhs.bsl[j] = -pt.sl[j] * pt.yl[j] - dn.dsl[j] * dn.dyl[j] + sigma_mu
+    bss, dss, dys = rhs.bss, dn.dss, dn.dys
+    for c in range(bss.shape[1]):
+        a0, a1, a2 = _apply_winv(sc, dss[0, c], dss[1, c], dss[2, c], c)
+        b0, b1, b2 = _apply_w(sc, dys[0, c], dys[1, c], dys[2, c], c)
+        bss[0, c] += -(a0 * b0 + a1 * b1 + a2 * b2) + sigma_mu
+        bss[1, c] += -(a0 * b1 + b0 * a1)
+        bss[2, c] += -(a0 * b2 + b0 * a2)
+    newton_into(d, sc, fac, nw, pt, res, rhs, refine_above, dn)
+
+
+@njit(cache=True, error_model="numpy")
+def step(pt: Point, dn: Direction) -> float:
+    """Move ``pt`` a fraction ``STEP`` of the way to the cone boundary along ``dn``.
+
+    The closed-form step to the boundary can be off by rounding for nearly degenerate cones;
+    the step is halved until every cone is strictly interior. Returns the step taken, or 0
+    (nothing moved) if no such step was found.
+    """
+    alpha = min(1.0, STEP * _max_step(pt, dn))
+    if not (math.isfinite(alpha) and alpha > 0.0):
+        return 0.0
+    inside = False
+    for _ in range(30):
+        if (_interior_after_step(pt.ss, alpha, dn.dss)
+                and _interior_after_step(pt.ys, alpha, dn.dys)):
+            inside = True
+            break
+        alpha *= 0.5
+    if not inside:
+        return 0.0
+    for u, du in ((pt.ss, dn.dss), (pt.ys, dn.dys)):
+        for c in range(u.shape[1]):
+            u[0, c] = u[0, c] + alpha * du[0, c]
+            u[1, c] = u[1, c] + alpha * du[1, c]
+            u[2, c] = u[2, c] + alpha * du[2, c]
+    _axpy(alpha, dn.dw, pt.w)
+    _axpy(alpha, dn.dt, pt.t)
+    _axpy(alpha, dn.dz, pt.z)
+    _axpy(alpha, dn.dsl, pt.sl)
+    _axpy(alpha, dn.dyl, pt.yl)
+    return alpha
 
 
 @njit(cache=True, error_model="numpy")
 def iterate(
-    d: Data, w0: FloatArray, t0: FloatArray, z0: FloatArray, tol: float, max_iter: int
-) -> tuple[FloatArray, FloatArray, int, int]:
-    """Mehrotra predictor–corrector iterations from the primal point ``(w0, t0, z0)``.
+    d: Data, pt: Point, res: Residual, dn: Direction, rhs: Rhs, sc: Scaling, fac: Factor,
+    nw: Work, log: FloatArray, tol: float, max_iter: int,
+) -> tuple[int, int]:
+    """Mehrotra predictor–corrector iterations from the primal point ``(w, t, z)`` in ``pt``.
 
-    The dual start is CVXOPT's default (least-norm ``y`` of ``G' y = -c``, shifted into the
-    cones). Returns ``(w, yl, iterations, status)`` in internal units; ``status`` is one of the
-    module's status codes.
+    ``sc`` must be the identity scaling. The iterate is updated in place (internal units);
+    returns ``(iterations, status)`` with one of the module's status codes. Row ``k`` of
+    ``log`` (shape ``(max_iter + 1, len(LOG_COLUMNS))``) records iteration ``k``.
     """
-    m = d.cw.size
-    nc = 2 * m
-    n_lin = d.b_lin.size
-    b_lin = d.b_lin
-    b_soc = np.zeros((3, nc))  # constant part of the cone rows: (1, 0, -1) and (0, 0, 2)
-    b_soc[0, :m] = 1.0
-    b_soc[2, :m] = -1.0
-    b_soc[2, m:] = 2.0
-    nu = n_lin + nc  # barrier degree: one per linear row and per cone
-
-    def lin() -> FloatArray:
-        return np.zeros(n_lin)
-
-    def node() -> FloatArray:
-        return np.zeros(m)
-
-    def cone() -> FloatArray:
-        return np.zeros((3, nc))
-
-    sc = Scaling(np.ones(nc), cone(), cone())
-    sc.v[0] = 1.0  # W = I for the starting point
-    fac = Factor(node(), node(), node(), lin(), node(), node(), node(), node(), node(), node(),
-                 node(), node(), node(), node(), node(), node())
-    nw = Work(lin(), lin(), cone(), node(), node(), node(), node(), node(), node(), node())
-    w, t, z, gw, gt, gz = node(), node(), node(), node(), node(), node()
-    sl, yl, ryl, bsl, dsl, dyl = lin(), lin(), lin(), lin(), lin(), lin()
-    ss, ys, rys, bss, dss, dys = cone(), cone(), cone(), cone(), cone(), cone()
-    ss_new, ys_new = cone(), cone()
-    dw, dt, dz = node(), node(), node()
-
-    factor_into(d, sc, np.ones(n_lin), np.ones(n_lin), fac)
-    w[:] = w0
-    t[:] = t0
-    z[:] = z0
-    g_lin_into(d, w, t, sl)
-    g_soc_into(w, t, z, ss)
-    sl[:] = b_lin - sl
-    ss[:] = b_soc - ss
-    solve_normal_into(d, fac, node(), -d.ct, node(), dw, dt, dz, nw.u)
-    g_lin_into(d, dw, dt, yl)
-    g_soc_into(dw, dt, dz, ys)
-    _shift_into_cone(sl, ss)
-    _shift_into_cone(yl, ys)
-    res_x0 = max(1.0, math.sqrt(m))
-    res_y0 = max(1.0, math.sqrt(_dot(b_lin, b_lin) + _dot(b_soc, b_soc)))
+    lay = d.lay
+    start_into(d, sc, fac, nw, pt, dn)
+    res_x0 = max(1.0, math.sqrt(lay.m))
+    b_soc2 = 0.0  # |b_soc|², entries in storage order
+    for r in range(3):
+        for c in range(lay.nc):
+            b_soc2 += _b_soc(r, c, lay.m) * _b_soc(r, c, lay.m)
+    res_y0 = max(1.0, math.sqrt(_dot(d.b_lin, d.b_lin) + b_soc2))
+    nu = lay.n_lin + lay.nc  # barrier degree: one per linear row and per cone
     status = MAX_ITERATIONS
     it = 0
     best_gap, stalled = np.inf, 0
     for it in range(max_iter + 1):
-        # Residuals, stored negated: they are the right-hand sides -(G'y + c), -(Gx + s - b).
-        g_adjoint_into(d, yl, ys, gw, gt, gz, nw.u)
-        g_lin_into(d, w, t, ryl)
-        g_soc_into(w, t, z, rys)
-        for i in range(m):
-            gw[i] = -gw[i]
-            gt[i] = -(gt[i] + d.ct[i])
-            gz[i] = -gz[i]
-        for j in range(n_lin):
-            ryl[j] = b_lin[j] - ryl[j] - sl[j]
-        for c in range(nc):
-            for r in range(3):
-                rys[r, c] = -rys[r, c] - ss[r, c]
-        ys_b = 0.0  # ys · b_soc with the constant part of the cone rows spelled out
-        for i in range(m):
-            rys[0, i] += 1.0
-            rys[2, i] -= 1.0
-            rys[2, m + i] += 2.0
-            ys_b += ys[0, i] - ys[2, i] + 2.0 * ys[2, m + i]
-        pcost = _dot(d.ct, t)
-        dcost = -_dot(yl, b_lin) - ys_b
-        gap = _dot(sl, yl) + _dot(ss, ys)
-        pres = math.sqrt(_dot(ryl, ryl) + _dot(rys, rys)) / res_y0
-        dres = math.sqrt(_dot(gw, gw) + _dot(gt, gt) + _dot(gz, gz)) / res_x0
+        pcost, dcost, gap, ry2, rx2 = residuals_into(d, pt, res)
+        pres = math.sqrt(ry2) / res_y0
+        dres = math.sqrt(rx2) / res_x0
         relgap = gap / max(min(abs(pcost), abs(dcost)), 1e-300)
+        log[it, 0], log[it, 1], log[it, 2], log[it, 3] = pcost, dcost, relgap, pres
+        log[it, 4] = dres
         if pres <= tol and dres <= tol and relgap <= tol:
             status = SOLVED
             break
@@ -694,62 +1009,18 @@ def iterate(
         if not (math.isfinite(pres) and math.isfinite(dres) and math.isfinite(gap)):
             status = NUMERICAL_ERROR
             break
-        scaling_into(ss, ys, sc)
-        if not factor_into(d, sc, yl, sl, fac):
+        scaling_into(pt.ss, pt.ys, sc)
+        if not factor_into(d, sc, pt.yl, pt.sl, fac):
             status = NUMERICAL_ERROR
             break
-        mu = gap / nu
         # Refinement only pays once the scaling is ill-conditioned, close to the optimum, and
         # only where the solve's own residual could show in the dual residual's test.
         refine_above = REFINE_RESIDUAL * tol * res_x0 if relgap < REFINE_BELOW else np.inf
-        # Right-hand side -λ∘λ (λ∘λ = s y on the linear rows).
-        for j in range(n_lin):
-            bsl[j] = -sl[j] * yl[j]
-        lam = sc.lam_s
-        for c in range(nc):
-            bss[0, c] = -(lam[0, c] ** 2 + lam[1, c] ** 2 + lam[2, c] ** 2)
-            bss[1, c] = -2.0 * lam[0, c] * lam[1, c]
-            bss[2, c] = -2.0 * lam[0, c] * lam[2, c]
-        # Predictor (affine-scaling) direction.
-        newton_into(d, sc, fac, nw, sl, gw, gt, gz, ryl, rys, bsl, bss, refine_above,
-                    dw, dt, dz, dsl, dss, dyl, dys)
-        alpha = min(max_step_lin(sl, dsl), max_step_lin(yl, dyl),
-                    max_step_soc(ss, dss), max_step_soc(ys, dys))
-        sigma = (1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT
-        # Corrector: second-order term and centring, same factorisation.
-        for j in range(n_lin):
-            bsl[j] = -sl[j] * yl[j] - dsl[j] * dyl[j] + sigma * mu
-        for c in range(nc):
-            a0, a1, a2 = _apply_winv(sc, dss[0, c], dss[1, c], dss[2, c], c)
-            b0, b1, b2 = _apply_w(sc, dys[0, c], dys[1, c], dys[2, c], c)
-            bss[0, c] += -(a0 * b0 + a1 * b1 + a2 * b2) + sigma * mu
-            bss[1, c] += -(a0 * b1 + b0 * a1)
-            bss[2, c] += -(a0 * b2 + b0 * a2)
-        newton_into(d, sc, fac, nw, sl, gw, gt, gz, ryl, rys, bsl, bss, refine_above,
-                    dw, dt, dz, dsl, dss, dyl, dys)
-        alpha_p = min(1.0, STEP * min(
-            max_step_lin(sl, dsl), max_step_lin(yl, dyl),
-            max_step_soc(ss, dss), max_step_soc(ys, dys)))
-        if not (math.isfinite(alpha_p) and alpha_p > 0.0):
+        sigma = predictor_into(d, sc, fac, nw, pt, res, rhs, refine_above, dn)
+        corrector_into(d, sc, fac, nw, pt, res, rhs, refine_above, sigma * (gap / nu), dn)
+        alpha = step(pt, dn)
+        log[it, 5], log[it, 6] = sigma, alpha
+        if alpha == 0.0:
             status = NUMERICAL_ERROR
             break
-        # The closed-form step to the boundary can be off by rounding for nearly degenerate
-        # cones; halve the step until every cone is strictly interior.
-        inside = False
-        for _ in range(30):
-            inside_s = _step_into_cones(ss, alpha_p, dss, ss_new)
-            if inside_s and _step_into_cones(ys, alpha_p, dys, ys_new):
-                inside = True
-                break
-            alpha_p *= 0.5
-        if not inside:
-            status = NUMERICAL_ERROR
-            break
-        _axpy(alpha_p, dw, w)
-        _axpy(alpha_p, dt, t)
-        _axpy(alpha_p, dz, z)
-        _axpy(alpha_p, dsl, sl)
-        _axpy(alpha_p, dyl, yl)
-        ss, ss_new = ss_new, ss
-        ys, ys_new = ys_new, ys
-    return w, yl, it, status
+    return it, status

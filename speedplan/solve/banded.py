@@ -5,7 +5,8 @@ The relaxation (paper eq. ``relax``, our :func:`~speedplan.solve.clarabel_.build
     minimise   Σ t_i
     subject to (w_{i+1} - w_i) <= A_i h_i,   (w_i - w_{i+1}) <= D_i h_i,   w_i <= w_max_i,
                w_i >= w_min_i                           (where ``w_min`` is given),
-               ±(τ_i / J_i) w''_i - t_i <= 0            (rows with finite ``J_i`` only),
+               ±τ_i (c_fi · w_{i-1:i+2}) / B_fi - t_i <= 0   (every finite row of every
+                                        stencil family f: jerk rows, lateral-jerk rows),
                z_i² <= w_i,   t_i z_i >= τ_i            (two 3-D second-order cones),
                w_0 = w_start,   w_{n-1} = w_end,
 
@@ -16,85 +17,118 @@ CVXOPT's ``coneqp``: ``G x + s = b``, ``s ∈ K``, ``G' y + c = 0``, ``y ∈ K``
 
 Every Newton step reduces to the normal equations ``G' W⁻² G Δx = r``. Their matrix couples
 node ``i`` only with ``i ± 1`` through the acceleration rows and with ``i ± 2`` through the
-second difference of the jerk rows; ``t_i`` and ``z_i`` appear only in rows of node ``i``. So
-we eliminate the 2×2 block of ``(t_i, z_i)`` per node (a closed-form Schur complement) and are
-left with a pentadiagonal symmetric positive-definite system in ``w``, factored once per
-iteration as ``L D L'`` and solved twice (predictor and corrector). The iteration itself
-is compiled (:mod:`speedplan.solve._banded_ipm`, numba): an iteration costs O(n) time and
-memory with no per-operation interpreter overhead.
+three-point stencils; ``t_i`` and ``z_i`` appear only in rows of node ``i``. So we eliminate
+the 2×2 block of ``(t_i, z_i)`` per node (a closed-form Schur complement) and are left with a
+pentadiagonal symmetric positive-definite system in ``w``, factored once per iteration as
+``L D L'`` and solved twice (predictor and corrector); ``docs/banded-ipm.md`` derives it.
+The iteration itself is compiled (:mod:`speedplan.solve._banded_ipm`, numba): an iteration
+costs O(n) time and memory with no per-operation interpreter overhead.
 
-The problem is solved in internal units (``w`` scaled to at most 1, ``s`` to unit mean step),
+The problem is solved in the units of :func:`unit_scales` (``w_max <= 1``, unit mean step),
 with every variable further scaled per node from the O(n) no-jerk profile ``w_ref``
 (``w = w_ref ŵ``, ``z = sqrt(w_ref) ẑ``, ``t = τ / sqrt(w_ref) t̂``) so that every node's cones
 become the same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``. The
 primal start is the midpoint of the slowest and fastest feasible profiles (see
 :func:`_start`), the dual start CVXOPT's default (least-norm, shifted into the cones);
-each Newton solve gets one round of iterative refinement once the gap is small.
+each Newton solve gets one round of iterative refinement once the gap is small and the
+solve's own residual could matter.
 
 Near the optimum the NT scaling becomes ill-conditioned and rounding can stop progress a
 little short of ``tol`` (seen with strongly varying ``J``, at ``tol`` = 1e-9 on some of
-the paper's families, and on very fine grids, where the reduced matrix inherits the
-conditioning of the fourth difference ``D̂'D̂``). Whatever stopped the iteration (a stall,
-a matrix that no longer factors, the iteration limit), the method reports
-``status="AlmostSolved"`` (as Clarabel does) if the certified relative gap below is at most
-1e-6 and ``w`` is feasible, and raises :class:`~speedplan.errors.SolverError` otherwise.
-On very fine grids (steps of a few millimetres) the iteration can also jam far from the
-optimum; after 20 iterations without halving the gap it stops with ``status="NoProgress"`` so
-that :func:`~speedplan.solve_discrete` falls back to Clarabel quickly (docs/performance.md).
+the paper's families, and on fine grids, where the reduced matrix inherits the conditioning
+of the fourth difference ``D̂'D̂``). Whatever stopped the iteration (a stall, a matrix that
+no longer factors, the iteration limit), the method reports ``status="AlmostSolved"`` (as
+Clarabel does) if the certified relative gap below is at most 1e-6 and ``w`` is feasible,
+and raises :class:`~speedplan.errors.SolverError` otherwise. Grids finer than double
+precision resolves (:func:`check_grid_resolvable`) are refused by
+:func:`~speedplan.solve.solve_problem` before any solver runs.
 
 The returned ``dual_objective`` is a rigorous lower bound, independent of how well the
 iterates satisfy the dual equations: the Lagrangian of the relaxation with the solver's
-multipliers of the acceleration and jerk rows (scaled so that the jerk multipliers of each
-node sum to at most 1, which makes the Lagrangian independent of ``t``) is minimised in
+multipliers of the acceleration and stencil rows (scaled so that the stencil multipliers of
+each node sum to at most 1, which makes the Lagrangian independent of ``t``) is minimised in
 closed form over the box ``w_min <= w <= w_max``, node by node. The ``primal_objective`` is
-``Σ max(τ_i / sqrt(w_i), τ_i |w''_i| / J_i)`` at the returned ``w``, i.e. the best ``t`` for it.
+``Σ max(τ_i / sqrt(w_i), max_f τ_i |c_fi · w| / B_fi)`` at the returned ``w``, i.e. the best
+``t`` for it.
+
+The kernel is compiled on first use after installation; until then ``backend="auto"``
+answers with Clarabel while a background process compiles it (:func:`kernel_ready`).
 """
 
 from __future__ import annotations
 
+import hashlib
+import os
+import subprocess
+import sys
+import tempfile
 import time
+from dataclasses import replace
+from typing import Any, NamedTuple
 
+import numba
 import numpy as np
 
-from ..core.checks import FloatArray
-from ..core.errors import InfeasibleError, SolverError
+from ..core.checks import FloatArray, IntArray
+from ..core.errors import InfeasibleError, InvalidInputError, SolverError
 from . import _banded_ipm as ipm
 from .clarabel_ import RelaxationResult
 from .nojerk import check_reachable, max_feasible_w, min_feasible_w
 from .problem import DiscreteProblem
 
-__all__ = ["solve_relaxation_banded"]
+__all__ = [
+    "COMPILE_LOCK_STALE", "MAX_RAMP_STEPS", "check_grid_resolvable", "compile_kernel",
+    "kernel_for_auto", "kernel_ready", "ramp_steps", "solve_relaxation_banded",
+    "solve_unit_relaxation", "unit_scales",
+]
 
 
-def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
+class _Rows(NamedTuple):
+    """Family and node of each stencil row of :class:`~speedplan.solve._banded_ipm.Data`."""
+
+    family: IntArray
+    node: IntArray
+
+
+def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> tuple[ipm.Data, _Rows]:
     """Flatten the (already scaled) problem into the arrays the iteration uses.
 
     Variables are scaled per node, ``w = cw ŵ``, ``z = sqrt(cw) ẑ``, ``t = ct t̂`` with
     ``cw = w_ref`` and ``ct = τ / sqrt(cw)``, which turns both cones of every node into the
     same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``; the acceleration rows get the coefficients
-    ``cw`` and the jerk rows are divided by ``ct``. The rows are not normalised further:
+    ``cw``, the stencil rows (every finite row of every family of
+    :meth:`~speedplan.solve.problem.DiscreteProblem.stencil_families`) the stencil times
+    ``cw`` and are divided by ``ct``. The rows are not normalised further:
     normalising the jerk rows to unit norm (as an earlier version did) made the method jam on
     grids finer than about 7 mm, e.g. ``paths/u_turn.json`` at ``n = 5000`` (NoProgress after
     36 iterations; without it, a certified gap below 1e-6 after 34), with no gain elsewhere.
     """
     n = p.n
     m = n - 2
-    h0, h1 = p.h[:-1], p.h[1:]
-    d0 = 2.0 / (h0 * (h0 + h1))
-    d1 = -2.0 / (h0 * h1)
-    d2 = 2.0 / (h1 * (h0 + h1))
     cw = w_ref
     ct = p.tau / np.sqrt(cw)
     cwp = np.concatenate(([0.0], cw, [0.0]))
-    jk = np.flatnonzero(np.isfinite(p.jerk))
-    cj = p.tau[jk] / p.jerk[jk] / ct[jk]
-    w_min = np.zeros(m) if p.w_min is None else p.w_min[1:-1]
-    lk = np.flatnonzero(w_min > 0)
     w_const = np.zeros(n)
     w_const[0], w_const[-1] = p.w_start, p.w_end
+    nodes, fams, stencils, coefs, consts = [], [], [], [], []
+    for f, family in enumerate(p.stencil_families()):
+        rows = np.flatnonzero(np.isfinite(family.bound))
+        c = np.asarray(family.coef)[rows]
+        nodes.append(rows)
+        fams.append(np.full(rows.size, f))
+        stencils.append(c * np.column_stack((cwp[rows], cw[rows], cwp[rows + 2])))
+        cj = p.tau[rows] / family.bound[rows] / ct[rows]
+        coefs.append(cj)
+        # The fixed ends' share of the row, moved to the right-hand side.
+        consts.append((c[:, 0] * w_const[rows] + c[:, 1] * w_const[rows + 1]
+                       + c[:, 2] * w_const[rows + 2]) * cj)
+    order = np.argsort(np.concatenate(nodes), kind="stable")  # by node, families in order
+    jk = np.concatenate(nodes)[order].astype(np.intp)
+    jconst = np.concatenate(consts)[order]
+    w_min = np.zeros(m) if p.w_min is None else p.w_min[1:-1]
+    lk = np.flatnonzero(w_min > 0)
     # G x + s = b with the fixed ends moved to b: b = bound - (row applied to the fixed ends).
     dconst = np.diff(w_const)
-    jconst = (d0 * w_const[:-2] + d1 * w_const[1:-1] + d2 * w_const[2:])[jk] * cj
     b_lin = np.concatenate(
         (
             p.accel * p.h - dconst,
@@ -105,8 +139,13 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
             jconst,
         )
     )
-    return ipm.Data(d0=d0 * cwp[:-2], d1=d1 * cw, d2=d2 * cwp[2:], jk=jk.astype(np.intp), cj=cj,
-                    lk=lk.astype(np.intp), ct=ct, cw=cw, b_lin=b_lin)
+    data = ipm.Data(
+        jk=jk, jstart=np.searchsorted(jk, np.arange(m + 1)).astype(np.intp),
+        jc=np.ascontiguousarray(np.concatenate(stencils)[order].T),
+        cj=np.concatenate(coefs)[order], lk=lk.astype(np.intp), ct=ct, cw=cw, b_lin=b_lin,
+        lay=ipm.layout(m, jk.size, lk.size),
+    )
+    return data, _Rows(family=np.concatenate(fams)[order], node=jk)
 
 
 # --- certificates -------------------------------------------------------------------------
@@ -115,40 +154,48 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
 def _primal_t(p: DiscreteProblem, w: FloatArray) -> FloatArray:
     """Smallest feasible ``t`` for the full ``w`` (interior ``w > 0``)."""
     t: FloatArray = p.tau / np.sqrt(w[1:-1])
-    finite = np.isfinite(p.jerk)
-    wpp = p.second_difference @ w
-    t[finite] = np.maximum(t[finite], p.tau[finite] * np.abs(wpp[finite]) / p.jerk[finite])
+    for family in p.stencil_families():
+        finite = np.isfinite(family.bound)
+        load = p.stencil_matrix(family.coef) @ w
+        t[finite] = np.maximum(t[finite],
+                               p.tau[finite] * np.abs(load[finite]) / family.bound[finite])
     return t
 
 
 def _lagrangian_bound(
-    p: DiscreteProblem, mu_acc: FloatArray, mu_dec: FloatArray, nu_p: FloatArray,
-    nu_m: FloatArray,
+    p: DiscreteProblem, mu_acc: FloatArray, mu_dec: FloatArray,
+    nu: list[tuple[FloatArray, FloatArray]],
 ) -> float:
-    """Lower bound from multipliers of the acceleration and jerk rows (weak duality).
+    """Lower bound from multipliers of the acceleration and stencil rows (weak duality).
 
-    With ``μ >= 0`` on the rows ``±(w_{k+1} - w_k) <= A_k h_k`` and ``ν± >= 0`` (per node,
-    zero where ``J = inf``) on ``±τ w'' / J - t <= 0``, the multiplier ``λ = 1 - ν⁺ - ν⁻ >= 0``
-    of ``t >= τ / sqrt(w)`` makes the Lagrangian free of ``t``; its minimum over the box
-    ``w_min <= w <= w_max`` is separable and closed-form (the minimiser of the convex
-    ``g w + c / sqrt(w)`` clipped to the box). Any such multipliers give a valid bound;
-    non-finite ones (an iterate that broke down) give none, ``-inf``.
+    With ``μ >= 0`` on the rows ``±(w_{k+1} - w_k) <= A_k h_k`` and ``ν±_f >= 0`` (per node,
+    zero where the bound is ``inf``) on the rows ``±τ (c_f · w) / B_f - t <= 0`` of every
+    family ``f``, scaled so that ``Σ_f (ν⁺_f + ν⁻_f) <= 1`` at every node, the multiplier
+    ``λ = 1 - Σ_f (ν⁺_f + ν⁻_f) >= 0`` of ``t >= τ / sqrt(w)`` makes the Lagrangian free of
+    ``t``; its minimum over the box ``w_min <= w <= w_max`` is separable and closed-form (the
+    minimiser of the convex ``g w + c / sqrt(w)`` clipped to the box). Any such multipliers
+    give a valid bound; non-finite ones (an iterate that broke down) give none, ``-inf``.
     """
-    if not all(np.all(np.isfinite(x)) for x in (mu_acc, mu_dec, nu_p, nu_m)):
+    arrays = [mu_acc, mu_dec, *(x for pair in nu for x in pair)]
+    if not all(np.all(np.isfinite(x)) for x in arrays):
         return -np.inf
     mu_acc, mu_dec = np.maximum(mu_acc, 0.0), np.maximum(mu_dec, 0.0)
-    nu_p, nu_m = np.maximum(nu_p, 0.0), np.maximum(nu_m, 0.0)
-    excess = np.maximum(nu_p + nu_m, 1.0)  # λ >= 0 needs ν⁺ + ν⁻ <= 1
-    nu_p, nu_m = nu_p / excess, nu_m / excess
-    lam = np.maximum(1.0 - nu_p - nu_m, 0.0)  # >= 0 up to rounding; c / g below stays >= 0
-    finite = np.isfinite(p.jerk)
-    coef = np.where(finite, (nu_p - nu_m) * p.tau / np.where(finite, p.jerk, 1.0), 0.0)
+    nu = [(np.maximum(a, 0.0), np.maximum(b, 0.0)) for a, b in nu]
+    excess = np.maximum(sum((a + b for a, b in nu), np.zeros(p.n - 2)), 1.0)  # λ >= 0
+    nu = [(a / excess, b / excess) for a, b in nu]
+    lam = np.ones(p.n - 2)
+    for a, b in nu:
+        lam = lam - a - b
+    lam = np.maximum(lam, 0.0)  # >= 0 up to rounding; c / g below stays >= 0
     # Linear coefficient of the full w in the Lagrangian.
     net = mu_acc - mu_dec
     g = np.zeros(p.n)
     g[1:] += net
     g[:-1] -= net
-    g += p.second_difference.T @ coef
+    for family, (a, b) in zip(p.stencil_families(), nu, strict=True):
+        finite = np.isfinite(family.bound)
+        coef = np.where(finite, (a - b) * p.tau / np.where(finite, family.bound, 1.0), 0.0)
+        g += p.stencil_matrix(family.coef).T @ coef
     const = (g[0] * p.w_start + g[-1] * p.w_end
              - float(mu_acc @ (p.accel * p.h)) - float(mu_dec @ (p.decel * p.h)))
     gi, c, wmax = g[1:-1], lam * p.tau, p.w_max[1:-1]
@@ -171,52 +218,324 @@ def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, Flo
     ``w`` is the mean of the fastest feasible profile ``w_ref`` and the slowest one
     (:func:`~speedplan.solve.nojerk.min_feasible_w`); both meet every acceleration row, so
     their mean does too, strictly inside the speed bounds wherever they differ. ``z`` and
-    ``t`` are then strictly inside their cones and above the jerk rows. Measured on ``plan()``
-    grids (with the jerk-row normalisation of the time) this more than halved the iterations of
-    CVXOPT's least-squares start (55 -> 20 on ``paths/u_turn.json``), whose point ignores the
-    chain of acceleration rows and spends iterations propagating it along the path.
+    ``t`` are then strictly inside their cones and above the stencil rows. Measured on
+    ``plan()`` grids (with the jerk-row normalisation of the time) this more than halved the
+    iterations of CVXOPT's least-squares start (55 -> 20 on ``paths/u_turn.json``), whose point
+    ignores the chain of acceleration rows and spends iterations propagating it along the path.
     """
     w_hat = 0.5 * (min_feasible_w(p)[1:-1] / d.cw + 1.0)
     z_hat = 0.5 * np.sqrt(w_hat)
-    # Jerk rows at t = 0: G x - b gives cj D̂ŵ plus the fixed ends' share.
-    rows = np.empty(d.b_lin.size)
-    ipm.g_lin_into(d, w_hat, np.zeros(w_hat.size), rows)
-    k = d.jk.size
-    jerk = np.zeros(w_hat.size)
-    positive = slice(d.b_lin.size - 2 * k, d.b_lin.size - k)
-    jerk[d.jk] = np.abs(rows[positive] - d.b_lin[positive])
-    t_hat = 2.0 * np.maximum(1.0 / z_hat, jerk) + 1.0
+    # Stencil rows at t = 0: G x - b gives cj (jc · ŵ) plus the fixed ends' share (the
+    # kernel's arithmetic, in numpy: the kernel itself is entered only once per solve).
+    padded = np.concatenate(([0.0], w_hat, [0.0]))
+    i = d.jk
+    rows = d.cj * (d.jc[0] * padded[i] + d.jc[1] * padded[i + 1] + d.jc[2] * padded[i + 2])
+    load = np.zeros(w_hat.size)
+    np.maximum.at(load, i, np.abs(rows - d.b_lin[d.lay.jp : d.lay.jm]))
+    t_hat = 2.0 * np.maximum(1.0 / z_hat, load) + 1.0
     return w_hat, t_hat, z_hat
 
 
-def _row_multipliers(d: ipm.Data, yl: FloatArray) -> tuple[FloatArray, ...]:
-    """Multipliers of the scaled problem's own rows (``t`` rescaled by ``ct``)."""
-    m, k = d.cw.size, d.jk.size
-    nl = m + 1
-    base = yl.size - 2 * k
-    nu_p, nu_m = np.zeros(m), np.zeros(m)
-    nu_p[d.jk] = yl[base : base + k] / d.ct[d.jk]
-    nu_m[d.jk] = yl[base + k :] / d.ct[d.jk]
-    return yl[:nl], yl[nl : 2 * nl], nu_p, nu_m
+def _row_multipliers(
+    p: DiscreteProblem, d: ipm.Data, rows: _Rows, yl: FloatArray
+) -> tuple[FloatArray, FloatArray, list[tuple[FloatArray, FloatArray]]]:
+    """Multipliers of the problem's own rows (stencil rows: ``t`` rescaled by ``ct``).
+
+    Returns ``(μ_acc, μ_dec, [(ν⁺_f, ν⁻_f) per family, per node]``).
+    """
+    lay = d.lay
+    nu = []
+    for f in range(len(p.stencil_families())):
+        mine = rows.family == f
+        node = rows.node[mine]
+        nu_p, nu_m = np.zeros(lay.m), np.zeros(lay.m)
+        nu_p[node] = yl[lay.jp : lay.jm][mine] / d.ct[node]
+        nu_m[node] = yl[lay.jm : lay.n_lin][mine] / d.ct[node]
+        nu.append((nu_p, nu_m))
+    return yl[: lay.dec], yl[lay.dec : lay.up], nu
 
 
 # --- driver --------------------------------------------------------------------------------
 
 
-def _scales(problem: DiscreteProblem, w_feasible: FloatArray) -> tuple[float, float]:
-    """Return ``(s_scale, w_scale)`` of the internal units: ``w`` up to 1 and unit mean step."""
-    w_scale = float(np.max(w_feasible))
-    s_scale = float(np.mean(problem.h))
-    return s_scale, w_scale
+def _kernel_args(
+    d: ipm.Data, w0: FloatArray, t0: FloatArray, z0: FloatArray
+) -> tuple[ipm.Data, ipm.Point, ipm.Residual, ipm.Direction, ipm.Rhs, ipm.Scaling, ipm.Factor,
+           ipm.Work]:
+    """The kernel's arrays for ``d`` with the start ``(w0, t0, z0)``, sizes checked."""
+    lay = d.lay
+    pt = ipm.Point.empty(lay)
+    pt.w[:], pt.t[:], pt.z[:] = w0, t0, z0
+    args = (d, pt, ipm.Residual.empty(lay), ipm.Direction.empty(lay), ipm.Rhs.empty(lay),
+            ipm.Scaling.identity(lay), ipm.Factor.empty(lay), ipm.Work.empty(lay))
+    ipm.check_sizes(*args)
+    return args
 
 
-def _check_feasible(problem: DiscreteProblem) -> FloatArray:
-    """Raise :class:`InfeasibleError` unless some ``w`` with ``w_i > 0`` inside meets the rows.
+def _run_kernel(
+    d: ipm.Data, w0: FloatArray, t0: FloatArray, z0: FloatArray, tol: float, max_iter: int
+) -> tuple[FloatArray, FloatArray, int, int]:
+    """Iterate from ``(w0, t0, z0)``; ``(w, yl, iterations, status code)``, internal units."""
+    args = _kernel_args(d, w0, t0, z0)
+    log = np.full((max_iter + 1, len(ipm.LOG_COLUMNS)), np.nan)
+    iterations, code = ipm.iterate(*args, log, tol, max_iter)
+    _Kernel.last_log = log[: iterations + 1]
+    pt = args[1]
+    return pt.w, pt.yl, iterations, code
+
+
+# --- first use: load, compile, or compile in the background ---------------------------------
+
+#: Environment variable: set to ``0`` to make ``backend="auto"`` wait for the kernel's first
+#: compilation instead of answering with Clarabel while a background process compiles it.
+BACKGROUND_COMPILE_ENV = "SPEEDPLAN_BACKGROUND_COMPILE"
+
+
+class _Kernel:
+    """Whether this process can call the compiled kernel without compiling it."""
+
+    ready = False
+    #: The iteration log of the last solve in this process (rows: iterations; columns:
+    #: :data:`~speedplan.solve._banded_ipm.LOG_COLUMNS`), for diagnostics and benchmarks.
+    last_log: FloatArray = np.zeros((0, len(ipm.LOG_COLUMNS)))
+    background: subprocess.Popen[bytes] | None = None
+    spawn_failed = False
+
+
+def _example_problem() -> DiscreteProblem:
+    n = 6
+    return DiscreteProblem(s=np.arange(n, dtype=float), w_max=np.full(n, 1.0),
+                           accel=np.full(n - 1, 0.5), decel=np.full(n - 1, 0.5),
+                           jerk=np.full(n - 2, 0.1), w_min=np.full(n, 0.0))
+
+
+def _load_from_disk_cache() -> bool:
+    """Load the compiled kernel from numba's on-disk cache if it is there; never compiles.
+
+    Mirrors what :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's
+    dispatcher offers no public "load but do not compile"); any failure means "not loaded".
+    """
+    disp: Any = ipm.iterate
+    p = _example_problem()
+    d, _ = _prepare(p, _positive_feasible(p)[1:-1])
+    args = (*_kernel_args(d, *_start(p, d)), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
+    try:
+        sig = tuple(numba.typeof(a) for a in args)  # type: ignore[no-untyped-call]
+        if sig in disp.overloads:
+            return True
+        from numba.core.compiler_lock import global_compiler_lock
+
+        with global_compiler_lock:
+            cres = disp._cache.load_overload(sig, disp.targetctx)
+            if cres is None:
+                return False
+            disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+            disp.add_overload(cres)
+        return True
+    except Exception:  # pragma: no cover - numba internals changed: behave as "not cached"
+        return False
+
+
+def compile_kernel() -> None:
+    """Make the compiled kernel available in this process now: load it, or compile it.
+
+    ``backend="auto"`` answers with Clarabel while the kernel is not available (see
+    :func:`kernel_ready`); call this first for runs whose backend must not depend on timing.
+
+    Examples
+    --------
+    >>> compile_kernel()
+    >>> kernel_ready()
+    True
+    """
+    if _Kernel.ready:
+        return
+    if _Kernel.background is not None:
+        _Kernel.background.wait()
+        _Kernel.background = None
+    solve_relaxation_banded(_example_problem())
+    _Kernel.ready = True
+
+
+def kernel_ready(*, start: bool = True) -> bool:
+    """Whether the banded kernel runs now without compiling; else compile it in the background.
+
+    The kernel is loaded from numba's on-disk cache when it is there (0.3-0.5 s). When it is
+    not (first use after installation, about 20-30 s to compile), and ``start`` is true, a
+    background Python process compiles it into the cache, unless the environment variable
+    ``SPEEDPLAN_BACKGROUND_COMPILE`` is ``0``; later calls load it once that process is done.
+    """
+    if _Kernel.ready:
+        return True
+    if _Kernel.background is not None:
+        code = _Kernel.background.poll()
+        if code is None:
+            return False
+        _Kernel.background = None
+        _Kernel.spawn_failed = code != 0  # never start a failing compilation twice
+    if _load_from_disk_cache():
+        _Kernel.ready = True
+        return True
+    if start and _background_allowed() and _claim_compile_lock():
+        _Kernel.background = _spawn_compile()
+        _Kernel.spawn_failed = _Kernel.background is None
+    return False
+
+
+#: A compile lock older than this [s] is taken to be left by a process that died.
+COMPILE_LOCK_STALE = 600.0
+
+
+def _lock_path() -> str:
+    """One lock per copy of speedplan, numba version, cache directory and interpreter."""
+    key = "|".join((os.path.abspath(ipm.__file__), numba.__version__,
+                    os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
+    digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+    return os.path.join(tempfile.gettempdir(), f"speedplan-kernel-{digest}.lock")
+
+
+def _claim_compile_lock() -> bool:
+    """Whether this process may start the background compilation (no other one is running).
+
+    Worker processes of :func:`~speedplan.plan_many` all start cold; the lock file makes one
+    of them compile while the others answer with Clarabel until the cache has the kernel.
+    """
+    path = _lock_path()
+    for _ in range(2):
+        try:
+            os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+            return True
+        except FileExistsError:
+            try:
+                if time.time() - os.path.getmtime(path) < COMPILE_LOCK_STALE:
+                    return False
+                os.remove(path)  # stale: its compiling process died
+            except OSError:
+                return False
+        except OSError:
+            return True  # no usable temporary directory: compile without a lock
+    return False
+
+
+def _background_allowed() -> bool:
+    return not _Kernel.spawn_failed and os.environ.get(BACKGROUND_COMPILE_ENV) != "0"
+
+
+def kernel_for_auto(*, wait: bool) -> bool:
+    """Whether ``backend="auto"`` should use the banded kernel now.
+
+    True when it is available (:func:`kernel_ready`, which starts a background compilation
+    if needed), or after compiling it here when ``wait`` is true or background compilation
+    is off (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could be started).
+    """
+    if kernel_ready(start=not wait):
+        return True
+    if wait or not _background_allowed():
+        compile_kernel()
+        return True
+    return False
+
+
+def _spawn_compile() -> subprocess.Popen[bytes] | None:
+    """Start ``python -c "...compile_kernel()"`` on this very copy of speedplan."""
+    if not sys.executable:
+        return None
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
+    # Lowest priority: the compilation must not slow down the process that is waiting for
+    # answers (it uses Clarabel meanwhile).
+    code = ("import os, sys; hasattr(os, 'nice') and os.nice(19)\n"
+            "from speedplan.solve.banded import compile_kernel\n"
+            "try:\n    compile_kernel()\nfinally:\n"
+            "    os.path.exists(sys.argv[1]) and os.remove(sys.argv[1])\n")
+    try:
+        return subprocess.Popen([sys.executable, "-c", code, _lock_path()], env=env,
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+    except OSError:
+        return None
+
+
+#: Longest jerk-limited change of acceleration, in grid steps, that the relaxation resolves.
+#: The reduced Newton matrix carries the fourth difference ``D̂'D̂`` over such a stretch of
+#: active jerk rows, whose condition number grows like its length to the fourth power; in
+#: double precision both backends lose the dual equations beyond a few thousand steps
+#: (measured on straights with steps of 0.17-2 mm, ``benchmarks/bench_fine_grids.py``: every
+#: case up to 4 000 steps solved; from 5 000 on some stalled, a 10 m straight already at
+#: 5 000, a 30 m one at 8 000; docs/banded-ipm.md). The grid is refused above this count.
+MAX_RAMP_STEPS = 4000
+
+
+def ramp_steps(problem: DiscreteProblem) -> float:
+    """Most grid steps a jerk-limited change of ``w'`` by its bound can take, over all nodes.
+
+    Node ``i``'s jerk row lets ``w'`` change by at most ``r_i = J_i τ_i / sqrt(w_i)`` per
+    step (``|w''| sqrt(w) <= J``), fewest at the fastest feasible ``w``. From node ``i`` on,
+    count the steps until the ``r`` add up to ``max(A, D)`` there; a node without a jerk row
+    ends the count. Invariant under :meth:`DiscreteProblem.scaled`.
+    """
+    finite = np.isfinite(problem.jerk)
+    if problem.n < 3 or not finite.any():
+        return 0.0
+    w = np.maximum(max_feasible_w(problem)[1:-1], 1e-300)
+    a = np.maximum.reduce([problem.accel[:-1], problem.accel[1:], problem.decel[:-1],
+                           problem.decel[1:]])
+    rate = np.where(finite, problem.jerk * problem.tau / np.sqrt(w), np.inf)
+    reached = np.concatenate(([0.0], np.cumsum(rate)))
+    end = np.searchsorted(reached, reached[:-1] + a, side="left")
+    return float(np.max(end - np.arange(rate.size)))
+
+
+def check_grid_resolvable(problem: DiscreteProblem) -> None:
+    """Raise :class:`InvalidInputError` if the grid is too fine for the relaxation to resolve.
+
+    See :data:`MAX_RAMP_STEPS`; the message gives the finest step supported for these bounds.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.solve.problem import DiscreteProblem
+    >>> n = 12_000
+    >>> p = DiscreteProblem(s=np.arange(n) * 1e-3, w_max=np.full(n, 4.0),
+    ...                     accel=np.full(n - 1, 2.0), decel=np.full(n - 1, 2.0),
+    ...                     jerk=np.full(n - 2, 0.5))
+    >>> check_grid_resolvable(p)
+    Traceback (most recent call last):
+    ...
+    speedplan.core.errors.InvalidInputError: the grid is too fine for the jerk bounds: ...
+    """
+    steps = ramp_steps(problem)
+    if steps <= MAX_RAMP_STEPS + 1:  # one step of slack: the count rounds up
+        return
+    h = float(np.mean(problem.h))
+    h_min = h * steps / MAX_RAMP_STEPS
+    length = float(problem.s[-1] - problem.s[0])
+    n_max = int(length / h_min) + 1
+    raise InvalidInputError(
+        f"the grid is too fine for the jerk bounds: a jerk-limited change of acceleration "
+        f"spans up to {steps:.0f} grid steps of {h:.3g}, more than the {MAX_RAMP_STEPS} the "
+        f"relaxation resolves in double precision; use steps of at least {h_min:.3g} "
+        f"(plan(): n <= {n_max} for this length {length:.6g}, or ds >= {h_min:.3g})"
+    )
+
+
+def unit_scales(problem: DiscreteProblem) -> tuple[float, float]:
+    """``(s_scale, w_scale)`` of the relaxation's units: unit mean step and ``w_max <= 1``.
+
+    :func:`~speedplan.solve.solve_problem` hands every relaxation backend
+    ``problem.scaled(*unit_scales(problem))``.
+    """
+    return float(np.mean(problem.h)), float(np.max(problem.w_max))
+
+
+def _positive_feasible(problem: DiscreteProblem) -> FloatArray:
+    """The fastest feasible ``w``; :class:`InfeasibleError` unless it is positive inside.
 
     The jerk rows never make the relaxation infeasible (``t`` may grow), so feasibility is
     that of the linear rows with strictly positive interior ``w``: the O(n) no-jerk pass.
+    The boundary values are assumed reachable (:func:`~speedplan.solve.nojerk.check_reachable`).
     """
-    check_reachable(problem)
     wmf = max_feasible_w(problem)
     inner = wmf[1:-1]
     if inner.size and float(np.min(inner)) <= 0.0:
@@ -278,25 +597,44 @@ def solve_relaxation_banded(
 
     """
     t_start = time.perf_counter()
-    if problem.n < 3:
+    if problem.n >= 3:
+        check_reachable(problem)
+    s_scale, w_scale = unit_scales(problem)
+    res = solve_unit_relaxation(problem.scaled(s_scale, w_scale), tol=tol, max_iter=max_iter)
+    time_scale = s_scale / np.sqrt(w_scale)
+    w = res.w * w_scale
+    w[0], w[-1] = problem.w_start, problem.w_end
+    return replace(res, w=w, t=res.t * time_scale,
+                   primal_objective=res.primal_objective * time_scale,
+                   dual_objective=res.dual_objective * time_scale,
+                   setup_time=time.perf_counter() - t_start - res.solve_time)
+
+
+def solve_unit_relaxation(
+    unit: DiscreteProblem, *, tol: float = 1e-8, max_iter: int = 100
+) -> RelaxationResult:
+    """:func:`solve_relaxation_banded` of a problem already in units and checked.
+
+    ``unit`` is in the units of :func:`unit_scales` (``w_max <= 1``, unit mean step) and its
+    boundary values are reachable (:func:`~speedplan.solve.nojerk.check_reachable`), as
+    :func:`~speedplan.solve.solve_problem` hands it to every relaxation backend; results are
+    in the same units.
+    """
+    t_start = time.perf_counter()
+    if unit.n < 3:
         raise SolverError("the relaxation needs n >= 3 grid nodes", backend="banded",
                           status="InvalidProblem")
-    wmf = _check_feasible(problem)
-    s_scale, w_scale = _scales(problem, wmf[1:-1])
-    scaled = problem.scaled(s_scale, w_scale)
-    d = _prepare(scaled, wmf[1:-1] / w_scale)
+    wmf = _positive_feasible(unit)
+    d, rows = _prepare(unit, wmf[1:-1])
     t_setup = time.perf_counter()
-    w_int, yl, iterations, code = ipm.iterate(d, *_start(scaled, d), tol, max_iter)
-    obj_scale = s_scale / np.sqrt(w_scale)
-    # Back to the scaled problem's units; clip rounding-level excursions past the bounds.
-    w_low = np.zeros(d.cw.size) if scaled.w_min is None else scaled.w_min[1:-1]
-    w_sc = np.concatenate(([scaled.w_start], np.clip(w_int * d.cw, w_low, scaled.w_max[1:-1]),
-                           [scaled.w_end]))
-    t = _primal_t(scaled, w_sc)
-    w = w_sc * w_scale
-    w[0], w[-1] = problem.w_start, problem.w_end
-    primal = float(t.sum()) * obj_scale
-    dual = _lagrangian_bound(scaled, *_row_multipliers(d, yl)) * obj_scale
+    w_int, yl, iterations, code = _run_kernel(d, *_start(unit, d), tol, max_iter)
+    # Clip rounding-level excursions past the bounds; the ends are the given values.
+    w_low = np.zeros(d.lay.m) if unit.w_min is None else unit.w_min[1:-1]
+    w = np.concatenate(([unit.w_start], np.clip(w_int * d.cw, w_low, unit.w_max[1:-1]),
+                        [unit.w_end]))
+    t = _primal_t(unit, w)
+    primal = float(t.sum())
+    dual = _lagrangian_bound(unit, *_row_multipliers(unit, d, rows, yl))
     status = ipm.STATUS_NAMES[code]
     if status != "Solved":
         # Like Clarabel's AlmostSolved: accepted only with a certified gap and feasible w,
@@ -305,7 +643,8 @@ def solve_relaxation_banded(
         # certified gap is 3.6e-11 (paths/slow_zone.json, n = 20 000), or the next Newton
         # matrix fails to factor one step after a certified gap of 9.9e-8 (u_turn.json).
         cert_gap = (primal - dual) / max(abs(primal), 1e-300)
-        feasible = problem.linear_violation(w) <= ipm.ALMOST_GAP * max(1.0, w_scale)
+        feasible = (unit.linear_violation(w)
+                    <= ipm.ALMOST_GAP * max(1.0, float(np.max(unit.w_max))))
         if not (cert_gap <= ipm.ALMOST_GAP and feasible):
             raise SolverError(
                 f"banded interior-point method stopped with status {status} after "
@@ -317,7 +656,7 @@ def solve_relaxation_banded(
     t_end = time.perf_counter()
     return RelaxationResult(
         w=w,
-        t=t * obj_scale,
+        t=t,
         primal_objective=primal,
         dual_objective=dual,
         status=status,

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
 from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
-from .banded import solve_relaxation_banded
+from .banded import check_grid_resolvable, kernel_for_auto, solve_unit_relaxation, unit_scales
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .ipopt_ import refine_ipopt
 from .nojerk import check_reachable, max_feasible_w
@@ -29,15 +29,21 @@ from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
 __all__ = ["BACKENDS", "REFINE_MODES", "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
 
-#: Relaxation backends by name; each maps a (normalised) problem to a RelaxationResult.
+#: Relaxation backends by name; each maps a problem in the units of
+#: :func:`~speedplan.solve.banded.unit_scales`, boundary values checked, to a RelaxationResult.
 RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = {
     "clarabel": solve_relaxation,
-    "banded": solve_relaxation_banded,
+    "banded": solve_unit_relaxation,
 }
 #: ``backend="auto"`` uses the banded interior-point method from this many nodes on (it is
 #: 5-8x faster than Clarabel from 100 to 500 nodes, measured); below, both take a few
 #: milliseconds and Clarabel, the reference, is used.
 AUTO_BANDED_FROM = 100
+#: Until the banded kernel is compiled (first use after installation, 20-30 s; see
+#: :func:`~speedplan.solve.banded.kernel_ready`), ``"auto"`` answers with Clarabel below this
+#: many nodes while a background process compiles it; from this size on Clarabel would take
+#: about as long as the compilation (16 s at 10^5 nodes), so ``"auto"`` waits for it.
+AUTO_WAIT_FROM = 100_000
 BACKENDS = ("auto", *RELAXATION_BACKENDS)
 REFINE_MODES = ("auto", "always", "never")
 
@@ -60,6 +66,13 @@ def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArr
         return w
     c = float(min(1.0, np.min(problem.jerk[finite] / load[finite]) ** (2.0 / 3.0)))
     return w * (c * (1.0 - 1e-12))
+
+
+def _auto_backend(problem: DiscreteProblem) -> str:
+    """``backend="auto"``: banded from :data:`AUTO_BANDED_FROM` nodes on, once it is compiled."""
+    if problem.n < AUTO_BANDED_FROM:
+        return "clarabel"
+    return "banded" if kernel_for_auto(wait=problem.n >= AUTO_WAIT_FROM) else "clarabel"
 
 
 def _relax_with_fallback(
@@ -90,6 +103,9 @@ def solve_problem(
 
     Raises
     ------
+    InvalidInputError
+        If the grid is finer than the relaxation can resolve for these jerk bounds
+        (:func:`~speedplan.solve.banded.check_grid_resolvable`).
     InfeasibleError
         If the boundary values cannot be met.
     SolverError
@@ -98,14 +114,6 @@ def solve_problem(
     t_start = time.perf_counter()
     refine = choice("refine", refine, REFINE_MODES)
     backend = choice("backend", backend, BACKENDS)
-    if backend == "auto":
-        banded_ok = problem.n >= AUTO_BANDED_FROM and not problem.has_lateral
-        backend = "banded" if banded_ok else "clarabel"
-    elif backend == "banded" and problem.has_lateral:
-        raise InvalidInputError(
-            "backend='banded' does not handle lateral-jerk rows yet; use backend='clarabel' or "
-            "'auto'"
-        )
     check_reachable(problem)
     if not problem.has_jerk or problem.n < 3:
         w = max_feasible_w(problem)
@@ -116,9 +124,11 @@ def solve_problem(
             solve_time=time.perf_counter() - t_start, backend="pass",
         )
 
+    check_grid_resolvable(problem)  # before any solver spends a minute on it
+    if backend == "auto":  # only now: the pass above needs no solver (and no compilation)
+        backend = _auto_backend(problem)
     # Solve in units where the mean step and the largest bound are 1: well-scaled cones.
-    s_scale = float(np.mean(problem.h))
-    w_scale = float(np.max(problem.w_max))
+    s_scale, w_scale = unit_scales(problem)
     time_scale = s_scale / np.sqrt(w_scale)
     unit = problem.scaled(s_scale, w_scale)
     relax, backend, fallback_reason = _relax_with_fallback(unit, backend)
@@ -241,7 +251,9 @@ def solve_discrete(
         warns).
     backend : {"auto", "clarabel", "banded"}
         Relaxation backend: Clarabel (reference), the structure-exploiting banded
-        interior-point method, or ``"auto"`` (banded from :data:`AUTO_BANDED_FROM` nodes on).
+        interior-point method, or ``"auto"`` (banded from :data:`AUTO_BANDED_FROM` nodes on;
+        Clarabel while the banded kernel is being compiled on first use, see
+        :func:`~speedplan.solve.banded.kernel_ready`).
 
     Returns
     -------
