@@ -209,7 +209,7 @@ def test_polyline_rejects_sharp_corners_and_cusps():
 @settings(max_examples=30, deadline=None)
 @given(
     pts=st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=2, max_size=7),
-    kind=st.sampled_from(["clothoid", "spline", "polyline"]),
+    kind=st.sampled_from(["g2", "clothoid", "spline", "polyline"]),
 )
 def test_every_kind_starts_and_ends_at_the_end_waypoints(pts, kind):
     xy = np.array(pts)

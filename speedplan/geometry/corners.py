@@ -49,7 +49,7 @@ __all__ = ["CUSP_ANGLE", "DEFAULT_DEVIATION", "DEFAULT_TRANSITION", "CornerShape
 DEFAULT_DEVIATION = 0.25
 #: Default share of a corner's turn taken by its two clothoids (``transition``).
 #: 0.5: the radius is within 9 % of a plain arc's for every turn up to 150°, while the
-#: sharpness (``dκ/ds``, what sets lateral jerk) is within 31 % of the clothoid pair's minimum;
+#: sharpness (``dκ/ds``, what sets lateral jerk) is within 32 % of the clothoid pair's minimum;
 #: smaller shares trade sharpness for radius quickly (docs/geometry.md).
 DEFAULT_TRANSITION = 0.5
 #: A waypoint where the path turns by more than this [rad] (150°) is a reversal (a cusp).
@@ -261,8 +261,8 @@ def g2_corners(
     for i in range(n - 1):
         # Each leg re-anchors the heading to its exact direction (nearest 2π branch), so
         # rounding in the corners never tilts a leg.
-        travel = float(head[i]) + (0.0 if direction > 0 else np.pi)
-        theta = travel + 2.0 * np.pi * round((theta - travel) / (2.0 * np.pi))
+        facing = float(head[i]) + (0.0 if direction > 0 else np.pi)
+        theta = facing + 2.0 * np.pi * round((theta - facing) / (2.0 * np.pi))
         t_out, t_in = float(tangent[i]), float(tangent[i + 1])
         straight = float(legs[i]) - t_out - t_in
         has_straight = straight > 1e-12 * legs[i]

@@ -150,8 +150,9 @@ def estimate_headings(pts: FloatArray) -> FloatArray:
     At an interior waypoint the heading halves the turn between the adjacent legs; at the
     first and last waypoint it is the leg's direction (for a closed point set, the bisector
     of the last and first legs). Unwrapped along the points. Measured against the former
-    estimate (tangents of a chord-length cubic spline), the chain strays 3-5 times less from
-    the legs (docs/geometry.md): the spline's end tangents swing off the first and last legs.
+    estimate (tangents of a chord-length cubic spline), the chain strays 2.4-4.6 times less
+    from the legs (docs/geometry.md): the spline's end tangents swing off the first and last
+    legs.
 
     Examples
     --------
