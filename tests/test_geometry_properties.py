@@ -50,9 +50,20 @@ def nurbs_paths(draw):
     return Path.from_nurbs(k, knots, ctrl, w)
 
 
+def joints(p):
+    """Arc lengths where the curvature may jump: piece joints and the inner knots of spline
+    and NURBS pieces (their second derivative jumps there, which finite differences see)."""
+    out = [p.offsets[1:-1]]
+    for piece, offset in zip(p.pieces, p.offsets, strict=False):
+        if hasattr(piece, "curve"):  # a CurvePiece: its table holds the knots as nodes
+            inner = np.asarray(piece.curve.breaks)[1:-1]
+            out.append(offset + piece._arc[np.isin(piece._tau, inner)])
+    return np.concatenate(out)
+
+
 def off_joints(p, s, gap):
-    """``s`` values farther than ``gap`` from every piece joint (curvature may jump there)."""
-    return s[np.abs(s[:, None] - p.offsets[None, 1:-1]).min(axis=1, initial=np.inf) > gap]
+    """``s`` values farther than ``gap`` from every joint (curvature may jump there)."""
+    return s[np.abs(s[:, None] - joints(p)[None, :]).min(axis=1, initial=np.inf) > gap]
 
 
 def speed(p, s, h):
