@@ -172,7 +172,10 @@ class Path:
         return self._dispatch(s, "point")
 
     def heading(self, s: Any) -> FloatArray:
-        """Heading [rad] at arc lengths ``s`` [m], continuous along the path.
+        """Vehicle heading (yaw) [rad] at arc lengths ``s`` [m], continuous along the path.
+
+        The direction of travel on forward pieces, that plus π on reverse ones; continuous
+        through cusps too (unwrapped).
 
         Examples
         --------
@@ -186,6 +189,8 @@ class Path:
 
     def curvature(self, s: Any) -> FloatArray:
         """Signed curvature [1/m] at arc lengths ``s`` [m] (positive: turning left).
+
+        That of the curve traversed in the direction of travel.
 
         Examples
         --------
