@@ -3,15 +3,17 @@
 Formats
 -------
 CSV waypoints (``.csv``)
-    A header row naming ``x`` and ``y`` columns (an optional ``heading`` column [rad] gives the
-    waypoint headings of a clothoid chain), then one waypoint per row, metres. Blank lines and
-    lines starting with ``#`` are ignored.
+    A header row naming ``x`` and ``y`` columns, then one waypoint per row, metres; joined by
+    the default kind of :meth:`Path.from_waypoints` (``"g2"``). An optional ``heading`` column
+    [rad] gives the waypoint headings of a clothoid chain (``kind="clothoid"``) instead. Blank
+    lines and lines starting with ``#`` are ignored.
 JSON segments (``.json``)
     ``{"start": [x, y], "heading": θ, "segments": [{"type": "line", "length": L},
     {"type": "arc", "radius": R, "angle": α}, {"type": "clothoid", "length": L, "k0": k,
     "k1": k}, ...], "zones": [{"polygon": [[x, y], ...], "v_max": v}, ...]}`` (``start``,
-    ``heading`` and ``zones`` optional). Instead of ``segments`` a file may give
-    ``"waypoints": [[x, y], ...]`` with an optional ``"kind"``.
+    ``heading`` and ``zones`` optional; a segment with ``"reverse": true`` is driven in
+    reverse, ``heading`` is the vehicle's). Instead of ``segments`` a file may give
+    ``"waypoints": [[x, y], ...]`` with an optional ``"kind"`` (default ``"g2"``).
 VDA 5050 (``.json``)
     An edge ``trajectory`` object ``{"degree": d, "knotVector": [...], "controlPoints":
     [{"x": .., "y": .., "weight": ..}, ...]}`` (``weight`` optional, default 1): bare, under
@@ -36,7 +38,7 @@ import numpy as np
 from .core.checks import as_array
 from .core.errors import InvalidInputError
 from .geometry import Path, SpeedZone
-from .geometry.fitting import KINDS
+from .geometry.fitting import DEFAULT_KIND, KINDS
 from .geometry.primitives import ClothoidPiece
 
 __all__ = [
@@ -103,7 +105,9 @@ def _read_csv(fs: FsPath, kind: str | None) -> Path:
         raise InvalidInputError(f"{fs.name}: needs at least two waypoints; got {data.shape[0]}")
     xy = data[:, [header.index("x"), header.index("y")]]
     headings = data[:, header.index("heading")] if "heading" in header else None
-    kind = "clothoid" if kind is None else kind
+    # Given headings mean a clothoid chain through those poses; otherwise the one default.
+    if kind is None:
+        kind = "clothoid" if headings is not None else DEFAULT_KIND
     try:
         if headings is not None and kind == "clothoid":
             return Path.from_waypoints(xy, kind, headings=headings)
@@ -174,7 +178,7 @@ def path_from_dict(doc: Any, name: str = "document") -> Path:
             return Path.from_segments(doc["segments"], start=doc.get("start", (0.0, 0.0)),
                                       heading=doc.get("heading", 0.0))
         if "waypoints" in doc:
-            return Path.from_waypoints(doc["waypoints"], kind=doc.get("kind", "clothoid"))
+            return Path.from_waypoints(doc["waypoints"], kind=doc.get("kind", DEFAULT_KIND))
     except InvalidInputError as exc:
         raise InvalidInputError(f"{name}: {exc}") from exc
     except (KeyError, TypeError, ValueError, AttributeError) as exc:  # safety net: odd JSON
@@ -218,8 +222,9 @@ def read_path(file: FileName, *, kind: str | None = None) -> Path:
     ----------
     file : str or os.PathLike
         The file; its extension selects the format.
-    kind : {"clothoid", "spline", "polyline"}, optional
-        How CSV waypoints are joined (default ``"clothoid"``); see :meth:`Path.from_waypoints`.
+    kind : {"g2", "clothoid", "spline", "polyline"}, optional
+        How CSV waypoints are joined; see :meth:`Path.from_waypoints`. Default ``"g2"``, or
+        ``"clothoid"`` through the given poses when the file has a ``heading`` column.
 
     Raises
     ------
@@ -271,8 +276,9 @@ def _zone_dicts(zones: Sequence[SpeedZone] | None) -> list[dict[str, Any]]:
 def path_to_dict(path: Path, zones: Sequence[SpeedZone] | None = None) -> dict[str, Any]:
     """The JSON-segments document of a path made of lines, arcs and clothoids.
 
-    Exact for paths from :meth:`Path.from_segments`, polylines and clothoid chains (and their
-    reversals): every piece is written as a segment from the first piece's pose.
+    Exact for paths from :meth:`Path.from_segments`, G2 corner paths, polylines and clothoid
+    chains (and their reversals): every piece is written as a segment from the first piece's
+    pose (its vehicle heading); pieces driven in reverse carry ``"reverse": true``.
 
     Raises
     ------
@@ -298,13 +304,16 @@ def path_to_dict(path: Path, zones: Sequence[SpeedZone] | None = None) -> dict[s
         )
     segments: list[dict[str, Any]] = []
     for p in pieces:
+        seg: dict[str, Any]
         if p.k0 == p.k1 == 0.0:
-            segments.append({"type": "line", "length": p.length})
+            seg = {"type": "line", "length": p.length}
         elif p.k0 == p.k1:
-            segments.append({"type": "arc", "radius": 1.0 / abs(p.k0),
-                             "angle": p.k0 * p.length})
+            seg = {"type": "arc", "radius": 1.0 / abs(p.k0), "angle": p.k0 * p.length}
         else:
-            segments.append({"type": "clothoid", "length": p.length, "k0": p.k0, "k1": p.k1})
+            seg = {"type": "clothoid", "length": p.length, "k0": p.k0, "k1": p.k1}
+        if p.direction < 0:
+            seg["reverse"] = True
+        segments.append(seg)
     first = pieces[0]
     doc: dict[str, Any] = {"start": [float(first.start[0]), float(first.start[1])],
                            "heading": float(first.theta0), "segments": segments}

@@ -7,6 +7,7 @@ from typing import Any
 
 from .core.limits import Limits
 from .geometry import Path, SpeedZone
+from .geometry.fitting import DEFAULT_KIND
 from .plan import plan
 from .timing import Trajectory
 
@@ -22,7 +23,11 @@ def profile_from_waypoints(
     j_max: float,
     a_decel: float | None = None,
     dt: float = 0.01,
-    kind: str = "clothoid",
+    kind: str = DEFAULT_KIND,
+    headings: Any = None,
+    corner_radius: float | None = None,
+    max_deviation: float | None = None,
+    transition: float | None = None,
     zones: Sequence[SpeedZone] | None = None,
     v0: float = 0.0,
     a0: float = 0.0,
@@ -32,8 +37,12 @@ def profile_from_waypoints(
 ) -> Trajectory:
     """Plan through waypoints and return the trajectory sampled every ``dt`` seconds.
 
-    The waypoints are joined by a drivable G1 path (a clothoid chain by default; see
-    :meth:`speedplan.Path.from_waypoints` for ``kind``), then planned with :func:`speedplan.plan`.
+    The waypoints are joined by a drivable path, by default straight legs with G2 corners
+    that cut each waypoint by at most ``max_deviation`` (0.25 m), then planned with
+    :func:`speedplan.plan`. ``kind``, ``headings``, ``corner_radius``, ``max_deviation`` and
+    ``transition`` are those of :meth:`speedplan.Path.from_waypoints` (an option that does not
+    apply to ``kind`` raises :class:`~speedplan.InvalidInputError`); the other keywords go to
+    :func:`speedplan.plan`.
 
     Examples
     --------
@@ -43,7 +52,8 @@ def profile_from_waypoints(
     >>> bool(traj.v[0] == 0 and traj.v.max() <= 2 * 1.005), bool(abs(traj.a[-1]) < 1e-9)
     (True, True)
     """
-    path = Path.from_waypoints(xy, kind=kind)
+    path = Path.from_waypoints(xy, kind, headings=headings, corner_radius=corner_radius,
+                               max_deviation=max_deviation, transition=transition)
     braking = {} if a_decel is None else {"a_decel": a_decel}
     limits = Limits(v_max=v_max, a_max=a_max, a_lat_max=a_lat_max, j_max=j_max, **braking)
     profile = plan(path, limits, zones=zones, v0=v0, a0=a0, vf=vf, af=af, **plan_options)

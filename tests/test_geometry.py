@@ -206,6 +206,9 @@ def test_linestring_round_trip_keeps_vertices():
         lambda: Path.from_waypoints([[0, 0], [3, 1], [5, 4]]),
         lambda: Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[0, 0], [1, 1], [2, 0]], [1, 2, 1]),
         lambda: Path.from_waypoints([[0, 0], [3, 1], [5, 4]], kind="spline").reversed(),
+        lambda: Path.from_waypoints([[0, 0], [10, 0], [3, 1], [8, 4]]),  # with a cusp
+        lambda: Path.from_waypoints([[0, 0], [3, 1], [5, 4]], kind="spline").reversed(
+            swap_direction=True),
     ],
 )
 def test_paths_pickle(make):
@@ -215,6 +218,8 @@ def test_paths_pickle(make):
     s = np.linspace(0, p.length, 9)
     np.testing.assert_array_equal(q.point(s), p.point(s))
     np.testing.assert_array_equal(q.curvature(s), p.curvature(s))
+    np.testing.assert_array_equal(q.heading(s), p.heading(s))
+    np.testing.assert_array_equal(q.direction(s), p.direction(s))
 
 
 def test_path_is_immutable_and_has_a_short_repr():

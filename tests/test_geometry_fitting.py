@@ -69,7 +69,7 @@ AISLE = np.array([[0, 0], [12, 0], [13.5, 1.5], [13.5, 10], [15, 11.5], [27, 11.
 @pytest.mark.parametrize("pts", [AISLE, AISLE * 1e-3 + 5.0, AISLE[::-1],
                                  np.array([[0, 0], [10, 0], [14, 4], [14, 12], [8, 16]], float)])
 def test_clothoid_chain_passes_through_every_waypoint_g1(pts):
-    p = Path.from_waypoints(pts)
+    p = Path.from_waypoints(pts, kind="clothoid")
     assert len(p.pieces) == len(pts) - 1
     scale = np.ptp(pts, axis=0).max()
     np.testing.assert_allclose(p.point(p.offsets), pts, rtol=0, atol=1e-9 * scale)
@@ -86,7 +86,7 @@ def test_clothoid_chain_passes_through_every_waypoint_g1(pts):
 
 def test_clothoid_chain_collinear_points_give_zero_curvature():
     pts = np.column_stack((np.linspace(0, 30, 7), np.linspace(0, 10, 7)))
-    p = Path.from_waypoints(pts)
+    p = Path.from_waypoints(pts, kind="clothoid")
     s = np.linspace(0, p.length, 200)
     assert np.abs(p.curvature(s)).max() < 1e-12
     assert p.length == pytest.approx(np.hypot(30, 10), rel=1e-14)
@@ -95,7 +95,7 @@ def test_clothoid_chain_collinear_points_give_zero_curvature():
 def test_clothoid_chain_uses_given_headings():
     pts = [[0, 0], [5, 5], [10, 0]]
     heads = [np.pi / 2, 0.0, -np.pi / 2]
-    p = Path.from_waypoints(pts, headings=heads)
+    p = Path.from_waypoints(pts, kind="clothoid", headings=heads)
     np.testing.assert_allclose(wrapped(p.heading(p.offsets) - heads), 0, atol=1e-12)
     np.testing.assert_allclose(p.point(p.offsets), pts, atol=1e-9)
 
@@ -209,7 +209,7 @@ def test_polyline_rejects_sharp_corners_and_cusps():
 @settings(max_examples=30, deadline=None)
 @given(
     pts=st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=2, max_size=7),
-    kind=st.sampled_from(["clothoid", "spline", "polyline"]),
+    kind=st.sampled_from(["g2", "clothoid", "spline", "polyline"]),
 )
 def test_every_kind_starts_and_ends_at_the_end_waypoints(pts, kind):
     xy = np.array(pts)

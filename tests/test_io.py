@@ -55,8 +55,11 @@ def test_samples_load_with_sane_lengths_and_are_documented():
 
 def test_csv_waypoints_with_and_without_headings(tmp_path):
     f = write(tmp_path, "w.csv", "# comment\nx,y\n0,0\n\n10,0\n10,10\n")
-    p = read_path(f)
-    np.testing.assert_allclose(p.point(p.offsets), [[0, 0], [10, 0], [10, 10]], atol=1e-9)
+    p = read_path(f)  # no headings: the default G2 corners, exact ends, corner within 0.25 m
+    np.testing.assert_allclose(p.point([0.0, p.length]), [[0, 0], [10, 10]], atol=1e-12)
+    corner = p.to_linestring(ds=1e-3).distance(shapely.Point(10, 0))
+    assert 0.2 < corner <= 0.25 + 1e-9
+    assert Path.from_waypoints([[0, 0], [10, 0], [10, 10]]).length == p.length
     g = write(tmp_path, "h.csv", "Y, X ,heading\n0,0,0\n5,5,0\n0,10,0\n")  # any column order
     q = read_path(g)
     np.testing.assert_allclose(q.point(q.offsets), [[0, 0], [5, 5], [10, 0]], atol=1e-9)

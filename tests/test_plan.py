@@ -209,9 +209,10 @@ def test_ten_nanometre_move_matches_the_jerk_limited_closed_form():
 
 def test_millimetres_and_metres_give_the_same_trajectory():
     pts = np.array([[0, 0], [8, 0], [12, 3], [12, 9]], dtype=float)
-    m = plan(Path.from_waypoints(pts), LGV)
+    # The corners' max_deviation is a length too: scale it with the waypoints.
+    m = plan(Path.from_waypoints(pts, max_deviation=0.25), LGV)
     k = 1000.0
-    mm = plan(Path.from_waypoints(pts * k),
+    mm = plan(Path.from_waypoints(pts * k, max_deviation=0.25 * k),
               Limits(v_max=2 * k, a_max=1 * k, a_lat_max=1 * k, j_max=0.5 * k))
     assert mm.duration == pytest.approx(m.duration, rel=1e-6)
     a, b = m.sample(0.05), mm.sample(0.05)

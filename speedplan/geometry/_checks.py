@@ -9,7 +9,7 @@ import numpy as np
 from ..core.checks import FloatArray, as_array
 from ..core.errors import InvalidInputError
 
-__all__ = ["as_int", "check_waypoints", "wrap_angle"]
+__all__ = ["as_direction", "as_int", "as_reverse", "check_waypoints", "wrap_angle"]
 
 
 def wrap_angle(a: Any) -> FloatArray:
@@ -27,6 +27,20 @@ def as_int(name: str, value: Any, *, minimum: int) -> int:
         ok = False
     if not ok or int(value) < minimum:
         raise InvalidInputError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
+    return int(value)
+
+
+def as_reverse(name: str, value: Any) -> bool:
+    """``value`` as a ``bool`` (only ``True``/``False``, numpy's included: ``1`` is ambiguous)."""
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidInputError(f"`{name}` must be True or False; got {value!r}")
+    return bool(value)
+
+
+def as_direction(name: str, value: Any) -> int:
+    """``value`` as a direction of travel: ``1`` (forward) or ``-1`` (reverse)."""
+    if isinstance(value, bool | np.bool_) or value not in (1, -1):
+        raise InvalidInputError(f"`{name}` must be 1 (forward) or -1 (reverse); got {value!r}")
     return int(value)
 
 

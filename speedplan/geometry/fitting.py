@@ -1,4 +1,9 @@
-"""Paths through waypoints: G1 clothoid chain, arc-length cubic spline, rounded polyline."""
+"""Paths through waypoints: G2 corners (default), G1 clothoid chain, spline, rounded polyline.
+
+``"g2"`` lives in :mod:`~speedplan.geometry.corners`; this module dispatches on ``kind``,
+validates the options of each kind and refuses reversals (turns back by more than
+:data:`~speedplan.geometry.corners.CUSP_ANGLE`) in the kinds that cannot drive in reverse.
+"""
 
 from __future__ import annotations
 
@@ -11,13 +16,21 @@ from scipy.interpolate import CubicSpline
 from ..core.checks import FloatArray, as_array, as_scalar, choice
 from ..core.errors import InvalidInputError
 from ._checks import check_waypoints, wrap_angle
+from .corners import CUSP_ANGLE, as_deviation, find_reversal, g2_corners, leg_turns
 from .pieces import CurvePiece, Piece
 from .primitives import ClothoidPiece
 
-__all__ = ["CORNER_FRACTION", "KINDS", "SplineCurve", "clothoid_chain", "fit_clothoid",
-           "fit_waypoints", "rounded_polyline", "spline_piece"]
+__all__ = ["CORNER_FRACTION", "DEFAULT_KIND", "KINDS", "SplineCurve", "clothoid_chain",
+           "estimate_headings", "fit_clothoid", "fit_waypoints", "rounded_polyline",
+           "spline_piece"]
 
-KINDS = ("clothoid", "spline", "polyline")
+KINDS = ("g2", "clothoid", "spline", "polyline")
+#: The kind of :meth:`Path.from_waypoints`, :meth:`Path.from_linestring`, CSV waypoints
+#: without headings and :func:`speedplan.profile_from_waypoints`.
+DEFAULT_KIND = "g2"
+#: The kinds each option applies to.
+_OPTIONS = {"headings": ("clothoid",), "corner_radius": ("polyline",),
+            "max_deviation": ("g2", "polyline"), "transition": ("g2",)}
 
 #: Default polyline corner rounding: each arc starts this fraction of the shorter adjacent leg
 #: before the corner (scale-free: the same path in millimetres or in metres).
@@ -113,25 +126,59 @@ def _chord_parameter(pts: FloatArray) -> FloatArray:
     return np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
 
 
+def _is_closed(pts: FloatArray) -> bool:
+    """Whether the last waypoint repeats the first (to ``1e-12`` of the polyline's length)."""
+    total = float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)))
+    return pts.shape[0] > 2 and bool(np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * total))
+
+
 def _chord_spline(pts: FloatArray) -> CubicSpline:
     """Chord-length cubic spline: periodic for closed point sets, not-a-knot otherwise."""
     tau = _chord_parameter(pts)
     if pts.shape[0] == 2:
         return CubicSpline(tau, pts, bc_type="natural")
-    closed = bool(np.allclose(pts[0], pts[-1], rtol=0.0, atol=1e-12 * tau[-1]))
+    closed = _is_closed(pts)
     if closed:
         pts = pts.copy()
         pts[-1] = pts[0]  # periodic splines need exactly equal ends
     return CubicSpline(tau, pts, bc_type="periodic" if closed else "not-a-knot")
 
 
+def estimate_headings(pts: FloatArray) -> FloatArray:
+    """Waypoint headings for a clothoid chain: the leg bisectors, the legs' at the ends [rad].
+
+    At an interior waypoint the heading halves the turn between the adjacent legs; at the
+    first and last waypoint it is the leg's direction (for a closed point set, the bisector
+    of the last and first legs). Unwrapped along the points. Measured against the former
+    estimate (tangents of a chord-length cubic spline), the chain strays 2.4-4.6 times less
+    from the legs (docs/geometry.md): the spline's end tangents swing off the first and last
+    legs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry.fitting import estimate_headings
+    >>> estimate_headings(np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])).round(6).tolist()
+    [0.0, 0.785398, 1.570796]
+    """
+    _, head, turn = leg_turns(pts)
+    legs = head[0] + np.concatenate(([0.0], np.cumsum(turn)))  # unwrapped leg directions
+    th = np.concatenate((legs[:1], legs[:-1] + 0.5 * turn, legs[-1:]))
+    if _is_closed(pts):
+        closing = float(wrap_angle(head[0] - head[-1]))
+        th[0] -= 0.5 * closing
+        th[-1] += 0.5 * closing
+    out: FloatArray = th
+    return out
+
+
 def clothoid_chain(pts: FloatArray, headings: Any = None) -> tuple[ClothoidPiece, ...]:
     """One clothoid per leg through ``pts``, G1 at every waypoint.
 
-    The headings at the waypoints are ``headings`` or, by default, the tangent directions of
-    a chord-length cubic spline through the points (periodic for a closed point set). Each leg
-    solves the G1 Hermite problem (:func:`fit_clothoid`); each leg starts with the previous
-    leg's end heading, so the heading is continuous (not only modulo 2π).
+    The headings at the waypoints are ``headings`` or, by default,
+    :func:`estimate_headings` (leg bisectors). Each leg solves the G1 Hermite problem
+    (:func:`fit_clothoid`); each leg starts with the previous leg's end heading, so the
+    heading is continuous (not only modulo 2π).
 
     Examples
     --------
@@ -143,10 +190,7 @@ def clothoid_chain(pts: FloatArray, headings: Any = None) -> tuple[ClothoidPiece
     """
     n = pts.shape[0]
     if headings is None:
-        d1 = _chord_spline(pts)(_chord_parameter(pts), 1)
-        th = np.arctan2(d1[:, 1], d1[:, 0])
-        if n == 2:
-            th[:] = np.arctan2(*(pts[1] - pts[0])[::-1])  # exactly the chord direction
+        th = estimate_headings(pts)
     else:
         th = as_array("headings", headings, ndim=1, length=n)
     pieces: list[ClothoidPiece] = []
@@ -221,7 +265,8 @@ def rounded_polyline(
     Raises
     ------
     InvalidInputError
-        The polyline reverses direction (a 180° turn), or a rounding parameter is not > 0.
+        The polyline turns back by more than 150° (a reversal, see :func:`refuse_reversal`),
+        or a rounding parameter is not > 0.
 
     Examples
     --------
@@ -232,16 +277,9 @@ def rounded_polyline(
     >>> [round(p.length, 6) for p in legs], round(1 / legs[1].k0, 6)
     ([8.792893, 1.896119, 8.792893], 1.207107)
     """
-    d = np.diff(pts, axis=0)
-    legs = np.linalg.norm(d, axis=1)
-    unit = d / legs[:, None]
-    head = np.arctan2(d[:, 1], d[:, 0])
-    turn = wrap_angle(np.diff(head))
-    if (np.abs(turn) > np.pi - 1e-9).any():
-        i = int(np.flatnonzero(np.abs(turn) > np.pi - 1e-9)[0]) + 1
-        raise InvalidInputError(
-            f"`xy` reverses direction at row {i} (a 180° cusp); split the path there"
-        )
+    refuse_reversal(pts, "polyline")
+    legs, head, turn = leg_turns(pts)
+    unit = np.diff(pts, axis=0) / legs[:, None]
     half = 0.5 * np.abs(turn)
     shorter = np.minimum(legs[:-1], legs[1:])
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -250,13 +288,7 @@ def rounded_polyline(
             radius = as_scalar("corner_radius", corner_radius, positive=True)
             tangent = np.minimum(tangent, radius * np.tan(half))
         if max_deviation is not None:
-            dev = as_scalar("max_deviation", max_deviation, nonnegative=True)
-            if dev == 0.0:
-                raise InvalidInputError(
-                    "`max_deviation`=0 keeps sharp corners, where the curvature is infinite "
-                    "and a vehicle must stop; pass max_deviation > 0, or split the path at the "
-                    "corners and plan each leg"
-                )
+            dev = as_deviation(max_deviation)
             # Corner-to-arc distance d = R (1/cos(α/2) - 1), tangent length R tan(α/2).
             tangent = np.minimum(tangent, dev * np.sin(half) / (1.0 - np.cos(half)))
         if corner_radius is None and max_deviation is None:
@@ -281,13 +313,43 @@ def rounded_polyline(
     return tuple(pieces)
 
 
+def refuse_reversal(pts: FloatArray, kind: str, name: str = "xy") -> None:
+    """Raise if the waypoints turn back by more than ``CUSP_ANGLE`` (150°) somewhere.
+
+    Only ``kind="g2"`` can drive a reversal (a cusp); the other kinds would loop round it
+    or fold onto themselves.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry.fitting import refuse_reversal
+    >>> from speedplan import InvalidInputError
+    >>> try:
+    ...     refuse_reversal(np.array([[0.0, 0.0], [4.0, 0.0], [1.0, 0.2]]), "clothoid")
+    ... except InvalidInputError as exc:
+    ...     print(str(exc)[:65])
+    `xy` reverses direction at row 1 (turns back by 176.2°, more than
+    """
+    found = find_reversal(pts)
+    if found is None:
+        return
+    row, turn = found
+    raise InvalidInputError(
+        f"`{name}` reverses direction at row {row} (turns back by {np.degrees(abs(turn)):.1f}°, "
+        f"more than {np.degrees(CUSP_ANGLE):.0f}°: a cusp); kind={kind!r} cannot drive in "
+        "reverse — use kind='g2' (the default), which stops there and reverses, or split the "
+        "path there"
+    )
+
+
 def fit_waypoints(
     xy: Any,
-    kind: str = "clothoid",
+    kind: str = DEFAULT_KIND,
     *,
     headings: Any = None,
     corner_radius: float | None = None,
     max_deviation: float | None = None,
+    transition: float | None = None,
     name: str = "xy",
 ) -> tuple[Piece, ...]:
     """Pieces of a path through the waypoints ``xy``; see :meth:`Path.from_waypoints`.
@@ -299,22 +361,26 @@ def fit_waypoints(
     >>> from speedplan.geometry.fitting import fit_waypoints
     >>> len(fit_waypoints([[0, 0], [4, 0], [4, 4]], "polyline"))
     3
+    >>> len(fit_waypoints([[0, 0], [4, 0], [4, 4]]))  # line, clothoid, arc, clothoid, line
+    5
     """
     choice("kind", kind, KINDS)
     pts = check_waypoints(xy, name)
-    if headings is not None and kind != "clothoid":
-        raise InvalidInputError("`headings` applies to kind='clothoid' only")
-    if (corner_radius is not None or max_deviation is not None) and kind != "polyline":
-        raise InvalidInputError(
-            "`corner_radius` and `max_deviation` apply to kind='polyline' only"
-        )
+    given = {"headings": headings, "corner_radius": corner_radius,
+             "max_deviation": max_deviation, "transition": transition}
+    for option, value in given.items():
+        applies = _OPTIONS[option]
+        if value is not None and kind not in applies:
+            listed = " and ".join(f"kind={k!r}" for k in applies)
+            raise InvalidInputError(
+                f"`{option}` applies to {listed} only; got kind={kind!r} — pass "
+                f"kind={applies[0]!r} to use it"
+            )
+    if kind == "g2":
+        return g2_corners(pts, max_deviation, transition)
+    refuse_reversal(pts, kind, name)
     if kind == "clothoid":
         return clothoid_chain(pts, headings)
     if kind == "spline":
         return (spline_piece(pts),)
-    try:
-        return rounded_polyline(pts, corner_radius, max_deviation)
-    except InvalidInputError as exc:
-        if name == "xy":
-            raise
-        raise InvalidInputError(str(exc).replace("`xy`", f"`{name}`")) from exc
+    return rounded_polyline(pts, corner_radius, max_deviation)

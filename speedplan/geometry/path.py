@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from itertools import pairwise
 from typing import Any
 
 import numpy as np
@@ -32,22 +33,25 @@ class PathSamples:
     xy : ndarray, shape (n, 2)
         Positions [m].
     heading : ndarray, shape (n,)
-        Headings [rad], continuous (unwrapped) along the path.
+        Vehicle headings [rad], continuous (unwrapped) along the path, through cusps too.
     curvature : ndarray, shape (n,)
-        Signed curvatures [1/m] (positive: turning left).
+        Signed curvatures [1/m] (positive: turning left in the direction of travel).
+    direction : ndarray of int, shape (n,)
+        Direction of travel, ``+1`` forward or ``-1`` reverse (see :meth:`Path.direction`).
 
     Examples
     --------
     >>> from speedplan.geometry import Line, Path
     >>> smp = Path.from_segments([Line(4.0)]).resample(n=3)
-    >>> smp.s.tolist(), smp.xy[:, 0].tolist(), smp.curvature.tolist()
-    ([0.0, 2.0, 4.0], [0.0, 2.0, 4.0], [0.0, 0.0, 0.0])
+    >>> smp.s.tolist(), smp.xy[:, 0].tolist(), smp.curvature.tolist(), smp.direction.tolist()
+    ([0.0, 2.0, 4.0], [0.0, 2.0, 4.0], [0.0, 0.0, 0.0], [1, 1, 1])
     """
 
     s: FloatArray
     xy: FloatArray
     heading: FloatArray
     curvature: FloatArray
+    direction: IntArray
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -58,6 +62,13 @@ class Path:
     :meth:`from_linestring`; it is immutable. Positions in metres, headings in radians
     (counter-clockwise from +x, continuous along the path), curvature in 1/m (positive turning
     left). Every query is vectorised over ``s``.
+
+    A path may be driven partly in reverse: each piece has a direction of travel (``+1``
+    forward, ``-1`` reverse; :meth:`direction`), and the positions where it flips are
+    :attr:`cusps`, where the vehicle stops. ``heading`` is the vehicle's heading (yaw): the
+    direction of travel on forward pieces, that plus π on reverse ones, continuous through
+    cusps (the travel tangent flips by π there); ``curvature`` is that of the curve traversed
+    in the direction of travel.
 
     Query positions within ``1e-9 * length`` outside ``[0, length]`` (rounding) are clipped to
     the ends; further outside they raise :class:`~speedplan.errors.InvalidInputError`.
@@ -161,7 +172,10 @@ class Path:
         return self._dispatch(s, "point")
 
     def heading(self, s: Any) -> FloatArray:
-        """Heading [rad] at arc lengths ``s`` [m], continuous along the path.
+        """Vehicle heading (yaw) [rad] at arc lengths ``s`` [m], continuous along the path.
+
+        The direction of travel on forward pieces, that plus π on reverse ones; continuous
+        through cusps too (unwrapped).
 
         Examples
         --------
@@ -176,6 +190,8 @@ class Path:
     def curvature(self, s: Any) -> FloatArray:
         """Signed curvature [1/m] at arc lengths ``s`` [m] (positive: turning left).
 
+        That of the curve traversed in the direction of travel.
+
         Examples
         --------
         >>> from speedplan.geometry import Arc, Line, Path
@@ -184,6 +200,58 @@ class Path:
         [0.0, -0.25]
         """
         return self._dispatch(s, "curvature")
+
+    def direction(self, s: Any) -> IntArray:
+        """Direction of travel at arc lengths ``s`` [m]: ``+1`` forward, ``-1`` reverse.
+
+        At a cusp the value is that of the piece after it.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Line, Path
+        >>> p = Path.from_segments([Line(2.0), Line(1.0, reverse=True)])
+        >>> p.direction([0.0, 1.0, 2.0, 3.0]).tolist()
+        [1, 1, -1, -1]
+        """
+        _, idx = self._locate(s)
+        out: IntArray = self._directions[idx]
+        return out
+
+    @cached_property
+    def _directions(self) -> IntArray:
+        return np.array([p.direction for p in self.pieces], dtype=np.intp)
+
+    @cached_property
+    def cusps(self) -> FloatArray:
+        """Arc lengths [m] where the direction of travel flips (empty when there is none).
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Line, Path
+        >>> Path.from_segments([Line(2.0), Line(1.0, reverse=True), Line(4.0)]).cusps.tolist()
+        [2.0, 3.0]
+        """
+        flips = np.flatnonzero(np.diff(self._directions) != 0) + 1
+        out: FloatArray = self.offsets[flips]
+        return out
+
+    def split_at_cusps(self) -> tuple[Path, ...]:
+        """The maximal single-direction sub-paths, in order, each with ``s`` from 0.
+
+        One element (the path itself) when there is no cusp.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Line, Path
+        >>> p = Path.from_segments([Line(2.0), Line(1.0, reverse=True), Line(4.0)])
+        >>> [(q.length, int(q.direction(0.0))) for q in p.split_at_cusps()]
+        [(2.0, 1), (1.0, -1), (4.0, 1)]
+        """
+        flips = np.flatnonzero(np.diff(self._directions) != 0) + 1
+        if flips.size == 0:
+            return (self,)
+        bounds = np.concatenate(([0], flips, [len(self.pieces)]))
+        return tuple(Path(self.pieces[a:b]) for a, b in pairwise(bounds.tolist()))
 
     def evaluate(self, s: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``(point, heading, curvature)`` at arc lengths ``s`` in one pass.
@@ -236,13 +304,23 @@ class Path:
             count = grid_size("n", as_int("n", n, minimum=2))
         s = np.linspace(0.0, self.length, max(count, 2))
         xy, theta, kappa = self.evaluate(s)
-        return PathSamples(s, xy, theta, kappa)
+        return PathSamples(s, xy, theta, kappa, self.direction(s))
 
-    def reversed(self) -> Path:
+    def reversed(self, *, swap_direction: bool = False) -> Path:
         """The same path travelled from its end to its start.
 
-        ``point_rev(s) = point(L - s)``, ``heading_rev(s) = heading(L - s) + π`` and
-        ``curvature_rev(s) = -curvature(L - s)``.
+        ``point_rev(s) = point(L - s)`` and ``curvature_rev(s) = -curvature(L - s)``; the cusps
+        move to ``L - cusps``. What happens to the vehicle's heading and gear:
+
+        * default: each piece keeps its direction flag and the vehicle is turned around,
+          ``heading_rev(s) = heading(L - s) + π`` and ``direction_rev(s) = direction(L - s)``
+          — the same manoeuvre driven from the other end, e.g. a forward path stays forward;
+        * ``swap_direction=True``: the flags flip and the heading is kept,
+          ``heading_rev(s) = heading(L - s)`` and ``direction_rev(s) = -direction(L - s)`` —
+          the vehicle retraces its poses backwards, e.g. backs out of a rack the way it drove
+          in.
+
+        Either way the heading stays continuous through the cusps.
 
         Examples
         --------
@@ -251,8 +329,11 @@ class Path:
         >>> r = p.reversed()
         >>> float(r.curvature(0.5)), (r.point(r.length).round(12) + 0.0).tolist()
         (-0.5, [0.0, 0.0])
+        >>> b = p.reversed(swap_direction=True)
+        >>> int(b.direction(0.0)), round(float(b.heading(b.length)), 12)
+        (-1, 0.0)
         """
-        return Path(tuple(p.reversed() for p in reversed(self.pieces)))
+        return Path(tuple(p.reversed(swap_direction) for p in reversed(self.pieces)))
 
     def to_linestring(self, ds: float | None = None) -> Any:
         """A shapely ``LineString`` through the path.
@@ -291,12 +372,16 @@ class Path:
         ----------
         segments : sequence
             :class:`Line`, :class:`Arc`, :class:`Clothoid`, or dicts ``{"type": "line" |
-            "arc" | "clothoid", ...}`` with the same fields. Arcs take a positive radius and a
-            signed angle (positive turns left).
+            "arc" | "clothoid", ...}`` with the same fields (and optionally ``"reverse":
+            true``). Arcs take a positive radius and a signed angle (positive turns left).
+            A segment with ``reverse=True`` is driven in reverse; one that follows a segment
+            of the other direction starts with a cusp: the travel tangent flips by π, the
+            vehicle's heading is unchanged.
         start : (x, y)
             Start point [m].
         heading : float
-            Initial heading [rad].
+            Initial vehicle heading [rad] (the direction of travel if the first segment is
+            driven forward, its opposite if in reverse).
 
         Returns
         -------
@@ -311,6 +396,9 @@ class Path:
         ...                         {"type": "clothoid", "length": 2.0, "k0": 0.5, "k1": 0.0}])
         >>> round(p.length, 12), round(float(p.heading(p.length)), 12)
         (10.0, 1.5)
+        >>> back = Path.from_segments([Line(5.0), Arc(2.0, -0.5, reverse=True)])  # a cusp at 5
+        >>> back.cusps.tolist(), back.direction([1.0, 6.0]).tolist()
+        ([5.0], [1, -1])
         """
         if isinstance(segments, str | bytes) or not isinstance(segments, Sequence):
             raise InvalidInputError(
@@ -333,11 +421,12 @@ class Path:
     def from_waypoints(
         cls,
         xy: Any,
-        kind: str = "clothoid",
+        kind: str = "g2",
         *,
         headings: Any = None,
         corner_radius: float | None = None,
         max_deviation: float | None = None,
+        transition: float | None = None,
     ) -> Path:
         """Path through waypoints.
 
@@ -345,35 +434,60 @@ class Path:
         ----------
         xy : array_like, shape (n, 2)
             Waypoints [m]; n >= 2, finite, no repeated consecutive points.
-        kind : {"clothoid", "spline", "polyline"}
-            ``"clothoid"`` (default): one clothoid per leg, through every waypoint, tangent
-            continuous (G1); see :func:`~speedplan.geometry.fitting.clothoid_chain`.
+        kind : {"g2", "clothoid", "spline", "polyline"}
+            ``"g2"`` (default): straight legs joined by clothoid–arc–clothoid corners that
+            cut each interior waypoint by at most ``max_deviation``, curvature continuous
+            (G2), exactly through the first and last waypoints; a waypoint where the path
+            turns back by more than 150° is a cusp, driven in reverse after it (see
+            :mod:`~speedplan.geometry.corners`).
+            ``"clothoid"``: one clothoid per leg, through every waypoint, tangent continuous
+            (G1); see :func:`~speedplan.geometry.fitting.clothoid_chain`.
             ``"spline"``: chord-length cubic spline reparametrised by true arc length (C²).
-            ``"polyline"``: straight legs with corners rounded by tangent circular arcs; see
-            :func:`~speedplan.geometry.fitting.rounded_polyline` for the default rounding.
+            ``"polyline"``: straight legs with corners rounded by tangent circular arcs (G1);
+            see :func:`~speedplan.geometry.fitting.rounded_polyline` for the default rounding.
+            Only ``"g2"`` drives reversals; the other kinds refuse them.
         headings : array_like, shape (n,), optional
-            Headings at the waypoints [rad] (``"clothoid"`` only; default: estimated).
+            ``"clothoid"`` only: headings at the waypoints [rad] (default: the bisectors of
+            the adjacent legs, the leg directions at the ends).
         corner_radius : float, optional
             ``"polyline"`` only: radius of the corner arcs [m] (reduced where the legs are too
             short).
         max_deviation : float, optional
-            ``"polyline"`` only: largest distance between a corner and its arc [m].
+            ``"g2"`` and ``"polyline"``: largest distance between a waypoint and the path [m]
+            (``"g2"``: default 0.25 m, reduced where the legs are short; ``inf`` rounds as
+            much as the legs allow).
+        transition : float, optional
+            ``"g2"`` only: share of each corner's turn taken by its two clothoids, in
+            ``(0, 1]`` (default 0.5; 1 is a clothoid pair without arc).
+
+        Raises
+        ------
+        InvalidInputError
+            Bad waypoints, an option that does not apply to ``kind``, or a reversal in a kind
+            other than ``"g2"`` (the message names the row).
 
         Examples
         --------
+        >>> import numpy as np
         >>> from speedplan import Path
         >>> pts = [[0, 0], [10, 0], [10, 10]]
-        >>> p = Path.from_waypoints(pts)                      # G1 clothoid chain
-        >>> p.point(p.offsets).round(9).tolist() == [[0, 0], [10, 0], [10, 10]]
+        >>> p = Path.from_waypoints(pts)                      # G2 corner
+        >>> p.point([0.0, p.length]).round(12).tolist(), round(float(p.curvature(10.0)), 4)
+        ([[0.0, 0.0], [10.0, 10.0]], 1.8014)
+        >>> c = Path.from_waypoints(pts, kind="clothoid")     # G1, through every waypoint
+        >>> c.point(c.offsets).round(9).tolist() == [[0, 0], [10, 0], [10, 10]]
         True
         >>> q = Path.from_waypoints(pts, kind="polyline", corner_radius=2.0)
         >>> round(float(q.curvature(10.0)), 12), round(q.length, 6)
         (0.5, 19.141593)
+        >>> r = Path.from_waypoints([[0, 0], [10, 0], [4, 0]])  # back out: a cusp at x = 10
+        >>> r.cusps.tolist(), r.direction([5.0, 12.0]).tolist()
+        ([10.0], [1, -1])
         """
         from .fitting import fit_waypoints
 
         return cls(fit_waypoints(xy, kind, headings=headings, corner_radius=corner_radius,
-                                 max_deviation=max_deviation))
+                                 max_deviation=max_deviation, transition=transition))
 
     @classmethod
     def from_nurbs(
@@ -408,16 +522,18 @@ class Path:
     def from_linestring(
         cls,
         ls: Any,
-        kind: str = "polyline",
+        kind: str = "g2",
         *,
         headings: Any = None,
         corner_radius: float | None = None,
         max_deviation: float | None = None,
+        transition: float | None = None,
     ) -> Path:
         """Path through the vertices of a shapely ``LineString`` (z ignored).
 
-        ``kind`` and the keyword options are those of :meth:`from_waypoints`; the default
-        ``"polyline"`` keeps the straight legs of the LineString and rounds its corners.
+        ``kind`` and the keyword options are those of :meth:`from_waypoints`, with the same
+        default ``"g2"``: the straight legs of the LineString, its corners cut by at most
+        ``max_deviation``.
 
         Examples
         --------
@@ -439,4 +555,4 @@ class Path:
 
         return cls(fit_waypoints(np.asarray(ls.coords)[:, :2], kind, headings=headings,
                                  corner_radius=corner_radius, max_deviation=max_deviation,
-                                 name="ls"))
+                                 transition=transition, name="ls"))

@@ -8,6 +8,11 @@ pieces with ``length`` and vectorised ``point(u)``, ``heading(u)``, ``curvature(
 * :class:`CurvePiece` — a parametric curve ``r(τ)`` with derivatives (cubic spline, NURBS),
   reparametrised by arc length: a Gauss–Legendre table of ``∫|r'|`` inverted by Newton's method.
 * :class:`ReversedPiece` — any piece travelled backwards.
+
+Every piece has a ``direction`` of travel: ``+1`` forward, ``-1`` driven in reverse. ``point``
+and ``curvature`` describe the curve traversed in the direction of travel; ``heading`` is the
+vehicle's heading (yaw), the direction of travel on forward pieces and that plus π on reverse
+ones.
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ import numpy as np
 from ..core.checks import FloatArray, IntArray
 from ..core.errors import InvalidInputError
 from ..core.numerics import GAUSS_NODES, GAUSS_WEIGHTS, SHORT_NODES, SHORT_WEIGHTS
+from ._checks import as_direction
 
 __all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "CurvePiece", "ParametricCurve", "Piece",
            "ReversedPiece"]
@@ -39,29 +45,38 @@ _SHORT_STEP = 1e-3
 
 
 class Piece:
-    """Interface of a path piece; ``u`` is the local arc length in ``[0, length]`` [m]."""
+    """Interface of a path piece; ``u`` is the local arc length in ``[0, length]`` [m].
+
+    ``direction`` is ``+1`` (forward) or ``-1`` (driven in reverse).
+    """
 
     length: float
+    direction: int = 1
 
     def point(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
         """Positions at local arc lengths ``u``, shape ``u.shape + (2,)`` [m]."""
         raise NotImplementedError
 
     def heading(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
-        """Headings at local arc lengths ``u`` [rad], continuous along the piece."""
+        """Vehicle headings at local arc lengths ``u`` [rad], continuous along the piece."""
         raise NotImplementedError
 
     def curvature(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
-        """Signed curvatures at local arc lengths ``u`` [1/m] (positive: turning left)."""
+        """Signed curvatures [1/m] (positive: turning left, in the direction of travel)."""
         raise NotImplementedError
 
     def evaluate(self, u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``(point, heading, curvature)`` at once (pieces share work where they can)."""
         return self.point(u), self.heading(u), self.curvature(u)
 
-    def reversed(self) -> Piece:
-        """The piece travelled from its end to its start."""
-        return ReversedPiece(self)
+    def reversed(self, swap_direction: bool = False) -> Piece:
+        """The piece travelled from its end to its start.
+
+        By default the direction flag is kept and the vehicle turned around (heading + π):
+        the mirrored manoeuvre. ``swap_direction=True`` flips the flag and keeps the heading:
+        the vehicle retraces its poses backwards (e.g. backs out the way it drove in).
+        """
+        return ReversedPiece(self, swap_direction)
 
 
 class ParametricCurve(Protocol):
@@ -92,6 +107,7 @@ class CurvePiece(Piece):
     """
 
     curve: ParametricCurve
+    direction: int = 1
     length: float = field(init=False)
     _tau: FloatArray = field(init=False, repr=False)
     _arc: FloatArray = field(init=False, repr=False)
@@ -99,6 +115,7 @@ class CurvePiece(Piece):
     _dtau: FloatArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "direction", as_direction("direction", self.direction))
         b = np.asarray(self.curve.breaks, dtype=np.float64)
         frac = np.linspace(0.0, 1.0, _TABLE_SPLIT + 1)[:-1]
         coarse = np.append((b[:-1, None] + np.diff(b)[:, None] * frac[None, :]).ravel(), b[-1])
@@ -119,8 +136,9 @@ class CurvePiece(Piece):
                 f"{coarse[i]:.6g}; the waypoints or control points double back — split the "
                 "path there"
             )
-        # Unwrapped headings at the table nodes anchor a continuous heading(u).
-        theta = np.unwrap(np.arctan2(d1[:, 1], d1[:, 0]))
+        # Unwrapped headings at the table nodes anchor a continuous heading(u); a vehicle
+        # driving the curve in reverse faces the other way.
+        theta = np.unwrap(np.arctan2(d1[:, 1], d1[:, 0])) + (np.pi if self.direction < 0 else 0.0)
         set_ = object.__setattr__
         set_(self, "_tau", tau)
         set_(self, "_arc", arc)
@@ -229,7 +247,7 @@ class CurvePiece(Piece):
         flat, j = self._cell(u)
         tau = self._parameter(flat, j)
         r, d1, d2 = self.curve(tau, 0), self.curve(tau, 1), self.curve(tau, 2)
-        raw = np.arctan2(d1[:, 1], d1[:, 0])
+        raw = np.arctan2(d1[:, 1], d1[:, 0]) + (np.pi if self.direction < 0 else 0.0)
         # Nearest 2π-branch to the heading interpolated in the table cell.
         w = (flat - self._arc[j]) / np.maximum(self._arc[j + 1] - self._arc[j], 1e-300)
         ref = (1.0 - w) * self._theta[j] + w * self._theta[j + 1]
@@ -243,7 +261,7 @@ class CurvePiece(Piece):
         return self.curve(self.parameter(u), 0).reshape(*np.shape(u), 2)
 
     def heading(self, u: FloatArray) -> FloatArray:
-        """Direction of ``r'(τ)`` [rad], continuous along the piece."""
+        """Direction of ``r'(τ)`` (+ π in reverse) [rad], continuous along the piece."""
         return self.evaluate(u)[1]
 
     def curvature(self, u: FloatArray) -> FloatArray:
@@ -253,31 +271,45 @@ class CurvePiece(Piece):
 
 @dataclass(frozen=True, eq=False)
 class ReversedPiece(Piece):
-    """``piece`` travelled backwards: heading turned by π, curvature negated."""
+    """``piece`` travelled backwards: curvature negated.
+
+    By default its direction flag is kept and the heading turned by π (the vehicle faces the
+    new direction of travel if it did the old one); ``swap_direction=True`` flips the flag and
+    keeps the heading (the vehicle retraces its poses backwards).
+    """
 
     piece: Piece
+    swap_direction: bool = False
 
     @property
     def length(self) -> float:  # type: ignore[override]
         """Length of the underlying piece [m]."""
         return self.piece.length
 
+    @property
+    def direction(self) -> int:  # type: ignore[override]
+        """Direction of travel: the piece's, flipped if ``swap_direction``."""
+        return -self.piece.direction if self.swap_direction else self.piece.direction
+
     def _mirror(self, u: FloatArray) -> FloatArray:
         out: FloatArray = self.piece.length - np.asarray(u, dtype=np.float64)
         return out
 
+    def _turn(self) -> float:
+        return 0.0 if self.swap_direction else np.pi
+
     def evaluate(self, u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``(point, heading, curvature)`` travelled backwards."""
         xy, theta, kappa = self.piece.evaluate(self._mirror(u))
-        return xy, theta + np.pi, -kappa
+        return xy, theta + self._turn(), -kappa
 
     def point(self, u: FloatArray) -> FloatArray:
         """Positions, travelled backwards [m]."""
         return self.piece.point(self._mirror(u))
 
     def heading(self, u: FloatArray) -> FloatArray:
-        """Headings turned by π [rad]."""
-        out: FloatArray = self.piece.heading(self._mirror(u)) + np.pi
+        """Headings turned by π (kept if ``swap_direction``) [rad]."""
+        out: FloatArray = self.piece.heading(self._mirror(u)) + self._turn()
         return out
 
     def curvature(self, u: FloatArray) -> FloatArray:
@@ -285,6 +317,8 @@ class ReversedPiece(Piece):
         out: FloatArray = -self.piece.curvature(self._mirror(u))
         return out
 
-    def reversed(self) -> Piece:
-        """The original piece."""
-        return self.piece
+    def reversed(self, swap_direction: bool = False) -> Piece:
+        """The original piece when reversed the same way; otherwise a nested reversal."""
+        if swap_direction == self.swap_direction:
+            return self.piece
+        return ReversedPiece(self, swap_direction)

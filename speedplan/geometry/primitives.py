@@ -1,5 +1,10 @@
 """Line, arc and clothoid segments, and the piece that evaluates them exactly.
 
+Every segment and piece may be driven in reverse (``reverse=True`` / ``direction=-1``): the
+vehicle's heading ``θ`` is then opposite to its direction of travel, which is
+``direction · (cos θ, sin θ)``; the curvature is that of the curve traversed in the direction
+of travel, and the heading changes at the rate of the curvature in both directions.
+
 A clothoid has curvature linear in arc length, so its heading is quadratic and its position
 is ``∫ (cos θ, sin θ)``, a (generalised) Fresnel integral. :class:`ClothoidPiece` evaluates it
 by Gauss–Legendre quadrature on cells over which the heading turns by at most 0.25 rad: 16
@@ -18,6 +23,7 @@ import numpy as np
 
 from ..core.checks import FloatArray, as_scalar
 from ..core.errors import InvalidInputError
+from ._checks import as_direction, as_reverse
 from .pieces import GAUSS_NODES, GAUSS_WEIGHTS, Piece
 
 __all__ = ["Arc", "Clothoid", "ClothoidPiece", "Line", "Segment", "as_segment", "segment_piece"]
@@ -34,18 +40,24 @@ class Line:
     ----------
     length : float
         Length [m], > 0.
+    reverse : bool
+        Driven in reverse (default ``False``): the vehicle moves opposite to its heading.
 
     Examples
     --------
     >>> from speedplan.geometry import Line, Path
     >>> Path.from_segments([Line(3.0)]).point(3.0).tolist()
     [3.0, 0.0]
+    >>> Path.from_segments([Line(3.0), Line(1.0, reverse=True)]).point(4.0).tolist()
+    [2.0, 0.0]
     """
 
     length: float
+    reverse: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "length", as_scalar("length", self.length, positive=True))
+        object.__setattr__(self, "reverse", as_reverse("reverse", self.reverse))
 
 
 @dataclass(frozen=True)
@@ -59,6 +71,9 @@ class Arc:
     angle : float
         Angle turned [rad], non-zero; its sign gives the direction (left positive). The arc
         length is ``radius * |angle|`` and the curvature ``sign(angle) / radius``.
+    reverse : bool
+        Driven in reverse (default ``False``); the curvature is that of the arc traversed in
+        the direction of travel and the vehicle's heading still changes by ``angle``.
 
     Examples
     --------
@@ -71,6 +86,7 @@ class Arc:
 
     radius: float
     angle: float
+    reverse: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "radius", as_scalar("radius", self.radius, positive=True))
@@ -78,6 +94,7 @@ class Arc:
         if angle == 0.0:
             raise InvalidInputError("`angle` of an Arc must be non-zero; use a Line instead")
         object.__setattr__(self, "angle", angle)
+        object.__setattr__(self, "reverse", as_reverse("reverse", self.reverse))
 
 
 @dataclass(frozen=True)
@@ -89,7 +106,10 @@ class Clothoid:
     length : float
         Length [m], > 0.
     k0, k1 : float
-        Signed curvature at the start and at the end [1/m] (positive: turning left).
+        Signed curvature at the start and at the end [1/m] (positive: turning left), of the
+        curve traversed in the direction of travel.
+    reverse : bool
+        Driven in reverse (default ``False``).
 
     Examples
     --------
@@ -102,11 +122,13 @@ class Clothoid:
     length: float
     k0: float
     k1: float
+    reverse: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "length", as_scalar("length", self.length, positive=True))
         object.__setattr__(self, "k0", as_scalar("k0", self.k0))
         object.__setattr__(self, "k1", as_scalar("k1", self.k1))
+        object.__setattr__(self, "reverse", as_reverse("reverse", self.reverse))
 
 
 Segment = Line | Arc | Clothoid
@@ -121,8 +143,9 @@ _FIELDS: dict[str, tuple[type[Line] | type[Arc] | type[Clothoid], tuple[str, ...
 def as_segment(seg: Any, name: str) -> Segment:
     """A :class:`Line`, :class:`Arc` or :class:`Clothoid` from itself or from a dict.
 
-    Dicts carry ``"type"`` (``"line"``, ``"arc"`` or ``"clothoid"``) and the fields of that
-    class. Errors name the argument, e.g. ``segments[2].radius``.
+    Dicts carry ``"type"`` (``"line"``, ``"arc"`` or ``"clothoid"``), the fields of that
+    class and optionally ``"reverse"`` (``true`` for a piece driven in reverse). Errors name
+    the argument, e.g. ``segments[2].radius``.
     """
     if isinstance(seg, Line | Arc | Clothoid):
         return seg
@@ -139,11 +162,13 @@ def as_segment(seg: Any, name: str) -> Segment:
     missing = [f for f in names if f not in seg]
     if missing:
         raise InvalidInputError(f"`{name}` ({kind}) lacks the field(s) {missing}")
-    unknown = sorted(set(seg) - set(names) - {"type"})
+    unknown = sorted(set(seg) - set(names) - {"type", "reverse"})
     if unknown:
         raise InvalidInputError(f"`{name}` ({kind}) has unknown field(s) {unknown}")
+    fields: dict[str, Any] = {f: seg[f] for f in names}
+    fields["reverse"] = seg.get("reverse", False)
     try:
-        return cls(*(seg[f] for f in names))
+        return cls(**fields)
     except InvalidInputError as exc:
         # Prefix the field name with the segment's position: `length` -> `segments[0].length`.
         raise InvalidInputError(str(exc).replace("`", f"`{name}.", 1)) from exc
@@ -151,10 +176,12 @@ def as_segment(seg: Any, name: str) -> Segment:
 
 @dataclass(frozen=True, eq=False)
 class ClothoidPiece(Piece):
-    """Curvature ``k0 + (k1 - k0) u / length`` from ``start`` with heading ``theta0``.
+    """Curvature ``k0 + (k1 - k0) u / length`` from ``start`` with (vehicle) heading ``theta0``.
 
-    Positions are tabulated at cell boundaries (heading turn <= 0.25 rad per cell); a query
-    adds a 16-point Gauss–Legendre integral from its cell's start, accurate to rounding.
+    ``direction = -1`` drives it in reverse: the travel tangent is ``direction · (cos θ,
+    sin θ)``. Positions are tabulated at cell boundaries (heading turn <= 0.25 rad per cell);
+    a query adds a 16-point Gauss–Legendre integral from its cell's start, accurate to
+    rounding.
     """
 
     start: tuple[float, float]
@@ -162,10 +189,12 @@ class ClothoidPiece(Piece):
     length: float
     k0: float
     k1: float
+    direction: int = 1
     _knots: FloatArray = field(init=False, repr=False)
     _knot_xy: FloatArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "direction", as_direction("direction", self.direction))
         turn = max(abs(self.k0), abs(self.k1)) * self.length
         m = int(np.clip(np.ceil(turn / _CELL_TURN), 1, 1_000_000))
         knots = np.linspace(0.0, self.length, m + 1)
@@ -178,11 +207,11 @@ class ClothoidPiece(Piece):
 
     @property
     def end(self) -> tuple[FloatArray, float]:
-        """End point [m] and end heading [rad]."""
+        """End point [m] and end (vehicle) heading [rad]."""
         return self._knot_xy[-1].copy(), float(self.heading(np.array(self.length)))
 
     def heading(self, u: FloatArray) -> FloatArray:
-        """Heading ``θ0 + k0 u + (k1 - k0) u² / (2 length)`` [rad]."""
+        """Vehicle heading ``θ0 + k0 u + (k1 - k0) u² / (2 length)`` [rad]."""
         u = np.asarray(u, dtype=np.float64)
         sharpness = (self.k1 - self.k0) / self.length
         out: FloatArray = self.theta0 + u * (self.k0 + 0.5 * sharpness * u)
@@ -195,8 +224,9 @@ class ClothoidPiece(Piece):
         return out
 
     def _integrate(self, a: FloatArray, b: FloatArray) -> FloatArray:
-        width = (b - a)[:, None]
-        th = self.heading(a[:, None] + width * GAUSS_NODES[None, :])
+        """Displacements from ``a`` to ``b`` (direction of travel included)."""
+        width = (b - a)[:, None] * self.direction
+        th = self.heading(a[:, None] + (b - a)[:, None] * GAUSS_NODES[None, :])
         return np.column_stack(((np.cos(th) * width) @ GAUSS_WEIGHTS,
                                 (np.sin(th) * width) @ GAUSS_WEIGHTS))
 
@@ -204,7 +234,7 @@ class ClothoidPiece(Piece):
         """Positions: the cell start's position plus a quadrature from it [m]."""
         u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
         if self.k0 == 0.0 and self.k1 == 0.0:  # a line: exact, no quadrature rounding
-            direction = np.array([np.cos(self.theta0), np.sin(self.theta0)])
+            direction = self.direction * np.array([np.cos(self.theta0), np.sin(self.theta0)])
             line: FloatArray = np.asarray(self.start) + u[..., None] * direction
             return line
         flat = u.ravel()
@@ -212,18 +242,25 @@ class ClothoidPiece(Piece):
         out = self._knot_xy[j] + self._integrate(self._knots[j], flat)
         return out.reshape(*u.shape, 2)
 
-    def reversed(self) -> ClothoidPiece:
-        """The same clothoid from its end: heading + π, curvature from ``-k1`` to ``-k0``."""
+    def reversed(self, swap_direction: bool = False) -> ClothoidPiece:
+        """The same clothoid from its end, curvature from ``-k1`` to ``-k0``.
+
+        Heading + π and the same direction flag by default; with ``swap_direction`` the
+        heading is kept and the direction flag flipped (see :meth:`Piece.reversed`).
+        """
         end, theta = self.end
-        return ClothoidPiece((float(end[0]), float(end[1])), theta + np.pi, self.length,
-                             -self.k1, -self.k0)
+        turn = 0.0 if swap_direction else np.pi
+        return ClothoidPiece((float(end[0]), float(end[1])), theta + turn, self.length,
+                             -self.k1, -self.k0,
+                             -self.direction if swap_direction else self.direction)
 
 
 def segment_piece(seg: Segment, start: tuple[float, float], theta0: float) -> ClothoidPiece:
-    """The piece of ``seg`` starting at ``start`` with heading ``theta0`` [rad]."""
+    """The piece of ``seg`` starting at ``start`` with vehicle heading ``theta0`` [rad]."""
+    d = -1 if seg.reverse else 1
     if isinstance(seg, Line):
-        return ClothoidPiece(start, theta0, seg.length, 0.0, 0.0)
+        return ClothoidPiece(start, theta0, seg.length, 0.0, 0.0, d)
     if isinstance(seg, Arc):
         k = float(np.sign(seg.angle)) / seg.radius
-        return ClothoidPiece(start, theta0, seg.radius * abs(seg.angle), k, k)
-    return ClothoidPiece(start, theta0, seg.length, seg.k0, seg.k1)
+        return ClothoidPiece(start, theta0, seg.radius * abs(seg.angle), k, k, d)
+    return ClothoidPiece(start, theta0, seg.length, seg.k0, seg.k1, d)
