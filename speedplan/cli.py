@@ -309,12 +309,12 @@ def _run_plan(args: argparse.Namespace, pathfile: str | FsPath) -> int:
     out_format = _output_format(args)
     _check_plot(args.plot)
     info: IO[str] = sys.stderr if args.output == "-" else sys.stdout
-    path, zones, name = _read_input(args, pathfile)
     limits = Limits(v_max=args.v_max, a_max=args.a_max, a_lat_max=args.a_lat_max,
                     j_max=args.j_max, a_decel=args.a_decel)
-    t0 = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
+    with warnings.catch_warnings(record=True) as caught:  # printed as one line each, below
         warnings.simplefilter("always")
+        path, zones, name = _read_input(args, pathfile)
+        t0 = time.perf_counter()
         profile = plan(path, limits, n=args.n, ds=args.ds, v0=args.v0, a0=args.a0, vf=args.vf,
                        af=args.af, zones=zones or None, standstill=args.standstill,
                        backend=args.backend, refine=args.refine)

@@ -190,3 +190,12 @@ def test_main_reads_a_stream_in_process(monkeypatch, capsys, root):
     monkeypatch.setattr(sys, "stdin", io.StringIO((root / "paths" / "u_turn.json").read_text()))
     assert cli.main(["plan", "-", *LGV_ARGS]) == 0
     assert "path      <stdin>" in capsys.readouterr().out
+
+
+def test_file_warnings_are_one_line_messages(tmp_path):
+    f = tmp_path / "ros.csv"
+    f.write_text("frame_id,x,y\nmap,0,0\nmap,10,0\n")
+    res = run("plan", str(f), *LGV_ARGS)
+    assert res.returncode == 0, res.stderr
+    assert "warning: ros.csv: ignored columns ['frame_id']" in res.stderr
+    assert "SpeedplanWarning" not in res.stderr  # not Python's file:line: Category: format
