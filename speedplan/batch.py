@@ -4,26 +4,55 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Callable, Iterable, Mapping
+import threading
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
-from .core.errors import InvalidInputError
+from .core.checks import shown
+from .core.errors import InvalidInputError, SpeedplanError
+from .core.log import logger
 from .model import PlanRequest
 from .plan import plan_request
 from .timing import SpeedProfile
 
-__all__ = ["BatchResult", "plan_many"]
+__all__ = ["BatchResult", "JobWarning", "plan_many"]
+
+
+class JobWarning(NamedTuple):
+    """A warning issued while a job ran: the name of its category and its message."""
+
+    category: str
+    message: str
 
 
 @dataclass(frozen=True)
 class BatchResult:
-    """Outcome of one job: ``profile`` on success, else ``error`` (the exception raised)."""
+    """Outcome of one job: ``profile`` on success, else ``error`` (the exception raised).
+
+    Attributes
+    ----------
+    index : int
+        Position of the job in ``jobs``.
+    profile : SpeedProfile or None
+        The plan, when the job succeeded.
+    error : BaseException or None
+        The exception the job raised.
+    warnings : tuple of JobWarning
+        The warnings issued while the job ran (e.g. ``("LimitWarning", "...")``), captured
+        in the worker, where they would otherwise go to the worker's stderr or nowhere.
+        Empty for jobs refused before they were sent and for jobs that failed with an
+        exception that is not a :class:`~speedplan.SpeedplanError` (a bug: its traceback
+        is kept instead).
+    """
 
     index: int
     profile: SpeedProfile | None
     error: BaseException | None
+    warnings: tuple[JobWarning, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -31,6 +60,77 @@ class BatchResult:
         return self.error is None
 
 
+class _Outcome(NamedTuple):
+    profile: SpeedProfile | None
+    error: SpeedplanError | None
+    warnings: tuple[JobWarning, ...]
+
+
+# ---- warnings of a job --------------------------------------------------------------------
+# Before Python 3.14 the warnings filters and ``showwarning`` are process-wide, and
+# ``catch_warnings`` saves and restores them: two threads using it at once (a thread pool, a
+# dask worker's threads) may leave the process with a dead recorder in place of
+# ``showwarning``. So one capture is installed while any job of this process runs, and
+# routes each warning to the list of the thread that issued it.
+_lock = threading.Lock()
+_active = 0
+_context: Any = None
+_show_before: Callable[..., None] | None = None
+_local = threading.local()
+
+
+def _route(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+           file: Any = None, line: str | None = None) -> None:
+    sink = getattr(_local, "sink", None)
+    if sink is not None:
+        sink.append(JobWarning(category.__name__, str(message)))
+    elif _show_before is not None:  # another thread's warning: shown as it would have been
+        _show_before(message, category, filename, lineno, file, line)
+
+
+@contextmanager
+def _captured_warnings() -> Iterator[list[JobWarning]]:
+    """Record every warning this thread issues inside the block (filter ``"always"``)."""
+    global _active, _context, _show_before
+    records: list[JobWarning] = []
+    if getattr(sys.flags, "context_aware_warnings", False):  # Python >= 3.14: per context
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            yield records
+        records.extend(JobWarning(w.category.__name__, str(w.message)) for w in caught)
+        return
+    with _lock:
+        if _active == 0:
+            _context = warnings.catch_warnings()
+            _context.__enter__()
+            warnings.simplefilter("always")  # a repeated warning is still this job's warning
+            _show_before = warnings.showwarning
+            warnings.showwarning = _route
+        _active += 1
+    outer = getattr(_local, "sink", None)
+    _local.sink = records
+    try:
+        yield records
+    finally:
+        _local.sink = outer
+        with _lock:
+            _active -= 1
+            if _active == 0:
+                _context.__exit__(None, None, None)  # restores filters and showwarning
+                _context = _show_before = None
+
+
+def _run_job(request: PlanRequest) -> _Outcome:
+    """The worker: ``plan_request(request)`` with the warnings it issues."""
+    with _captured_warnings() as caught:
+        try:
+            profile = plan_request(request)
+        except SpeedplanError as exc:
+            return _Outcome(None, exc, tuple(caught))
+    return _Outcome(profile, None, tuple(caught))
+
+
+# ---- the batch ------------------------------------------------------------------------------
 def _normalise(job: Any, index: int) -> dict[str, Any]:
     if isinstance(job, Mapping):
         kwargs = dict(job)
@@ -46,6 +146,24 @@ def _normalise(job: Any, index: int) -> dict[str, Any]:
     return kwargs
 
 
+def _job_list(jobs: Any) -> list[Any]:
+    if isinstance(jobs, Mapping):
+        raise InvalidInputError(
+            "`jobs` must be an iterable of jobs; got a single dict: wrap it in a list, "
+            "plan_many([job])"
+        )
+    if isinstance(jobs, str | bytes):
+        raise InvalidInputError(f"`jobs` must be an iterable of jobs; got {shown(jobs)}")
+    try:
+        return list(jobs)
+    except TypeError as exc:
+        raise InvalidInputError(
+            "`jobs` must be an iterable (list, generator) of dicts {'path': ..., 'limits': ..., "
+            "**plan_kwargs} or tuples (path, limits[, kwargs]); got "
+            f"{type(jobs).__name__}"
+        ) from exc
+
+
 def _request(kwargs: dict[str, Any]) -> PlanRequest:
     kw = dict(kwargs)
     return PlanRequest.create(kw.pop("path"), kw.pop("limits"), **kw)
@@ -54,6 +172,20 @@ def _request(kwargs: dict[str, Any]) -> PlanRequest:
 def _print_progress(done: int, total: int) -> None:
     print(f"\rplanned {done}/{total}", end="" if done < total else "\n", file=sys.stderr,
           flush=True)
+
+
+def _common_failure(results: list[BatchResult], shipped: Iterable[int]) -> BaseException | None:
+    """The error every shipped job failed with, if they all failed the same non-speedplan way.
+
+    That is the executor failing (a pickling error, a process pool broken because workers
+    cannot import the main module), not the jobs.
+    """
+    errors = [results[i].error for i in shipped]
+    if not errors or any(e is None or isinstance(e, SpeedplanError) for e in errors):
+        return None
+    first = errors[0]
+    same = all(type(e) is type(first) and str(e) == str(first) for e in errors)
+    return first if same else None
 
 
 def plan_many(
@@ -79,6 +211,26 @@ def plan_many(
     -------
     list of BatchResult
         One per job, in order; a failed job carries its exception and the others still run.
+        Each result carries the warnings its job issued (``BatchResult.warnings``).
+
+    Raises
+    ------
+    InvalidInputError
+        ``jobs`` is not an iterable of jobs, or ``executor`` is not an executor.
+    SpeedplanError
+        Every job sent to the executor failed with the same error that is not a speedplan
+        error: the executor could not run them (see Notes). The error is chained.
+
+    Notes
+    -----
+    Process pools under the ``spawn`` or ``forkserver`` start method (the default on macOS
+    and Windows, and on Linux from Python 3.14) import the main module in every worker. A
+    script must therefore call ``plan_many`` under ``if __name__ == "__main__":``; without
+    it the workers fail to start and ``plan_many`` raises instead of returning a list of
+    failures.
+
+    With a thread-based executor, a warning issued by another thread of the program while
+    jobs run is shown even if a filter would normally hide a repeat of it.
 
     Examples
     --------
@@ -88,10 +240,15 @@ def plan_many(
     >>> jobs = [(Path.from_waypoints([[0, 0], [L, 0]], kind="polyline"), lim) for L in (5, 10)]
     >>> with ThreadPoolExecutor(2) as ex:
     ...     results = plan_many(jobs, ex)
-    >>> [r.ok for r in results]
-    [True, True]
+    >>> [r.ok for r in results], results[0].warnings
+    ([True, True], ())
     """
-    normalised = [_normalise(job, i) for i, job in enumerate(jobs)]
+    normalised = [_normalise(job, i) for i, job in enumerate(_job_list(jobs))]
+    if executor is not None and not callable(getattr(executor, "submit", None)):
+        raise InvalidInputError(
+            "`executor` must be a concurrent.futures.Executor (something with submit()); got "
+            f"{type(executor).__name__}"
+        )
     total = len(normalised)
     report = _print_progress if progress is True else (progress or None)
     results: list[BatchResult | None] = [None] * total
@@ -101,6 +258,7 @@ def plan_many(
         try:
             requests[i] = _request(kwargs)
         except (InvalidInputError, TypeError) as exc:
+            logger.debug("plan_many: job %d refused before sending: %s", i, exc)
             results[i] = BatchResult(i, None, exc)
     done = total - len(requests)
     if report is not None and done:
@@ -110,17 +268,32 @@ def plan_many(
         ProcessPoolExecutor(max_workers=os.cpu_count()) if requests else None)
     try:
         if ex is not None:
-            futures = {ex.submit(plan_request, req): i for i, req in requests.items()}
+            futures = {ex.submit(_run_job, req): i for i, req in requests.items()}
             for fut in as_completed(futures):
                 i = futures[fut]
                 try:
-                    results[i] = BatchResult(i, fut.result(), None)
+                    outcome = fut.result()
+                    result = BatchResult(i, outcome.profile, outcome.error, outcome.warnings)
                 except Exception as exc:  # one job's failure must not lose the others
-                    results[i] = BatchResult(i, None, exc)
+                    result = BatchResult(i, None, exc)
+                if result.error is not None:
+                    logger.debug("plan_many: job %d failed: %r", i, result.error)
+                results[i] = result
                 done += 1
                 if report is not None:
                     report(done, total)
     finally:
         if own and ex is not None:
             ex.shutdown()
-    return [r for r in results if r is not None]
+    out = [r for r in results if r is not None]
+    common = _common_failure(out, requests)
+    if common is not None:
+        raise SpeedplanError(
+            f"plan_many: all {len(requests)} jobs sent to the executor failed with the same "
+            f"error, {type(common).__name__}: {str(common).rstrip('.')}. The executor could "
+            "not run them. With "
+            "a process pool under the 'spawn' or 'forkserver' start method (macOS, Windows), "
+            'call plan_many under `if __name__ == "__main__":` in your script; also check that '
+            "the jobs can be pickled"
+        ) from common
+    return out

@@ -1,33 +1,96 @@
 """Command line: ``speedplan plan``, ``speedplan demo``, ``speedplan bench``.
 
-Exit codes: 0 success; 2 bad arguments or unreadable input; 3 infeasible request;
-4 solver failure; 5 limits exceeded beyond tolerance (only with ``--strict``).
+Exit codes: 0 planned; 2 bad arguments or unreadable input; 3 infeasible request; 4 solver
+failure; 5 limits exceeded (status ``"limits_exceeded"``, or with ``--strict`` any limit
+beyond tolerance in ``verify()``).
 """
 
 from __future__ import annotations
 
 import argparse
+import io
+import logging
+import math
+import os
 import sys
 import time
 import warnings
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path as FsPath
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._version import __version__
 from .core.errors import (
     InfeasibleError,
     InvalidInputError,
-    LimitWarning,
     SolverError,
     SpeedplanError,
 )
 from .core.limits import Limits
+from .core.log import logger
+from .solve import BACKENDS, REFINE_MODES
 
-__all__ = ["EXIT_CODES", "main"]
+if TYPE_CHECKING:
+    from .timing import SpeedProfile, Trajectory
+
+__all__ = ["EXIT_CODES", "exit_status", "main"]
 
 EXIT_CODES = {"ok": 0, "usage": 2, "infeasible": 3, "solver": 4, "limits": 5}
 DEMO_PATH = "warehouse_loop.json"
+DEMO_LIMITS = {"v_max": 2.0, "a_max": 1.0, "a_lat_max": 1.0, "j_max": 0.5}
+TRAJECTORY_FORMATS = ("csv", "json")
+STANDSTILL_HELP = {
+    "smooth": "acceleration 0 at a standstill, jerk-limited from the first instant",
+    "free": "the paper's model: the acceleration may jump at a standstill",
+}
+
+EPILOG = """\
+exit codes:
+  0  planned (status optimal, refined, scaled or relaxed)
+  2  bad arguments or unreadable input (the message names the argument or file)
+  3  infeasible request (the message says which constraint and where)
+  4  a solver failed and no feasible profile could be produced
+  5  limits exceeded: status limits_exceeded (the trajectory exceeds a limit beyond
+     tolerance even after local refinement), or with --strict any verify() failure;
+     the output files are still written
+"""
+
+
+class _HelpFormatter(argparse.HelpFormatter):
+    """Show ``(default: ...)`` for every option that has a default worth showing.
+
+    Texts with line breaks (the exit-code table) are kept as written; others are wrapped.
+    """
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        if "\n" in text:
+            return "".join(indent + line for line in text.splitlines(keepends=True))
+        return super()._fill_text(text, width, indent)
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        hidden = action.default is None or action.default is False \
+            or action.default == argparse.SUPPRESS
+        if "%(default)" not in text and not hidden and action.option_strings:
+            text += " (default: %(default)s)"
+        return text
+
+
+def _positive(kind: type[float] | type[int]) -> Any:
+    def parse(text: str) -> float | int:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a {kind.__name__}; got {text!r}") from None
+        if not (math.isfinite(value) and value > 0):
+            raise argparse.ArgumentTypeError(f"must be a finite number > 0; got {text!r}")
+        return value
+
+    parse.__name__ = f"positive {kind.__name__}"
+    return parse
 
 
 def _bundled_paths_dir() -> FsPath:
@@ -47,9 +110,51 @@ def _add_limits(p: argparse.ArgumentParser, defaults: dict[str, float] | None = 
                         ("j-max", "jerk limit [m/s³]")):
         key = flag.replace("-", "_")
         g.add_argument(f"--{flag}", type=float, required=key not in d, default=d.get(key),
-                       help=help_)
-    g.add_argument("--a-decel", type=float, default=None,
-                   help="braking limit [m/s²] (default a-max)")
+                       metavar="X", help=help_ + ("" if key in d else " (required)"))
+    g.add_argument("--a-decel", type=float, default=None, metavar="X",
+                   help="braking limit [m/s²] (default: a-max)")
+
+
+def _add_common(p: argparse.ArgumentParser, out: str | None = None,
+                plot: str | None = None) -> None:
+    g = p.add_argument_group("boundary states")
+    g.add_argument("--v0", type=float, default=0.0, metavar="V", help="start speed [m/s]")
+    g.add_argument("--a0", type=float, default=0.0, metavar="A",
+                   help="start acceleration [m/s²]")
+    g.add_argument("--vf", type=float, default=0.0, metavar="V", help="end speed [m/s]")
+    g.add_argument("--af", type=float, default=0.0, metavar="A", help="end acceleration [m/s²]")
+    g.add_argument("--standstill", choices=tuple(STANDSTILL_HELP), default="smooth",
+                   help="model at a standstill: "
+                   + "; ".join(f"{k}: {v}" for k, v in STANDSTILL_HELP.items()))
+    g = p.add_argument_group("solver")
+    g.add_argument("--n", type=_positive(int), default=None, metavar="N",
+                   help="uniform grid with N nodes (default: adaptive grid)")
+    g.add_argument("--ds", type=_positive(float), default=None, metavar="DS",
+                   help="uniform grid step [m] (default: adaptive grid)")
+    g.add_argument("--backend", choices=BACKENDS, default="auto",
+                   help="relaxation solver: banded interior point or Clarabel")
+    g.add_argument("--refine", choices=REFINE_MODES, default="auto",
+                   help="IPOPT refinement: auto = only when the relaxation is not exact")
+    g.add_argument("--strict", action="store_true",
+                   help="exit 5 if verify() finds any limit exceeded beyond its tolerance")
+    g = p.add_argument_group("output")
+    g.add_argument("--dt", type=_positive(float), default=0.01,
+                   help="trajectory sampling period [s]")
+    g.add_argument("-o", "--output", default=out, metavar="FILE",
+                   help="trajectory file: .csv or .json, or - for standard output (the "
+                   "summary then goes to standard error); '' writes none")
+    g.add_argument("--output-format", choices=TRAJECTORY_FORMATS, default=None,
+                   help="format of the trajectory on standard output (default: csv)")
+    g.add_argument("--plot", default=plot, metavar="FIG",
+                   help="figure file; its extension (.png, .svg, .pdf, ...) sets the format; "
+                   "'' writes none")
+    g.add_argument("--dpi", type=_positive(float), default=150,
+                   help="resolution of raster figures [dots per inch]")
+
+
+def _add_verbose(p: argparse.ArgumentParser, default: Any) -> None:
+    p.add_argument("-v", "--verbose", action="store_true", default=default,
+                   help="debug messages (files read and written, solver steps) on stderr")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -57,105 +162,282 @@ def _parser() -> argparse.ArgumentParser:
         prog="speedplan",
         description="Minimum-time speed planning along a path under speed, acceleration, "
         "lateral-acceleration and jerk limits.",
-        epilog="exit codes: 0 ok, 2 bad input, 3 infeasible, 4 solver failure, "
-        "5 limits exceeded (--strict)",
+        epilog=EPILOG, formatter_class=_HelpFormatter,
     )
-    sub = ap.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("plan", help="plan a path file (CSV waypoints, JSON segments, VDA 5050)")
-    p.add_argument("pathfile", help="path file: .csv waypoints, .json segments or VDA 5050 NURBS")
+    ap.add_argument("--version", action="version", version=f"speedplan {__version__}")
+    _add_verbose(ap, False)
+    sub = ap.add_subparsers(dest="command", required=True, metavar="{plan,demo,bench}")
+    p = sub.add_parser(
+        "plan", help="plan a path file (CSV waypoints, JSON segments, VDA 5050)",
+        description="Plan the minimum-time speed law along a path file and report it.",
+        epilog=EPILOG, formatter_class=_HelpFormatter)
+    p.add_argument("pathfile",
+                   help="path file: .csv waypoints, .json segments or VDA 5050 NURBS; - reads "
+                   "standard input")
+    p.add_argument("--format", choices=("csv", "json"), default=None,
+                   help="format of the path file (default: from the extension; on standard "
+                   "input from the first character, { or [ meaning JSON)")
     _add_limits(p)
     _add_common(p)
-    d = sub.add_parser("demo", help="plan the bundled warehouse loop; write a trajectory and plot")
-    _add_limits(d, {"v_max": 2.0, "a_max": 1.0, "a_lat_max": 1.0, "j_max": 0.5})
+    _add_verbose(p, argparse.SUPPRESS)
+    limits = ", ".join(f"{k.replace('_', '-')} {v:g}" for k, v in DEMO_LIMITS.items())
+    d = sub.add_parser(
+        "demo", help="plan the bundled warehouse loop; write a trajectory and a figure",
+        description=f"Plan the bundled warehouse loop ({DEMO_PATH}) with LGV limits "
+        f"({limits}) and write the trajectory and the figure.",
+        epilog=EPILOG, formatter_class=_HelpFormatter)
+    _add_limits(d, DEMO_LIMITS)
     _add_common(d, out="speedplan-demo.csv", plot="speedplan-demo.png")
-    b = sub.add_parser("bench", help="benchmark the solver on the paper's instance families")
-    b.add_argument("--instances", type=int, default=3, help="instances per family")
-    b.add_argument("--n", type=int, default=1000, help="grid size")
+    _add_verbose(d, argparse.SUPPRESS)
+    b = sub.add_parser(
+        "bench", help="benchmark the solver on the paper's instance families",
+        description="Solve random instances of the paper's 18 families and print, per "
+        "family, how many relaxations were not exact and the median solve times.",
+        formatter_class=_HelpFormatter)
+    b.add_argument("--instances", type=_positive(int), default=3, help="instances per family")
+    b.add_argument("--n", type=_positive(int), default=1000, help="grid size")
+    _add_verbose(b, argparse.SUPPRESS)
     return ap
 
 
-def _add_common(p: argparse.ArgumentParser, out: str | None = None,
-                plot: str | None = None) -> None:
-    p.add_argument("--v0", type=float, default=0.0, help="start speed [m/s]")
-    p.add_argument("--a0", type=float, default=0.0, help="start acceleration [m/s²]")
-    p.add_argument("--vf", type=float, default=0.0, help="end speed [m/s]")
-    p.add_argument("--af", type=float, default=0.0, help="end acceleration [m/s²]")
-    p.add_argument("--n", type=int, default=None, help="uniform grid with N nodes")
-    p.add_argument("--ds", type=float, default=None, help="uniform grid step [m]")
-    p.add_argument("--dt", type=float, default=0.01, help="trajectory sampling period [s]")
-    p.add_argument("--standstill", choices=("smooth", "free"), default="smooth")
-    p.add_argument("-o", "--output", default=out,
-                   help="trajectory file (.csv or .json)" + (f"; default {out}" if out else ""))
-    p.add_argument("--plot", default=plot, help="figure file (.png, .svg, .pdf)")
-    p.add_argument("--strict", action="store_true", help="exit 5 if a limit is exceeded")
+# ---- checks done before planning ------------------------------------------------------------
+def _writable(option: str, file: str) -> None:
+    folder = FsPath(file).parent
+    if not folder.is_dir():
+        raise InvalidInputError(
+            f"`{option}` {file!r}: directory {str(folder)!r} does not exist; create it first"
+        )
+    if not os.access(folder, os.W_OK):
+        raise InvalidInputError(f"`{option}` {file!r}: directory {str(folder)!r} is not "
+                                "writable")
+    if FsPath(file).is_dir():
+        raise InvalidInputError(f"`{option}` {file!r} is a directory; give a file name")
 
 
-def _run_plan(args: argparse.Namespace, pathfile: FsPath) -> int:
+def _output_format(args: argparse.Namespace) -> str | None:
+    """The trajectory format, after checking ``--output`` (None: no trajectory)."""
+    out, fmt = args.output, args.output_format
+    if not out:
+        if fmt is not None:
+            raise InvalidInputError("`--output-format` needs `-o -` (standard output)")
+        return None
+    if out == "-":
+        return fmt or "csv"
+    suffix = FsPath(out).suffix.lower().lstrip(".")
+    if suffix not in TRAJECTORY_FORMATS:
+        raise InvalidInputError(
+            f"`--output` {out!r}: unknown trajectory file type "
+            f"{FsPath(out).suffix or '(no extension)'}; use .csv or .json, or - for standard "
+            "output"
+        )
+    if fmt is not None and fmt != suffix:
+        raise InvalidInputError(
+            f"`--output-format` {fmt} contradicts the extension of `--output` {out!r}"
+        )
+    _writable("--output", out)
+    return suffix
+
+
+def _check_plot(file: str | None) -> None:
+    if not file:
+        return
+    try:
+        from matplotlib.backend_bases import FigureCanvasBase
+    except ImportError as exc:
+        raise InvalidInputError(
+            "`--plot` needs matplotlib: pip install 'speedplan[plot]'"
+        ) from exc
+    types = FigureCanvasBase.get_supported_filetypes()
+    suffix = FsPath(file).suffix.lower().lstrip(".")
+    if suffix not in types:
+        raise InvalidInputError(
+            f"`--plot` {file!r}: unknown figure type {FsPath(file).suffix or '(no extension)'}"
+            f"; use one of {', '.join('.' + t for t in sorted(types))}"
+        )
+    _writable("--plot", file)
+
+
+# ---- planning -------------------------------------------------------------------------------
+def _metadata(profile: SpeedProfile, args: argparse.Namespace, path_name: str | None
+              ) -> dict[str, Any]:
+    """What the trajectory file records about how it was made (for a reader, later)."""
+    meta: dict[str, Any] = {
+        "speedplan_version": __version__,
+        "path_file": path_name,
+        "status": profile.status,
+        "duration": profile.duration,
+        "objective": profile.objective,
+        "lower_bound": profile.lower_bound,
+        "gap": profile.gap,
+        "dt": args.dt,
+        "grid_nodes": int(profile.s.size),
+        "backend": profile.solution.backend,
+        "refined": profile.solution.refined,
+        "limits": profile.limits,
+        "boundary": {"v0": args.v0, "a0": args.a0, "vf": args.vf, "af": args.af},
+        "standstill": args.standstill,
+    }
+    return meta
+
+
+def _with_metadata(traj: Trajectory, meta: dict[str, Any]) -> Trajectory:
+    # What the planner filled in (when it does) wins over the command line's own account.
+    return replace(traj, metadata={**meta, **traj.metadata})
+
+
+def _read_input(args: argparse.Namespace, pathfile: str | FsPath) -> tuple[Any, Any, str]:
     from .io import read_path, read_zones
+
+    if str(pathfile) == "-":
+        text = sys.stdin.read()
+
+        def stream() -> io.StringIO:
+            buf = io.StringIO(text)
+            buf.name = "<stdin>"  # named in error messages
+            return buf
+
+        path = read_path(stream(), format=args.format)
+        return path, read_zones(stream(), format=args.format), "<stdin>"
+    fmt = getattr(args, "format", None)
+    return read_path(pathfile, format=fmt), read_zones(pathfile, format=fmt), \
+        FsPath(pathfile).name
+
+
+def _run_plan(args: argparse.Namespace, pathfile: str | FsPath) -> int:
     from .plan import plan
 
-    path = read_path(pathfile)
-    zones = read_zones(pathfile)
+    out_format = _output_format(args)
+    _check_plot(args.plot)
+    info: IO[str] = sys.stderr if args.output == "-" else sys.stdout
     limits = Limits(v_max=args.v_max, a_max=args.a_max, a_lat_max=args.a_lat_max,
                     j_max=args.j_max, a_decel=args.a_decel)
-    t0 = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", LimitWarning)
+    with warnings.catch_warnings(record=True) as caught:  # printed as one line each, below
+        warnings.simplefilter("always")
+        path, zones, name = _read_input(args, pathfile)
+        t0 = time.perf_counter()
         profile = plan(path, limits, n=args.n, ds=args.ds, v0=args.v0, a0=args.a0, vf=args.vf,
-                       af=args.af, zones=zones or None, standstill=args.standstill)
+                       af=args.af, zones=zones or None, standstill=args.standstill,
+                       backend=args.backend, refine=args.refine)
     elapsed = time.perf_counter() - t0
     check = profile.verification or profile.verify()
-    print(f"path      {pathfile.name}: {path.length:.3f} m, {profile.s.size} grid nodes")
-    print(f"duration  {profile.duration:.4f} s   (planned in {elapsed:.3f} s)")
-    print(f"status    {profile.status}   exact={profile.exact}   gap={profile.gap:.2e}")
-    print("realised maxima / limits:")
-    print("  " + check.summary().replace("\n", "\n  "))
-    if args.output:
-        traj = profile.sample(args.dt)
-        out = FsPath(args.output)
-        if out.suffix.lower() == ".json":
-            traj.to_json(out)
+    print(f"path      {name}: {path.length:.3f} m, {profile.s.size} grid nodes", file=info)
+    print(f"duration  {profile.duration:.4f} s   (planned in {elapsed:.3f} s)", file=info)
+    print(f"status    {profile.status}   exact={profile.exact}   gap={profile.gap:.2e}",
+          file=info)
+    print("realised maxima / limits:", file=info)
+    print("  " + check.summary().replace("\n", "\n  "), file=info)
+    if out_format is not None:
+        traj = _with_metadata(profile.sample(args.dt), _metadata(profile, args, name))
+        target: Any = sys.stdout if args.output == "-" else FsPath(args.output)
+        if out_format == "json":
+            traj.to_json(target)
+            if args.output == "-":
+                sys.stdout.write("\n")
         else:
-            traj.to_csv(out)
-        print(f"wrote     {out} ({len(traj)} samples every {args.dt} s)")
+            traj.to_csv(target)
+        where = "standard output" if args.output == "-" else args.output
+        print(f"wrote     {where} ({len(traj)} samples every {args.dt} s)", file=info)
     if args.plot:
         from .plot import plot_profile
 
-        plot_profile(profile, args.plot, dt=args.dt)
-        print(f"wrote     {args.plot}")
+        plot_profile(profile, args.plot, dt=args.dt, dpi=args.dpi)
+        print(f"wrote     {args.plot}", file=info)
     for w in caught:
         print(f"warning: {w.message}", file=sys.stderr)
-    if args.strict and not check.ok:
-        return EXIT_CODES["limits"]
-    return EXIT_CODES["ok"]
+    code, reason = exit_status(profile.status, check.violations, strict=args.strict)
+    if reason:
+        print(f"speedplan: {reason}", file=sys.stderr)
+    return code
+
+
+def exit_status(status: str, violations: dict[str, float], *, strict: bool = False
+                ) -> tuple[int, str | None]:
+    """Exit code of ``speedplan plan`` for a profile's status and ``verify()`` violations.
+
+    Returns the code and, when it is not 0, why.
+
+    Examples
+    --------
+    >>> from speedplan.cli import exit_status
+    >>> exit_status("optimal", {})
+    (0, None)
+    >>> exit_status("limits_exceeded", {"jerk": 1.31})[0]
+    5
+    >>> exit_status("optimal", {"jerk": 1.31})
+    (0, None)
+    >>> exit_status("optimal", {"jerk": 1.31}, strict=True)
+    (5, 'limits exceeded (--strict): jerk 1.310× the limit')
+    """
+    worst = ", ".join(f"{k} {r:.3f}× the limit" for k, r in violations.items())
+    if status == "limits_exceeded":
+        return EXIT_CODES["limits"], (
+            "limits exceeded: the trajectory exceeds a limit beyond its tolerance even after "
+            f"local refinement (status limits_exceeded{'; ' + worst if worst else ''})"
+        )
+    if strict and violations:
+        return EXIT_CODES["limits"], f"limits exceeded (--strict): {worst}"
+    return EXIT_CODES["ok"], None
 
 
 def _run_bench(args: argparse.Namespace) -> int:
     from .solve import solve_discrete
     from .solve.paper import FAMILIES, paper_instance
 
-    print(f"{'W':8s} {'A':5s} {'J':5s} {'non-exact':>9s} {'median time [s]':>16s}")
+    print(f"paper's families, {args.instances} random instance(s) each, n = {args.n}; wall-clock "
+          "medians:\n  relaxation [s]: setup + solve of the convex relaxation\n"
+          "  solve_discrete [s]: the whole call (relaxation, plus IPOPT when not exact)")
+    print(f"{'W':8s} {'A':5s} {'J':6s} {'non-exact':>9s} {'relaxation [s]':>15s} "
+          f"{'solve_discrete [s]':>19s}")
     for i, fam in enumerate(FAMILIES):
-        times, non_exact = [], 0
+        relax, total, non_exact = [], [], 0
         for k in range(args.instances):
             inst = paper_instance(*fam, n=args.n, seed=1000 * i + k)
             sol = solve_discrete(inst.w_max, inst.A, inst.J)
-            times.append(sol.relaxation.time if sol.relaxation else 0.0)
+            relax.append(sol.relaxation.time if sol.relaxation else 0.0)
+            total.append(sol.solve_time)
             non_exact += not sol.exact
-        print(f"{fam[0]:8s} {fam[1]:5s} {fam[2]:5s} {non_exact:>5d}/{args.instances:<3d} "
-              f"{float(np.median(times)):16.4f}   [{i + 1}/{len(FAMILIES)}]", flush=True)
+        print(f"{fam[0]:8s} {fam[1]:5s} {fam[2]:6s} {non_exact:>5d}/{args.instances:<3d} "
+              f"{float(np.median(relax)):15.4f} {float(np.median(total)):19.4f}   "
+              f"[{i + 1}/{len(FAMILIES)}]", flush=True)
     return EXIT_CODES["ok"]
+
+
+class _StderrHandler(logging.StreamHandler):  # type: ignore[type-arg]
+    """Writes to the current ``sys.stderr`` (tests and callers may swap it)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.setFormatter(logging.Formatter("speedplan %(levelname)s: %(message)s"))
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.stream = sys.stderr
+        super().emit(record)
+
+
+def _configure_logging(verbose: bool) -> None:
+    handlers = [h for h in logger.handlers if isinstance(h, _StderrHandler)]
+    if verbose and not handlers:
+        logger.addHandler(_StderrHandler())
+        logger.setLevel(logging.DEBUG)
+    elif not verbose:
+        for h in handlers:
+            logger.removeHandler(h)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``speedplan`` command; returns the exit code."""
     args = _parser().parse_args(argv)
+    _configure_logging(args.verbose)
     try:
         if args.command == "plan":
-            return _run_plan(args, FsPath(args.pathfile))
+            return _run_plan(args, args.pathfile)
         if args.command == "demo":
             return _run_plan(args, _bundled_paths_dir() / DEMO_PATH)
         return _run_bench(args)
+    except BrokenPipeError:  # the reader of our output left (e.g. `| head`): stop quietly
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_CODES["ok"]
     except InfeasibleError as exc:
         print(f"speedplan: infeasible: {exc}", file=sys.stderr)
         return EXIT_CODES["infeasible"]

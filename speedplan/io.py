@@ -1,23 +1,34 @@
-"""Path files: CSV waypoints, JSON segments (with optional speed zones), VDA 5050 NURBS.
+"""Path files (CSV waypoints, JSON segments and zones, VDA 5050 NURBS) and trajectory files.
 
 Formats
 -------
 CSV waypoints (``.csv``)
-    A header row naming ``x`` and ``y`` columns, then one waypoint per row, metres; joined by
-    the default kind of :meth:`Path.from_waypoints` (``"g2"``). An optional ``heading`` column
-    [rad] gives the waypoint headings of a clothoid chain (``kind="clothoid"``) instead. Blank
-    lines and lines starting with ``#`` are ignored.
+    A header row naming the columns, then one waypoint per row, metres; joined by the default
+    kind of :meth:`Path.from_waypoints` (``"g2"``). Blank lines and lines starting with ``#``
+    are ignored. Column names are matched case-insensitively, with surrounding spaces and a
+    bracketed unit (``x [m]``) stripped. Read are: ``x`` and ``y`` (required, unit ``m`` if
+    given) and at most one of ``heading``, ``yaw`` or ``theta`` (optional, unit ``rad`` if
+    given): the waypoint headings of a clothoid chain (``kind="clothoid"``) through those
+    poses. **Every other column is ignored**, whatever it holds (numbers, or text such as
+    ROS's ``frame_id``), with a :class:`~speedplan.SpeedplanWarning` naming the ignored
+    columns so that a misspelt heading column does not go unnoticed. The columns that are read
+    must hold numbers in every row.
 JSON segments (``.json``)
     ``{"start": [x, y], "heading": θ, "segments": [{"type": "line", "length": L},
     {"type": "arc", "radius": R, "angle": α}, {"type": "clothoid", "length": L, "k0": k,
-    "k1": k}, ...], "zones": [{"polygon": [[x, y], ...], "v_max": v}, ...]}`` (``start``,
-    ``heading`` and ``zones`` optional; a segment with ``"reverse": true`` is driven in
-    reverse, ``heading`` is the vehicle's). Instead of ``segments`` a file may give
-    ``"waypoints": [[x, y], ...]`` with an optional ``"kind"`` (default ``"g2"``).
+    "k1": k}, ...], "zones": [{"polygon": [[x, y], ...], "holes": [[[x, y], ...]],
+    "v_max": v}, ...]}`` (``start``, ``heading``, ``zones`` and ``holes`` optional; a segment
+    with ``"reverse": true`` is driven in reverse, ``heading`` is the vehicle's). Instead of
+    ``segments`` a file may give ``"waypoints": [[x, y], ...]`` with an optional ``"kind"``
+    (default ``"g2"``).
 VDA 5050 (``.json``)
     An edge ``trajectory`` object ``{"degree": d, "knotVector": [...], "controlPoints":
     [{"x": .., "y": .., "weight": ..}, ...]}`` (``weight`` optional, default 1): bare, under
     ``"trajectory"``, or in the first entry of an ``"edges"`` list that carries one.
+
+The readers take a file name or an open text stream (``sys.stdin``, ``io.StringIO``); the
+format comes from ``format=``, else the file extension, else (a stream without a name) the
+first character: ``{`` or ``[`` is JSON, anything else CSV.
 
 Every reader raises :class:`~speedplan.errors.InvalidInputError` naming the file and what is
 wrong; never a raw ``KeyError`` or ``JSONDecodeError``.
@@ -28,24 +39,34 @@ from __future__ import annotations
 import csv
 import io as _io
 import json
+import re
+import warnings
 from collections.abc import Sequence
 from os import PathLike
 from pathlib import Path as FsPath
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
+import shapely
 
-from .core.checks import as_array
-from .core.errors import InvalidInputError
+from .core.checks import as_array, choice
+from .core.errors import InvalidInputError, SpeedplanWarning
+from .core.log import logger
 from .geometry import Path, SpeedZone
+from .geometry.bounds import check_zones
 from .geometry.fitting import DEFAULT_KIND, KINDS
 from .geometry.primitives import ClothoidPiece
+from .timing.trajectory import COLUMNS, Trajectory, text_output
 
 __all__ = [
+    "FORMATS",
+    "HEADING_COLUMNS",
     "path_from_dict",
     "path_to_dict",
     "read_path",
+    "read_trajectory",
     "read_zones",
+    "write_nurbs",
     "write_path",
     "write_trajectory",
     "write_waypoints",
@@ -53,58 +74,128 @@ __all__ = [
 ]
 
 FileName = str | PathLike[str]
+Source = str | PathLike[str] | IO[str]
+
+#: Path file formats, by the name ``format=`` takes.
+FORMATS = ("csv", "json")
+
+#: Accepted names of the heading column of CSV waypoints [rad] (at most one per file).
+HEADING_COLUMNS = ("heading", "yaw", "theta")
 
 
-def _load(file: FileName) -> tuple[FsPath, Any]:
-    """``(path, parsed JSON)``; the document is ``None`` for CSV files."""
+def _load_text(file: Source, format: str | None) -> tuple[str, str, str]:
+    """``(name, format, text)`` of a path file or an open text stream."""
+    if format is not None:
+        choice("format", format, FORMATS)
+    if hasattr(file, "read"):
+        name = str(getattr(file, "name", "<stream>"))
+        try:
+            text = file.read()
+        except (OSError, UnicodeDecodeError) as exc:
+            raise InvalidInputError(f"{name}: cannot read ({exc})") from exc
+        if not isinstance(text, str):
+            raise InvalidInputError(f"{name}: open the stream in text mode, not binary")
+        suffix = FsPath(name).suffix.lower().lstrip(".")
+        if format is None:
+            format = suffix if suffix in FORMATS else (
+                "json" if text.lstrip()[:1] in ("{", "[") else "csv")
+        logger.debug("read %s from stream %s (%d characters)", format, name, len(text))
+        return name, format, text
     fs = FsPath(file)
+    if fs.is_dir():
+        raise InvalidInputError(f"path file {str(fs)!r} is a directory, not a file")
     if not fs.is_file():
         raise InvalidInputError(f"path file {str(fs)!r} does not exist")
     suffix = fs.suffix.lower()
-    if suffix == ".csv":
-        return fs, None
-    if suffix != ".json":
-        raise InvalidInputError(
-            f"{fs.name}: unknown path file type {fs.suffix!r}; use .csv (waypoints) or .json "
-            "(segments, waypoints or a VDA 5050 trajectory)"
-        )
-    try:
-        return fs, json.loads(fs.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InvalidInputError(f"{fs.name}: not valid JSON ({exc})") from exc
-    except OSError as exc:
-        raise InvalidInputError(f"{fs.name}: cannot read ({exc})") from exc
-
-
-def _read_csv(fs: FsPath, kind: str | None) -> Path:
+    if format is None:
+        if suffix not in (".csv", ".json"):
+            raise InvalidInputError(
+                f"{fs.name}: unknown path file type {fs.suffix!r}; use .csv (waypoints) or "
+                ".json (segments, waypoints or a VDA 5050 trajectory), or pass `format`"
+            )
+        format = suffix[1:]
     try:
         text = fs.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise InvalidInputError(f"{fs.name}: cannot read ({exc})") from exc
+    logger.debug("read %s file %s (%d characters)", format, fs, len(text))
+    return fs.name, format, text
+
+
+def _parse_json(name: str, text: str) -> Any:
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InvalidInputError(f"{name}: not valid JSON ({exc})") from exc
+
+
+_COLUMN_NAME = re.compile(r"\s*(.*?)\s*(?:\[\s*(.*?)\s*\])?\s*")
+
+
+def _csv_table(text: str, name: str) -> tuple[list[str], list[str], list[list[str]]]:
+    """``(names, units, rows)`` of a CSV text: ``#`` and blank lines dropped, names lowered."""
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     rows = list(csv.reader(lines))
     if not rows:
-        raise InvalidInputError(f"{fs.name}: empty file; expected a header 'x,y' and waypoints")
-    header = [h.strip().lower() for h in rows[0]]
-    if "x" not in header or "y" not in header:
-        raise InvalidInputError(
-            f"{fs.name}: the header must name columns 'x' and 'y'; got {rows[0]}"
-        )
-    data = np.empty((len(rows) - 1, len(header)))
+        raise InvalidInputError(f"{name}: empty file; expected a header 'x,y' and waypoints")
+    names, units = [], []
+    for h in rows[0]:
+        m = _COLUMN_NAME.fullmatch(h)
+        names.append((m.group(1) if m else h).strip().lower())
+        units.append((m.group(2) or "") if m else "")
     for i, row in enumerate(rows[1:]):
+        if len(row) != len(names):
+            raise InvalidInputError(
+                f"{name}: data row {i + 1} ({','.join(row)!r}) has {len(row)} values for "
+                f"{len(names)} columns"
+            )
+    return names, units, rows[1:]
+
+
+def _numeric_column(name: str, rows: list[list[str]], j: int, column: str) -> Any:
+    out = np.empty(len(rows))
+    for i, row in enumerate(rows):
         try:
-            if len(row) != len(header):
-                raise ValueError(f"{len(row)} values for {len(header)} columns")
-            data[i] = [float(v) for v in row]
+            out[i] = float(row[j])
         except ValueError as exc:
             raise InvalidInputError(
-                f"{fs.name}: data row {i + 1} ({','.join(row)!r}) must hold {len(header)} "
-                f"numbers ({exc})"
+                f"{name}: data row {i + 1} ({','.join(row)!r}): column {column!r} must hold a "
+                f"number; got {row[j]!r}"
             ) from exc
-    if data.shape[0] < 2:
-        raise InvalidInputError(f"{fs.name}: needs at least two waypoints; got {data.shape[0]}")
-    xy = data[:, [header.index("x"), header.index("y")]]
-    headings = data[:, header.index("heading")] if "heading" in header else None
+    return out
+
+
+def _read_csv(text: str, name: str, kind: str | None) -> Path:
+    names, units, rows = _csv_table(text, name)
+    if "x" not in names or "y" not in names:
+        raise InvalidInputError(
+            f"{name}: the header must name columns 'x' and 'y'; got {names}"
+        )
+    found = [h for h in HEADING_COLUMNS if h in names]
+    if len(found) > 1:
+        raise InvalidInputError(
+            f"{name}: columns {found} both give the heading; keep one of "
+            f"{', '.join(map(repr, HEADING_COLUMNS))}"
+        )
+    wanted = {"x": "m", "y": "m", **{h: "rad" for h in found}}
+    for col, unit in wanted.items():
+        got = units[names.index(col)]
+        if got and got.lower() != unit:
+            raise InvalidInputError(
+                f"{name}: column {col!r} must be in {unit}; got [{got}] (convert it first)"
+            )
+    ignored = [names[j] for j in range(len(names)) if names[j] not in wanted]
+    if ignored:
+        warnings.warn(
+            f"{name}: ignored columns {ignored}; only 'x', 'y' and one of "
+            f"{', '.join(map(repr, HEADING_COLUMNS))} are read",
+            SpeedplanWarning, stacklevel=3,
+        )
+    if len(rows) < 2:
+        raise InvalidInputError(f"{name}: needs at least two waypoints; got {len(rows)}")
+    cols = {c: _numeric_column(name, rows, names.index(c), c) for c in wanted}
+    xy = np.column_stack((cols["x"], cols["y"]))
+    headings = cols[found[0]] if found else None
     # Given headings mean a clothoid chain through those poses; otherwise the one default.
     if kind is None:
         kind = "clothoid" if headings is not None else DEFAULT_KIND
@@ -113,7 +204,7 @@ def _read_csv(fs: FsPath, kind: str | None) -> Path:
             return Path.from_waypoints(xy, kind, headings=headings)
         return Path.from_waypoints(xy, kind)
     except InvalidInputError as exc:
-        raise InvalidInputError(f"{fs.name}: {exc}") from exc
+        raise InvalidInputError(f"{name}: {exc}") from exc
 
 
 def _vda5050(doc: Any) -> Any:
@@ -209,67 +300,107 @@ def zones_from_dict(doc: Any, name: str = "document") -> list[SpeedZone]:
             raise InvalidInputError(f"{name}: zones[{i}] must be an object with 'polygon' and "
                                     "'v_max'")
         try:
-            out.append(SpeedZone(z["polygon"], z["v_max"]))
+            out.append(SpeedZone(_zone_polygon(z), z["v_max"]))
         except InvalidInputError as exc:
             raise InvalidInputError(f"{name}: zones[{i}]: {exc}") from exc
     return out
 
 
-def read_path(file: FileName, *, kind: str | None = None) -> Path:
-    """Read a path file: ``.csv`` waypoints, ``.json`` segments/waypoints or VDA 5050.
+def _ring(name: str, value: Any) -> Any:
+    pts = as_array(name, value)
+    if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 3:
+        raise InvalidInputError(f"`{name}` must be (m, 2) vertices with m >= 3; got shape "
+                                f"{pts.shape}")
+    return pts
+
+
+def _zone_polygon(z: dict[str, Any]) -> Any:
+    """The zone's ``polygon`` vertices, or a shapely Polygon when it lists ``holes``."""
+    if "holes" not in z:
+        return z["polygon"]
+    holes = z["holes"]
+    if not isinstance(holes, list):
+        raise InvalidInputError("`holes` must be a list of vertex lists")
+    return shapely.Polygon(_ring("polygon", z["polygon"]),
+                           [_ring(f"holes[{k}]", h) for k, h in enumerate(holes)])
+
+
+def read_path(file: Source, *, kind: str | None = None, format: str | None = None) -> Path:
+    r"""Read a path file: CSV waypoints, JSON segments/waypoints or a VDA 5050 trajectory.
 
     Parameters
     ----------
-    file : str or os.PathLike
-        The file; its extension selects the format.
+    file : str, os.PathLike or text stream
+        The file, or an open text stream such as ``sys.stdin``.
     kind : {"g2", "clothoid", "spline", "polyline"}, optional
         How CSV waypoints are joined; see :meth:`Path.from_waypoints`. Default ``"g2"``, or
-        ``"clothoid"`` through the given poses when the file has a ``heading`` column.
+        ``"clothoid"`` through the given poses when the file has a heading column.
+    format : {"csv", "json"}, optional
+        The format; default from the file extension, or sniffed from a stream's first
+        character (``{`` or ``[``: JSON).
 
     Raises
     ------
     InvalidInputError
-        The file is missing or malformed; the message names the file and what is wrong.
+        The file is missing, a directory or malformed; the message names the file and what is
+        wrong.
+
+    Warns
+    -----
+    SpeedplanWarning
+        A CSV file has columns that are not read (they are named).
 
     Examples
     --------
+    >>> import io
     >>> from speedplan.io import read_path
-    >>> round(read_path("paths/slow_zone.json").length, 9)  # doctest: +SKIP
-    40.0
+    >>> read_path(io.StringIO("x,y\n0,0\n3,4\n")).length
+    5.0
+    >>> read_path(io.StringIO('{"segments": [{"type": "line", "length": 2.5}]}')).length
+    2.5
     """
     if kind is not None and kind not in KINDS:
         raise InvalidInputError(
             f"`kind` must be one of {', '.join(map(repr, KINDS))}; got {kind!r}"
         )
-    fs, doc = _load(file)
-    if doc is None:
-        return _read_csv(fs, kind)
-    return path_from_dict(doc, fs.name)
+    name, fmt, text = _load_text(file, format)
+    path = (_read_csv(text, name, kind) if fmt == "csv"
+            else path_from_dict(_parse_json(name, text), name))
+    logger.debug("path from %s: %d pieces, %.6g m", name, len(path.pieces), path.length)
+    return path
 
 
-def read_zones(file: FileName) -> list[SpeedZone]:
+def read_zones(file: Source, *, format: str | None = None) -> list[SpeedZone]:
     """Speed zones stored in a JSON path file (none for CSV files).
+
+    ``file`` and ``format`` as in :func:`read_path`.
 
     Examples
     --------
+    >>> import io
     >>> from speedplan.io import read_zones
-    >>> [z.v_max for z in read_zones("paths/slow_zone.json")]  # doctest: +SKIP
+    >>> doc = '{"zones": [{"polygon": [[0, 0], [4, 0], [4, 1]], "v_max": 0.5}]}'
+    >>> [z.v_max for z in read_zones(io.StringIO(doc))]
     [0.5]
     """
-    fs, doc = _load(file)
-    if doc is None:
+    name, fmt, text = _load_text(file, format)
+    if fmt == "csv":
         return []
-    return zones_from_dict(doc, fs.name)
+    return zones_from_dict(_parse_json(name, text), name)
 
 
 # ---- writers --------------------------------------------------------------------------------
-def _zone_dicts(zones: Sequence[SpeedZone] | None) -> list[dict[str, Any]]:
+def _zone_dicts(zones: Any) -> list[dict[str, Any]]:
+    """JSON zone objects; a MultiPolygon zone becomes one object per part (same ``v_max``)."""
     out = []
-    for i, z in enumerate(zones or ()):
-        if not isinstance(z, SpeedZone):
-            raise InvalidInputError(f"`zones[{i}]` must be a SpeedZone; got {type(z).__name__}")
-        ring = np.asarray(z.polygon.exterior.coords)[:-1]
-        out.append({"polygon": ring.tolist(), "v_max": z.v_max})
+    for z in check_zones(zones):
+        parts = z.polygon.geoms if isinstance(z.polygon, shapely.MultiPolygon) else [z.polygon]
+        for poly in parts:
+            doc: dict[str, Any] = {"polygon": np.asarray(poly.exterior.coords)[:-1].tolist()}
+            if poly.interiors:
+                doc["holes"] = [np.asarray(r.coords)[:-1].tolist() for r in poly.interiors]
+            doc["v_max"] = z.v_max
+            out.append(doc)
     return out
 
 
@@ -322,11 +453,9 @@ def path_to_dict(path: Path, zones: Sequence[SpeedZone] | None = None) -> dict[s
     return doc
 
 
-def _write_text(file: FileName, text: str) -> None:
-    try:
-        FsPath(file).write_text(text, encoding="utf-8")
-    except OSError as exc:
-        raise InvalidInputError(f"cannot write {str(file)!r} ({exc})") from exc
+def _write_text(file: FileName, text: str, what: str) -> None:
+    with text_output(file, what) as fh:
+        fh.write(text)
 
 
 def write_waypoints(file: FileName, xy: Any, headings: Any = None) -> None:
@@ -353,7 +482,7 @@ def write_waypoints(file: FileName, xy: Any, headings: Any = None) -> None:
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(header)
     writer.writerows(np.column_stack(cols).tolist())  # repr-exact floats
-    _write_text(file, buf.getvalue())
+    _write_text(file, buf.getvalue(), "waypoints CSV")
 
 
 def write_path(
@@ -385,7 +514,7 @@ def write_path(
     """
     suffix = FsPath(file).suffix.lower()
     if suffix == ".json":
-        _write_text(file, json.dumps(path_to_dict(path, zones), indent=1) + "\n")
+        _write_text(file, json.dumps(path_to_dict(path, zones), indent=1) + "\n", "path JSON")
     elif suffix == ".csv":
         if not isinstance(path, Path):
             raise InvalidInputError(f"`path` must be a speedplan.Path; got {type(path).__name__}")
@@ -397,21 +526,32 @@ def write_path(
         )
 
 
-def write_trajectory(
+def write_nurbs(
     file: FileName,
     degree: int,
     knots: Any,
     control_points: Any,
     weights: Any = None,
 ) -> None:
-    """Write a NURBS as a VDA 5050 edge ``trajectory`` JSON object (validated first).
+    """Write a NURBS path as a VDA 5050 edge ``trajectory`` JSON object (validated first).
+
+    VDA 5050 calls the geometry of an edge its ``trajectory``; it holds no timing. For a
+    planned trajectory in time use :meth:`speedplan.Trajectory.to_csv` or
+    :meth:`~speedplan.Trajectory.to_json`.
+
+    Parameters
+    ----------
+    file : str or os.PathLike
+        The ``.json`` file to write.
+    degree, knots, control_points, weights
+        As in :meth:`speedplan.Path.from_nurbs` (``weights`` default 1).
 
     Examples
     --------
     >>> import os, tempfile
-    >>> from speedplan.io import read_path, write_trajectory
+    >>> from speedplan.io import read_path, write_nurbs
     >>> f = os.path.join(tempfile.mkdtemp(), "edge.json")
-    >>> write_trajectory(f, 1, [0, 0, 1, 1], [[0, 0], [3, 4]])
+    >>> write_nurbs(f, 1, [0, 0, 1, 1], [[0, 0], [3, 4]])
     >>> read_path(f).length
     5.0
     """
@@ -424,4 +564,100 @@ def write_trajectory(
         "controlPoints": [{"x": float(x), "y": float(y), "weight": float(wi)}
                           for (x, y), wi in zip(ctrl, w, strict=True)],
     }}
-    _write_text(file, json.dumps(doc, indent=1) + "\n")
+    _write_text(file, json.dumps(doc, indent=1) + "\n", "VDA 5050 NURBS JSON")
+
+
+def write_trajectory(
+    file: FileName,
+    degree: int,
+    knots: Any,
+    control_points: Any,
+    weights: Any = None,
+) -> None:
+    """Deprecated name of :func:`write_nurbs` (it writes a path, not a trajectory in time).
+
+    Warns
+    -----
+    DeprecationWarning
+        Always; call :func:`write_nurbs` instead.
+    """
+    warnings.warn(
+        "speedplan.io.write_trajectory writes a VDA 5050 NURBS path, not a trajectory in time, "
+        "and is renamed write_nurbs; call speedplan.io.write_nurbs (same arguments)",
+        DeprecationWarning, stacklevel=2,
+    )
+    write_nurbs(file, degree, knots, control_points, weights)
+
+
+# ---- trajectories ---------------------------------------------------------------------------
+def _metadata_value(text: str) -> Any:
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return text  # a plain string (status, version, file name)
+
+
+def _trajectory_from_columns(name: str, cols: dict[str, Any], metadata: dict[str, Any]
+                             ) -> Trajectory:
+    missing = [c for c in COLUMNS if c not in cols]
+    if missing:
+        raise InvalidInputError(f"{name}: not a speedplan trajectory; columns {missing} missing")
+    arrays = {c: as_array(f"{name}: column {c!r}", cols[c], ndim=1) for c in COLUMNS}
+    sizes = {a.size for a in arrays.values()}
+    if len(sizes) != 1 or 0 in sizes:
+        raise InvalidInputError(f"{name}: the columns must be non-empty and of equal length")
+    arrays["heading"] = np.unwrap(arrays["heading"])  # the file holds it wrapped
+    return Trajectory(**arrays, metadata=metadata)
+
+
+def read_trajectory(file: Source, *, format: str | None = None) -> Trajectory:
+    """Read a trajectory written by :meth:`Trajectory.to_csv` or :meth:`Trajectory.to_json`.
+
+    The values come back bit for bit, except the heading: the files hold it wrapped to
+    ``[-π, π)`` and it is unwrapped again (``numpy.unwrap``), so it is continuous and starts
+    in ``[-π, π)``. The metadata (``# key: value`` lines of a CSV file) is in
+    ``Trajectory.metadata``.
+
+    Parameters
+    ----------
+    file : str, os.PathLike or text stream
+        The file; format from ``format``, the extension or the first character.
+    format : {"csv", "json"}, optional
+        The format.
+
+    Raises
+    ------
+    InvalidInputError
+        The file is missing or is not a speedplan trajectory (a column is missing).
+
+    Examples
+    --------
+    >>> import io
+    >>> import numpy as np
+    >>> from speedplan import Limits, Path, plan
+    >>> from speedplan.io import read_trajectory
+    >>> prof = plan(Path.from_waypoints([[0, 0], [10, 0]], kind="polyline"),
+    ...             Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    >>> traj = prof.sample(0.1)
+    >>> buf = io.StringIO()
+    >>> traj.to_csv(buf)
+    >>> back = read_trajectory(io.StringIO(buf.getvalue()))
+    >>> bool(np.array_equal(back.v, traj.v)), back.metadata["heading_range"]
+    (True, '[-pi, pi)')
+    """
+    name, fmt, text = _load_text(file, format)
+    if fmt == "json":
+        doc = _parse_json(name, text)
+        if not isinstance(doc, dict) or not isinstance(doc.get("columns"), dict):
+            raise InvalidInputError(f"{name}: not a speedplan trajectory; no 'columns' object")
+        meta = doc.get("metadata", {})
+        return _trajectory_from_columns(name, doc["columns"], meta if isinstance(meta, dict)
+                                        else {})
+    metadata: dict[str, Any] = {}
+    for line in text.splitlines():
+        if line.startswith("#") and ":" in line:
+            key, _, value = line[1:].partition(":")
+            metadata[key.strip()] = _metadata_value(value.strip())
+    names, _units, rows = _csv_table(text, name)
+    cols = {c: _numeric_column(name, rows, names.index(c), c) for c in COLUMNS if c in names}
+    return _trajectory_from_columns(name, cols, metadata)

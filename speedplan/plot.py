@@ -1,4 +1,10 @@
-"""Plots of a planned profile (matplotlib, from the ``plot`` extra, imported lazily)."""
+"""Figures of a planned profile (matplotlib, from the ``plot`` extra, imported lazily).
+
+Everything is drawn on :class:`matplotlib.figure.Figure` objects, never through
+``matplotlib.pyplot``: plotting neither switches the caller's backend nor leaves figures open
+in pyplot's registry. Pass your own figure (``fig=``) or axes (``ax=``) to draw into them;
+in Jupyter a returned figure displays itself.
+"""
 
 from __future__ import annotations
 
@@ -7,26 +13,217 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .core.errors import SpeedplanError
+from .core.errors import InvalidInputError, SpeedplanError
 
 if TYPE_CHECKING:
+    from .core.limits import Limits
     from .timing import SpeedProfile, Trajectory
 
-__all__ = ["plot_profile"]
+__all__ = [
+    "plot_acceleration",
+    "plot_jerk",
+    "plot_lateral",
+    "plot_path",
+    "plot_profile",
+    "plot_speed",
+]
+
+#: Resolution of saved raster figures [dots per inch].
+DPI = 150
+LIMIT_STYLE: dict[str, Any] = {"color": "0.3", "ls": "--", "lw": 1.0}
+HEADROOM = 1.45  # y range above the largest limit, where the legend goes
 
 
-def _pyplot() -> Any:
+def _figure(**kwargs: Any) -> Any:
     try:
-        import matplotlib
-
-        if matplotlib.get_backend().lower() not in ("agg", "module://matplotlib_inline.backend_inline"):
-            matplotlib.use("Agg", force=False)
-        import matplotlib.pyplot as plt
+        from matplotlib.figure import Figure
     except ImportError as exc:  # pragma: no cover - exercised only without the extra
         raise SpeedplanError(
             "plotting needs matplotlib: pip install 'speedplan[plot]'"
         ) from exc
-    return plt
+    return Figure(**kwargs)
+
+
+def _axes(ax: Any) -> Any:
+    """``ax``, or the axes of a new single-panel figure."""
+    if ax is None:
+        return _figure(figsize=(6, 4), layout="constrained").subplots()
+    if not hasattr(ax, "plot") or not hasattr(ax, "figure"):
+        raise InvalidInputError(f"`ax` must be a matplotlib Axes; got {type(ax).__name__}")
+    return ax
+
+
+def _legend_on_top(ax: Any, top: float, bottom: float) -> None:
+    """Room above the traces for the legend, so that it never covers them."""
+    ax.set_ylim(bottom, top)
+    ax.legend(loc="upper center", ncol=3, fontsize=8, frameon=False)
+
+
+def plot_path(
+    trajectory: Trajectory, ax: Any = None, *, v_max: float | None = None, zones: Any = None
+) -> Any:
+    """The path coloured by speed, with its start, its end, the direction of travel and zones.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        Sampled states (``x``, ``y``, ``v``, ``s``).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; default a new figure.
+    v_max : float, optional
+        Top of the colour scale [m/s]; default the largest speed.
+    zones : SpeedZone or sequence of SpeedZone, optional
+        Speed zones to shade, each labelled with its limit.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from matplotlib.collections import LineCollection
+
+    ax = _axes(ax)
+    traj = trajectory
+    pts = np.column_stack((traj.x, traj.y))
+    segs = np.stack((pts[:-1], pts[1:]), axis=1)
+    speed = 0.5 * (traj.v[:-1] + traj.v[1:])
+    top = float(v_max) if v_max is not None else float(max(traj.v.max(), 1e-9))
+    lc = LineCollection(list(segs), array=speed, cmap="viridis", linewidths=3,
+                        norm=_norm(0.0, top))
+    ax.add_collection(lc)
+    _draw_zones(ax, zones)
+    ax.autoscale()
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.figure.colorbar(lc, ax=ax, label="speed v [m/s]", shrink=0.9, pad=0.01)
+    # The end hollow and larger, the start on top: on a closed loop both stay visible.
+    ax.plot(traj.x[0], traj.y[0], "o", ms=7, color="tab:green", label="start", zorder=5)
+    ax.plot(traj.x[-1], traj.y[-1], "s", ms=12, mfc="none", mec="tab:red", mew=2, label="end",
+            zorder=4)
+    ahead = int(np.searchsorted(traj.s, min(0.04 * traj.s[-1], traj.s[0] + 3.0)))
+    if 0 < ahead < len(traj):
+        from matplotlib.transforms import offset_copy
+
+        # Beside the path (8 points to its left), not over the colours it would hide.
+        h = float(traj.heading[0])
+        beside = offset_copy(ax.transData, fig=ax.figure, x=-8 * np.sin(h), y=8 * np.cos(h),
+                             units="points")
+        ax.annotate("", xy=(traj.x[ahead], traj.y[ahead]), xytext=(traj.x[0], traj.y[0]),
+                    xycoords=beside, textcoords=beside,
+                    arrowprops={"arrowstyle": "-|>", "color": "tab:green", "lw": 2},
+                    zorder=5)
+    ax.plot([], [], color="tab:green", marker=r"$\rightarrow$", ls="none", ms=12,
+            label="direction of travel")
+    ax.set(xlabel="x [m]", ylabel="y [m]")
+    ax.set_title("path coloured by speed", loc="left")
+    # In the title line, right-aligned: inside the axes it would hide part of the path.
+    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=4, fontsize=8, frameon=False,
+              borderaxespad=0.2)
+    return ax
+
+
+def _draw_zones(ax: Any, zones: Any) -> None:
+    import shapely
+    from matplotlib.patches import Polygon as Patch
+
+    from .geometry.bounds import check_zones
+
+    label: str | None = "speed zone"
+    for zone in check_zones(zones):
+        poly = zone.polygon
+        for part in (poly.geoms if isinstance(poly, shapely.MultiPolygon) else [poly]):
+            ax.add_patch(Patch(np.asarray(part.exterior.coords), closed=True, fc="tab:orange",
+                               ec="tab:orange", alpha=0.25, zorder=1, label=label))
+            label = None
+        x0, _, x1, y1 = poly.bounds  # above the zone: inside, the path would cross the text
+        ax.annotate(f"zone limit {zone.v_max:g} m/s", (0.5 * (x0 + x1), y1), ha="center",
+                    va="bottom", fontsize=8, color="tab:brown", zorder=6)
+
+
+def _norm(lo: float, hi: float) -> Any:
+    from matplotlib.colors import Normalize
+
+    return Normalize(vmin=lo, vmax=hi)
+
+
+def plot_speed(profile: SpeedProfile, trajectory: Trajectory, ax: Any = None) -> Any:
+    """Speed ``v(s)`` against the speed limit from ``v_max``, curvature and zones.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    ax = _axes(ax)
+    s_fine = np.linspace(0.0, profile.path.length, 2000)
+    bound = np.sqrt(profile.speed_bound(s_fine))
+    ax.plot(s_fine, bound, "k--", lw=1, label="speed limit (v_max, lateral, zones)")
+    ax.plot(trajectory.s, trajectory.v, "C0", lw=2, label="speed v(s)")
+    ax.set(xlabel="s [m]", ylabel="v [m/s]",
+           title=f"speed law, duration {profile.duration:.3f} s")
+    top = float(max(np.max(bound[np.isfinite(bound)], initial=0.0), trajectory.v.max()))
+    _legend_on_top(ax, HEADROOM * top, -0.04 * top)
+    return ax
+
+
+def _limit_lines(ax: Any, upper: float, lower: float, label: str) -> None:
+    ax.axhline(upper, **LIMIT_STYLE, label=label)
+    ax.axhline(-lower, **LIMIT_STYLE)
+
+
+def plot_acceleration(trajectory: Trajectory, limits: Limits, ax: Any = None) -> Any:
+    """Tangential acceleration ``a(t)`` against ``a_max`` and ``-a_decel``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    ax = _axes(ax)
+    ax.plot(trajectory.t, trajectory.a, "C1", label="tangential a(t)")
+    _limit_lines(ax, limits.a_max, limits.a_decel, "limits a_max, −a_decel")
+    ax.set(xlabel="t [s]", ylabel="a [m/s²]", title="tangential acceleration")
+    _legend_on_top(ax, HEADROOM * limits.a_max, -1.1 * limits.a_decel)
+    return ax
+
+
+def _symmetric(ax: Any, t: Any, y: Any, limit: float, limit_label: str,
+               style: dict[str, Any]) -> Any:
+    """A trace ``y(t)`` against ``±limit`` (none when infinite), legend above the traces."""
+    ax.plot(t, y, **style)
+    peak = float(np.abs(y).max())
+    if np.isfinite(limit):
+        _limit_lines(ax, limit, limit, limit_label)
+        peak = max(peak, limit)
+    peak = peak if peak > 0 else 1.0
+    _legend_on_top(ax, HEADROOM * peak, -1.1 * peak)
+    return ax
+
+
+def plot_lateral(trajectory: Trajectory, limits: Limits, ax: Any = None) -> Any:
+    """Lateral acceleration ``a_lat(t) = κ v²`` against ``±a_lat_max``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    ax = _axes(ax)
+    ax.set(xlabel="t [s]", ylabel="a_lat [m/s²]", title="lateral acceleration (+ = left turn)")
+    return _symmetric(ax, trajectory.t, trajectory.a_lat, limits.a_lat_max, "limits ±a_lat_max",
+                      {"color": "C2", "label": "lateral a_lat(t)"})
+
+
+def plot_jerk(trajectory: Trajectory, limits: Limits, ax: Any = None) -> Any:
+    """Jerk ``j(t)`` against ``±j_max``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    ax = _axes(ax)
+    ax.set(xlabel="t [s]", ylabel="jerk [m/s³]", title="jerk")
+    return _symmetric(ax, trajectory.t, trajectory.j, limits.j_max, "limits ±j_max",
+                      {"color": "C3", "lw": 1.2, "label": "jerk j(t)"})
+
+
+#: Panel names of :func:`plot_profile`, in ``fig.axes`` order (colour bar last).
+PANELS = ("path", "speed", "lateral", "acceleration", "jerk")
 
 
 def plot_profile(
@@ -35,72 +232,67 @@ def plot_profile(
     *,
     trajectory: Trajectory | None = None,
     dt: float = 0.01,
+    fig: Any = None,
+    dpi: float = DPI,
 ) -> Any:
-    """Draw a profile in four panels, optionally saved to ``file``.
+    """Draw a profile in five panels, optionally saved to ``file``.
 
-    The path coloured by speed; ``v(s)`` against ``sqrt(mu+(s))``; ``a(t)`` and ``a_lat(t)``
-    against their limits; ``j(t)`` against ``±j_max``.
+    The path coloured by speed (start, end, direction of travel); ``v(s)`` against the speed
+    limit; lateral acceleration, tangential acceleration and jerk in time against their
+    limits.
 
     Parameters
     ----------
     profile : SpeedProfile
         The planned profile.
     file : path-like, optional
-        Where to save the figure (PNG, SVG, PDF by extension).
+        Where to save the figure; the extension sets the format (PNG, SVG, PDF, ...).
     trajectory : Trajectory, optional
         A sampled trajectory to draw; default ``profile.sample(dt)``.
     dt : float
         Sampling period [s] when ``trajectory`` is not given.
+    fig : matplotlib.figure.Figure or SubFigure, optional
+        An empty figure to draw into; default a new ``Figure`` (not registered with pyplot,
+        so nothing needs closing).
+    dpi : float
+        Resolution of a saved raster figure [dots per inch].
 
     Returns
     -------
     matplotlib.figure.Figure
+        The figure (``fig``, or the figure holding the SubFigure ``fig``); the panels' axes
+        come first in ``fig.axes``, in the order of :data:`PANELS`, then the colour bar.
+
+    Examples
+    --------
+    >>> import io
+    >>> from speedplan import Limits, Path, plan
+    >>> from speedplan.plot import plot_profile
+    >>> prof = plan(Path.from_waypoints([[0, 0], [10, 0], [10, 8]]),
+    ...             Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    >>> fig = plot_profile(prof)
+    >>> [ax.get_xlabel() for ax in fig.axes[:5]]
+    ['x [m]', 's [m]', 't [s]', 't [s]', 't [s]']
+    >>> fig.savefig(io.BytesIO(), format="svg")
     """
-    plt = _pyplot()
     traj = trajectory if trajectory is not None else profile.sample(dt)
+    if fig is None:
+        fig = _figure(figsize=(11, 9.5), layout="constrained")
+    elif not hasattr(fig, "subplot_mosaic"):
+        raise InvalidInputError(
+            f"`fig` must be a matplotlib Figure or SubFigure; got {type(fig).__name__}"
+        )
+    axes = fig.subplot_mosaic(
+        [["path", "path"], ["speed", "lateral"], ["acceleration", "jerk"]],
+        height_ratios=[1.25, 1, 1],
+    )
     lim = profile.limits
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), constrained_layout=True)
-    ax = axes[0, 0]
-    from matplotlib.collections import LineCollection
-
-    pts = np.column_stack((traj.x, traj.y))
-    segs = np.stack((pts[:-1], pts[1:]), axis=1)
-    speed = 0.5 * (traj.v[:-1] + traj.v[1:])
-    lc = LineCollection(list(segs), array=speed, cmap="viridis", linewidths=3)
-    ax.add_collection(lc)
-    ax.autoscale()
-    ax.set_aspect("equal", adjustable="datalim")
-    fig.colorbar(lc, ax=ax, label="speed v [m/s]")
-    ax.plot(traj.x[0], traj.y[0], "go", label="start")
-    ax.plot(traj.x[-1], traj.y[-1], "rs", label="end")
-    ax.set(xlabel="x [m]", ylabel="y [m]", title="path coloured by speed")
-    ax.legend(loc="best", fontsize=8)
-
-    ax = axes[0, 1]
-    s_fine = np.linspace(0.0, profile.path.length, 2000)
-    ax.plot(s_fine, np.sqrt(profile.speed_bound(s_fine)), "k--", lw=1, label="bound sqrt(mu+(s))")
-    ax.plot(traj.s, traj.v, "C0", lw=2, label="v(s)")
-    ax.set(xlabel="s [m]", ylabel="v [m/s]", title=f"speed law, duration {profile.duration:.3f} s")
-    ax.legend(loc="best", fontsize=8)
-
-    ax = axes[1, 0]
-    ax.plot(traj.t, traj.a, "C1", label="a(t) tangential")
-    ax.plot(traj.t, traj.a_lat, "C2", label="a_lat(t) lateral")
-    ax.axhline(lim.a_max, color="C1", ls="--", lw=1)
-    ax.axhline(-lim.a_decel, color="C1", ls="--", lw=1)
-    if np.isfinite(lim.a_lat_max):
-        for sign in (1, -1):
-            ax.axhline(sign * lim.a_lat_max, color="C2", ls=":", lw=1)
-    ax.set(xlabel="t [s]", ylabel="acceleration [m/s²]", title="accelerations and limits")
-    ax.legend(loc="best", fontsize=8)
-
-    ax = axes[1, 1]
-    ax.plot(traj.t, traj.j, "C3", label="j(t)")
-    if np.isfinite(lim.j_max):
-        for sign in (1, -1):
-            ax.axhline(sign * lim.j_max, color="C3", ls="--", lw=1)
-    ax.set(xlabel="t [s]", ylabel="jerk [m/s³]", title="jerk and limit")
-    ax.legend(loc="best", fontsize=8)
+    zones = profile.request.zones if profile.request is not None else None
+    plot_path(traj, axes["path"], v_max=lim.v_max, zones=zones)
+    plot_speed(profile, traj, axes["speed"])
+    plot_lateral(traj, lim, axes["lateral"])
+    plot_acceleration(traj, lim, axes["acceleration"])
+    plot_jerk(traj, lim, axes["jerk"])
     if file is not None:
-        fig.savefig(file, dpi=110)
-    return fig
+        fig.savefig(file, dpi=dpi)
+    return getattr(fig, "figure", None) or fig

@@ -2,20 +2,24 @@
 
 from __future__ import annotations
 
+import io
 import json
 import re
+import warnings
 from pathlib import Path as FsPath
 
 import numpy as np
 import pytest
 import shapely
 
-from speedplan import InvalidInputError, Path, SpeedZone
-from speedplan.geometry import Arc, Clothoid, Line
+from speedplan import InvalidInputError, Limits, Path, SpeedplanWarning, SpeedZone, plan
+from speedplan.core.checks import as_array, as_scalar, broadcast_positive, choice
+from speedplan.geometry import Arc, Clothoid, Line, speed_bounds, zone_intervals
 from speedplan.io import (
     path_to_dict,
     read_path,
     read_zones,
+    write_nurbs,
     write_path,
     write_trajectory,
     write_waypoints,
@@ -118,14 +122,21 @@ def test_csv_round_trip_approximates_any_path(tmp_path):
     assert read_path(tmp_path / "w.csv").length == pytest.approx(5.0, rel=1e-14)
 
 
-def test_write_trajectory_round_trip(tmp_path):
+def test_write_nurbs_round_trip(tmp_path):
     f = tmp_path / "t.json"
-    write_trajectory(f, 2, [0, 0, 0, 1, 1, 1], [[1, 0], [1, 1], [0, 1]], [1, 0.5**0.5, 1])
+    write_nurbs(f, 2, [0, 0, 0, 1, 1, 1], [[1, 0], [1, 1], [0, 1]], [1, 0.5**0.5, 1])
     assert read_path(f).length == pytest.approx(np.pi / 2, rel=1e-12)
     doc = json.loads(f.read_text())
     assert doc["trajectory"]["controlPoints"][1] == {"x": 1.0, "y": 1.0, "weight": 0.5**0.5}
     with pytest.raises(InvalidInputError, match="`knots`"):
-        write_trajectory(f, 2, [0, 1, 0, 1, 1, 1], [[1, 0], [1, 1], [0, 1]])
+        write_nurbs(f, 2, [0, 1, 0, 1, 1, 1], [[1, 0], [1, 1], [0, 1]])
+
+
+def test_write_trajectory_is_a_deprecated_alias_of_write_nurbs(tmp_path):
+    with pytest.warns(DeprecationWarning, match="write_nurbs"):
+        write_trajectory(tmp_path / "old.json", 1, [0, 0, 1, 1], [[0, 0], [3, 4]])
+    write_nurbs(tmp_path / "new.json", 1, [0, 0, 1, 1], [[0, 0], [3, 4]])
+    assert (tmp_path / "old.json").read_text() == (tmp_path / "new.json").read_text()
 
 
 def test_writers_refuse_what_they_cannot_store(tmp_path):
@@ -200,3 +211,145 @@ def test_missing_file():
         read_path("no/such/file.json")
     with pytest.raises(InvalidInputError, match="`kind`"):
         read_path(SAMPLES[0], kind="bezier")
+
+
+# ---- CSV columns: heading/yaw/theta, units, ignored columns ---------------------------------
+@pytest.mark.parametrize("column", ["heading", "yaw", "theta", "Yaw [rad]", " THETA "])
+def test_csv_heading_column_may_be_named_yaw_or_theta(tmp_path, column):
+    f = write(tmp_path, "w.csv", f"x,y,{column}\n0,0,0.5\n5,5,0.5\n0,10,0.5\n")
+    p = read_path(f)
+    np.testing.assert_allclose(p.heading(p.offsets), 0.5, atol=1e-12)  # the headings are used
+
+
+def test_csv_with_two_heading_columns_is_refused(tmp_path):
+    f = write(tmp_path, "w.csv", "x,y,yaw,heading\n0,0,0,0\n5,0,0,0\n")
+    with pytest.raises(InvalidInputError, match="keep one of"):
+        read_path(f)
+
+
+def test_csv_extra_columns_are_ignored_with_a_warning_naming_them(tmp_path):
+    f = write(tmp_path, "ros.csv", "frame_id,x,y,z,yaw\nmap,0,0,0,0\nmap,5,0,0,0\n"
+                                   "map,5,5,0,1.5707963267948966\n")
+    with pytest.warns(SpeedplanWarning, match=r"ros\.csv: ignored columns \['frame_id', 'z'\]"):
+        p = read_path(f)
+    ref = Path.from_waypoints([[0, 0], [5, 0], [5, 5]], "clothoid",
+                                 headings=[0, 0, np.pi / 2])
+    s = np.linspace(0, ref.length, 30)
+    np.testing.assert_array_equal(p.point(s), ref.point(s))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no warning when every column is read
+        read_path(write(tmp_path, "plain.csv", "x,y\n0,0\n1,0\n"))
+
+
+def test_csv_units_in_the_header(tmp_path):
+    p = read_path(write(tmp_path, "u.csv", "x [m],y [m],heading [rad]\n0,0,0\n4,0,0\n"))
+    assert p.length == pytest.approx(4.0, rel=1e-12)
+    with pytest.raises(InvalidInputError, match="column 'heading' must be in rad"):
+        read_path(write(tmp_path, "deg.csv", "x,y,heading [deg]\n0,0,0\n4,0,0\n"))
+
+
+def test_a_planned_trajectory_csv_reads_back_as_a_path(tmp_path):
+    prof = plan(Path.from_waypoints([[0, 0], [6, 0], [6, 4]]),
+                Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    f = tmp_path / "traj.csv"
+    prof.sample(0.2).to_csv(f)
+    with pytest.warns(SpeedplanWarning, match="ignored columns"):
+        back = read_path(f)
+    assert back.length == pytest.approx(prof.path.length, rel=1e-3)
+
+
+def test_text_in_a_column_that_is_read_names_row_and_column(tmp_path):
+    f = write(tmp_path, "bad.csv", "x,y,frame_id\n0,0,map\n1,oops,map\n")
+    with pytest.warns(SpeedplanWarning), pytest.raises(InvalidInputError,
+                                                       match=r"row 2 .*column 'y'"):
+        read_path(f)
+
+
+# ---- streams and directories ----------------------------------------------------------------
+def test_streams_with_format_or_sniffing():
+    assert read_path(io.StringIO("x,y\n0,0\n3,4\n")).length == pytest.approx(5.0)
+    doc = json.dumps({"segments": [{"type": "line", "length": 2}],
+                      "zones": [{"polygon": [[0, -1], [1, -1], [1, 1]], "v_max": 0.2}]})
+    assert read_path(io.StringIO(doc)).length == 2.0
+    assert read_path(io.StringIO("  \n" + doc), format="json").length == 2.0
+    assert [z.v_max for z in read_zones(io.StringIO(doc))] == [0.2]
+    assert read_zones(io.StringIO("x,y\n0,0\n3,4\n")) == []
+    with pytest.raises(InvalidInputError, match="`format`"):
+        read_path(io.StringIO(doc), format="yaml")
+    with pytest.raises(InvalidInputError, match="binary"):
+        read_path(io.BytesIO(b"x,y\n0,0\n1,1\n"))
+
+
+def test_a_directory_is_named_as_such(tmp_path):
+    with pytest.raises(InvalidInputError, match="is a directory"):
+        read_path(tmp_path)
+
+
+def test_writers_name_a_missing_directory(tmp_path):
+    with pytest.raises(InvalidInputError, match="does not exist"):
+        write_waypoints(tmp_path / "no" / "w.csv", [[0, 0], [1, 1]])
+    with pytest.raises(InvalidInputError, match="does not exist"):
+        write_nurbs(tmp_path / "no" / "e.json", 1, [0, 0, 1, 1], [[0, 0], [3, 4]])
+
+
+# ---- zones ----------------------------------------------------------------------------------
+LIM = Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
+
+
+def test_a_single_zone_is_a_list_of_one():
+    p = Path.from_segments([Line(10.0)])
+    zone = SpeedZone(shapely.box(2, -1, 5, 1), 0.5)
+    s = np.linspace(0, 10, 101)
+    np.testing.assert_array_equal(speed_bounds(p, LIM, s, zones=zone),
+                                  speed_bounds(p, LIM, s, zones=[zone]))
+    assert zone_intervals(p, zone) == zone_intervals(p, [zone])
+    one = plan(p, LIM, zones=zone)
+    assert one.duration == plan(p, LIM, zones=[zone]).duration
+
+
+def test_multipolygon_zones_limit_speed_in_every_part():
+    parts = shapely.MultiPolygon([shapely.box(2, -1, 3, 1), shapely.box(6, -1, 7, 1)])
+    zone = SpeedZone(parts, 0.5)
+    p = Path.from_segments([Line(10.0)])
+    s = np.linspace(0, 10, 1001)
+    inside = ((s >= 2) & (s <= 3)) | ((s >= 6) & (s <= 7))  # oracle: the boxes themselves
+    np.testing.assert_array_equal(speed_bounds(p, LIM, s, zones=[zone]),
+                                  np.where(inside, 0.25, 4.0))
+    got = zone_intervals(p, [zone])
+    assert [(round(a, 9), round(b, 9), v) for a, b, v in got] == [(2.0, 3.0, 0.5),
+                                                                    (6.0, 7.0, 0.5)]
+    overlapping = shapely.MultiPolygon([shapely.box(0, 0, 2, 2), shapely.box(1, 1, 3, 3)])
+    with pytest.raises(InvalidInputError, match="must not overlap"):
+        SpeedZone(overlapping, 0.5)
+    with pytest.raises(InvalidInputError, match="LineString"):
+        SpeedZone(shapely.LineString([(0, 0), (1, 1)]), 0.5)
+
+
+def test_zones_with_parts_and_holes_round_trip_through_json(tmp_path):
+    ring = shapely.Polygon(shapely.box(0, 0, 10, 10).exterior, [shapely.box(4, 4, 6, 6)
+                                                                 .exterior.coords])
+    parts = shapely.MultiPolygon([shapely.box(20, 0, 21, 1), shapely.box(30, 0, 31, 1)])
+    f = tmp_path / "z.json"
+    write_path(f, Path.from_segments([Line(3.0)]), zones=[SpeedZone(ring, 0.3),
+                                                          SpeedZone(parts, 0.4)])
+    back = read_zones(f)
+    assert [z.v_max for z in back] == [0.3, 0.4, 0.4]
+    assert back[0].polygon.equals(ring) and back[0].polygon.area == 96.0
+    assert shapely.union_all([z.polygon for z in back[1:]]).equals(parts)
+
+
+# ---- messages -------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("call", "shown"),
+    [
+        (lambda: broadcast_positive("A", np.array([1.0, -1.0]), 2), "got -1.0 at index 1"),
+        (lambda: choice("refine", np.float64(2.5), ("auto",)), "got 2.5"),
+        (lambda: as_array("xy", [np.float64(1.0), "a"]), "got [1.0, 'a']"),
+        (lambda: as_scalar("v_max", np.float64(-1.0), positive=True), "got -1.0"),
+    ],
+)
+def test_messages_show_numpy_scalars_as_plain_numbers(call, shown):
+    with pytest.raises(InvalidInputError) as info:
+        call()
+    assert shown in str(info.value)
+    assert "np.float64" not in str(info.value)

@@ -21,9 +21,27 @@ IntArray = NDArray[np.intp]
 MAX_GRID_POINTS = 5_000_000
 
 
-def _short(value: Any) -> str:
+def shown(value: Any) -> str:
+    """``value`` as a message shows it: numpy scalars as plain numbers, long texts cut.
+
+    ``repr`` of a numpy scalar is ``np.float64(-1.0)`` since numpy 2; a message should say
+    ``-1.0``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.core.checks import shown
+    >>> shown(np.float64(-1.0)), shown(np.int64(3)), shown("on"), shown([np.float64(1.5)])
+    ('-1.0', '3', "'on'", '[1.5]')
+    """
+    if isinstance(value, np.generic):
+        value = value.item()
+    elif isinstance(value, list | tuple) and any(isinstance(v, np.generic) for v in value):
+        value = type(value)(v.item() if isinstance(v, np.generic) else v for v in value)
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
+
+
 
 
 def as_array(
@@ -42,7 +60,7 @@ def as_array(
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise InvalidInputError(
-            f"`{name}` must be numeric (a number or an array of numbers); got {_short(value)}"
+            f"`{name}` must be numeric (a number or an array of numbers); got {shown(value)}"
         ) from exc
     if ndim is not None and arr.ndim != ndim:
         raise InvalidInputError(
@@ -70,7 +88,7 @@ def as_scalar(
 ) -> float:
     """Return ``value`` as a float after checking sign and finiteness."""
     if isinstance(value, bool):
-        raise InvalidInputError(f"`{name}` must be a number; got {value!r}")
+        raise InvalidInputError(f"`{name}` must be a number; got {shown(value)}")
     arr = as_array(name, value, ndim=0, allow_inf=allow_inf)
     x = float(arr)
     if positive and not x > 0:
@@ -94,7 +112,7 @@ def broadcast_positive(
     if not (arr > 0).all():
         bad = int(np.flatnonzero(~(arr > 0))[0])
         raise InvalidInputError(
-            f"`{name}` must be > 0 everywhere; got {arr[bad]!r} at index {bad}"
+            f"`{name}` must be > 0 everywhere; got {shown(arr[bad])} at index {bad}"
         )
     return arr
 
@@ -104,7 +122,7 @@ def choice(name: str, value: Any, options: Iterable[str]) -> str:
     opts = tuple(options)
     if not isinstance(value, str) or value not in opts:
         listed = ", ".join(repr(o) for o in opts)
-        raise InvalidInputError(f"`{name}` must be one of {listed}; got {_short(value)}")
+        raise InvalidInputError(f"`{name}` must be one of {listed}; got {shown(value)}")
     return value
 
 

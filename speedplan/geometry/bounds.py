@@ -23,9 +23,10 @@ class SpeedZone:
 
     Parameters
     ----------
-    polygon : shapely.Polygon or array_like, shape (m, 2)
-        The region (vertices [m], m >= 3, when not a Polygon); must be valid with positive
-        area. Points on its boundary count as inside.
+    polygon : shapely.Polygon, shapely.MultiPolygon or array_like, shape (m, 2)
+        The region (vertices [m], m >= 3, when not a shapely geometry); must be valid (a
+        MultiPolygon's parts must not overlap) with positive area. Points on its boundary
+        count as inside; holes are outside.
     v_max : float
         Speed limit inside [m/s], >= 0.
 
@@ -35,6 +36,11 @@ class SpeedZone:
     >>> z = SpeedZone([(0, -1), (5, -1), (5, 1), (0, 1)], v_max=0.5)
     >>> z.polygon.area, z.v_max
     (10.0, 0.5)
+    >>> import shapely
+    >>> two = SpeedZone(shapely.MultiPolygon([shapely.box(0, 0, 1, 1), shapely.box(3, 0, 4, 1)]),
+    ...                 v_max=0.3)
+    >>> two.polygon.area
+    2.0
     """
 
     polygon: Any
@@ -42,17 +48,24 @@ class SpeedZone:
 
     def __post_init__(self) -> None:
         poly = self.polygon
-        if not isinstance(poly, shapely.Polygon):
+        if isinstance(poly, shapely.Geometry) and not isinstance(
+                poly, shapely.Polygon | shapely.MultiPolygon):
+            raise InvalidInputError(
+                "`polygon` must be a shapely Polygon or MultiPolygon, or (m, 2) vertices; got a "
+                f"{poly.geom_type}"
+            )
+        if not isinstance(poly, shapely.Geometry):
             pts = as_array("polygon", poly)
             if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 3:
                 raise InvalidInputError(
-                    "`polygon` must be a shapely Polygon or (m, 2) vertices with m >= 3; "
-                    f"got shape {pts.shape}"
+                    "`polygon` must be a shapely Polygon or MultiPolygon, or (m, 2) vertices "
+                    f"with m >= 3; got shape {pts.shape}"
                 )
             poly = shapely.Polygon(pts)
         if poly.is_empty or not poly.is_valid or not poly.area > 0:
             raise InvalidInputError(
-                "`polygon` must be a valid polygon with positive area (no self-intersections)"
+                "`polygon` must be a valid polygon with positive area (no self-intersections; "
+                f"the parts of a MultiPolygon must not overlap): {shapely.is_valid_reason(poly)}"
             )
         shapely.prepare(poly)  # speeds up the vectorised point-in-polygon tests
         object.__setattr__(self, "polygon", poly)
@@ -64,7 +77,7 @@ def speed_bounds(
     limits: Limits,
     s: Any,
     *,
-    zones: Sequence[SpeedZone] | None = None,
+    zones: Sequence[SpeedZone] | SpeedZone | None = None,
     v_limit: Any = None,
 ) -> FloatArray:
     """Upper bound ``mu+(s)`` on ``w = v²`` [m²/s²] at arc lengths ``s`` [m].
@@ -82,7 +95,7 @@ def speed_bounds(
         Uses ``v_max`` [m/s] and ``a_lat_max`` [m/s²].
     s : array_like
         Arc lengths [m] in ``[0, path.length]``.
-    zones : sequence of SpeedZone, optional
+    zones : SpeedZone or sequence of SpeedZone, optional
         Speed-limit regions (inside or on the boundary counts).
     v_limit : (s_knots, v_knots), optional
         Per-position speed limit [m, m/s]: ``s_knots`` strictly increasing, ``v_knots >= 0``
@@ -209,7 +222,7 @@ def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:
 
 
 def zone_intervals(
-    path: Path, zones: Sequence[SpeedZone], *, tol: float = 1e-9
+    path: Path, zones: Sequence[SpeedZone] | SpeedZone, *, tol: float = 1e-9
 ) -> list[tuple[float, float, float]]:
     """Where the path is inside each zone: ``[(s_enter, s_exit, v_max), ...]`` sorted by entry.
 
@@ -222,7 +235,7 @@ def zone_intervals(
     ----------
     path : Path
         The path.
-    zones : sequence of SpeedZone
+    zones : SpeedZone or sequence of SpeedZone
         Speed-limit regions.
     tol : float
         Accuracy of the entry and exit positions [m].
@@ -264,9 +277,22 @@ def zone_intervals(
 
 
 def check_zones(zones: Any) -> list[SpeedZone]:
-    """``zones`` as a list of :class:`SpeedZone`; raise naming the entry that is not one."""
+    """``zones`` as a list of :class:`SpeedZone`; raise naming the entry that is not one.
+
+    A single zone counts as a list of one.
+
+    Examples
+    --------
+    >>> from speedplan.geometry import SpeedZone
+    >>> from speedplan.geometry.bounds import check_zones
+    >>> z = SpeedZone([(0, 0), (1, 0), (1, 1)], v_max=0.5)
+    >>> check_zones(z) == check_zones([z]) == [z]
+    True
+    """
     if zones is None:
         return []
+    if isinstance(zones, SpeedZone):
+        return [zones]
     try:
         zone_list = list(zones)
     except TypeError as exc:
