@@ -45,7 +45,7 @@ ACCEPTABLE_TOL = 1e-6
 #: Iterations per run, restoration included: successful runs took at most 156 on the
 #: benchmark corpus; runs that fail (a locally infeasible problem) would go on for hundreds.
 MAX_ITER = 200
-MAX_RESTORATIONS = 10
+MAX_RESTORATIONS = 50
 # IPOPT's algorithmic constants and defaults (same names).
 KAPPA_EPS, KAPPA_MU, THETA_MU, TAU_MIN = 10.0, 0.2, 1.5, 0.99
 GAMMA_THETA, GAMMA_PHI, DELTA, S_THETA, S_PHI, ETA_PHI = 1e-5, 1e-8, 1.0, 1.1, 2.3, 1e-8
@@ -723,7 +723,10 @@ def solve_banded_nlp(
             status = "LocallyInfeasible" if rout.status in ("Solved", "Acceptable") \
                 else "RestorationFailed"
             break
-        pt = _Point(rout.point.x, rout.point.s, empty, empty, np.zeros(rows.size), empty)
+        # Rows still violated leave their slacks on a bound, where the next step could only
+        # move a sliver (fraction to the boundary): push them back inside, as at the start.
+        s_back = _push_inside(rout.point.s, rows.lo, rows.hi, start.push)
+        pt = _Point(rout.point.x, s_back, empty, empty, np.zeros(rows.size), empty)
         pt = pt._replace(z=mu / main.gaps(pt))
     return BandedNlpResult(
         w=rows.full(pt.x), status=status, success=status in ("Solved", "Acceptable"),
