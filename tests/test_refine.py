@@ -143,7 +143,13 @@ def test_best_of_the_starts_is_returned():
     res = refine(p, w0)
     each = [banded_nlp.solve_banded_nlp(p, w0, start) for start in banded_nlp.STARTS]
     accepted = [p.travel_time(r.w) for r in each if r.success and _feasible(p, r.w)]
-    assert accepted and p.travel_time(res.w) == min(accepted)
+    assert len(accepted) >= 2
+    # Either the best of all, or the first two agreed and the third was skipped.
+    first_two = accepted[:2]
+    assert p.travel_time(res.w) == min(accepted) or (
+        abs(first_two[0] - first_two[1]) <= refine_module.AGREE * first_two[0]
+        and p.travel_time(res.w) == min(first_two))
+    assert p.travel_time(res.w) <= min(accepted) * (1 + refine_module.AGREE)
 
 
 def test_lateral_jerk_rows_are_refined():
