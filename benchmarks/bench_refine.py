@@ -25,6 +25,11 @@ the same unit-scaled problem ``solve_problem`` passes, with
 ``fatrop``
     CasADi's structure-exploiting ``fatrop`` on a stage-wise rewrite (state
     ``(w_{k-1}, w_k)``, control ``w_{k+1}``); problems without lateral-jerk rows only.
+``near``, ``ipopt-default``, ``nearer``
+    One run of the banded interior-point method from that start
+    (:data:`speedplan.solve.banded_nlp.STARTS`); the summary then also counts the instances
+    where the first two agree to :data:`speedplan.solve.refine.AGREE` (``refine`` skips the
+    third there).
 
 Every answer is checked with ``solve_problem``'s acceptance test on the original problem
 (clipped into ``[0, w_max]``, linear rows within ``1e-7 max(1, max w_max)``, jerk rows within
@@ -46,6 +51,8 @@ medians over repetitions, objectives those of the first.
 Usage::
 
     python benchmarks/bench_refine.py --repeats 3
+    python benchmarks/refine_corpus.py --seed 2 --draws 800 --max-keep 40 --out /tmp/c2.npz
+    python benchmarks/bench_refine.py --corpus benchmarks/data/refine_corpus.npz /tmp/c2.npz
     python benchmarks/bench_refine.py --solvers new plain --sizes 200 --seeds 0 1 --no-corpus
 """
 
@@ -70,14 +77,16 @@ import numpy as np
 from speedplan import solve_discrete
 from speedplan.core.checks import FloatArray
 from speedplan.core.errors import SolverError, SpeedplanWarning
+from speedplan.solve import banded_nlp
 from speedplan.solve.discrete import _linear_tol  # speedplan's own acceptance tolerance
 from speedplan.solve.ipopt_ import refine_ipopt
 from speedplan.solve.paper import paper_instance
 from speedplan.solve.problem import DiscreteProblem, StencilRows
-from speedplan.solve.refine import refine
+from speedplan.solve.refine import AGREE, refine
 
 CORPUS = Path(__file__).parent / "data" / "refine_corpus.npz"
-SOLVERS = ("old", "new", "plain", "plain-tight", "ipopt", "fatrop")
+STARTS = {start.name: start for start in banded_nlp.STARTS}
+SOLVERS = ("old", "new", "plain", "plain-tight", "ipopt", "fatrop", *STARTS)
 TIGHT = {"tol": 1e-10, "constr_viol_tol": 1e-10}
 FATROP_BOUND_RELAX = 1e-8  # fatrop's fixed bound relaxation (not settable in CasADi)
 
@@ -111,7 +120,7 @@ def unit_case(key: str, p: DiscreteProblem, w0_unit: FloatArray, lower_bound: fl
                 np.asarray(w0_unit, dtype=np.float64), lower_bound)
 
 
-def load_corpus(path: Path) -> list[Case]:
+def load_corpus(path: Path, prefix: str = "") -> list[Case]:
     """The stored ``plan()`` problems (see ``refine_corpus.py``)."""
     z = np.load(path)
     cases = []
@@ -126,7 +135,8 @@ def load_corpus(path: Path) -> list[Case]:
             jerk=get("jerk"), w_start=float(get("ends")[0]), w_end=float(get("ends")[1]),
             w_min=w_min if w_min.any() else None, lateral=lateral,
         )
-        cases.append(unit_case(f"plan{i} {label}", p, get("w0"), float(get("lower_bound"))))
+        cases.append(unit_case(f"{prefix}plan{i} {label}", p, get("w0"),
+                               float(get("lower_bound"))))
     return cases
 
 
@@ -171,6 +181,13 @@ def evaluate(case: Case, run: Run) -> dict[str, float | bool]:
 def run_new(case: Case) -> Run:
     t0 = time.perf_counter()
     res = refine(case.unit, case.w0, accept=lambda w: accepted(case, w))
+    return Run(res.status, res.success, res.w, time.perf_counter() - t0)
+
+
+def run_start(case: Case, name: str) -> Run:
+    """One run of the banded interior-point method from one of its starts."""
+    t0 = time.perf_counter()
+    res = banded_nlp.solve_banded_nlp(case.unit, case.w0, STARTS[name])
     return Run(res.status, res.success, res.w, time.perf_counter() - t0)
 
 
@@ -309,7 +326,8 @@ def fmt(value: float, ok: bool) -> str:
 def main(argv: list[str] | None = None) -> None:
     """Run every solver on every instance, interleaved, and print the tables."""
     ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
-    ap.add_argument("--corpus", default=str(CORPUS))
+    ap.add_argument("--corpus", nargs="+", default=[str(CORPUS)],
+                    help="corpus files from refine_corpus.py")
     ap.add_argument("--no-corpus", action="store_true")
     ap.add_argument("--families", nargs="+", default=["rnd/cnst/logrnd", "pw lin/rnd/logrnd",
                                                       "rnd/cnst/rnd"])
@@ -325,6 +343,8 @@ def main(argv: list[str] | None = None) -> None:
         "new": run_new, "plain": run_plain, "ipopt": run_ipopt, "fatrop": run_fatrop,
         "plain-tight": lambda case: run_plain(case, TIGHT),
     }
+    for name in STARTS:
+        runners[name] = lambda case, name=name: run_start(case, name)
     solvers = list(args.solvers)
     if "old" in solvers:
         old = load_old(args.old_commit)
@@ -333,7 +353,10 @@ def main(argv: list[str] | None = None) -> None:
             solvers.remove("old")
         else:
             runners["old"] = old
-    cases = [] if args.no_corpus else load_corpus(Path(args.corpus))
+    cases = [] if args.no_corpus else [
+        c for k, path in enumerate(args.corpus)
+        for c in load_corpus(Path(path), prefix="" if len(args.corpus) == 1 else f"c{k}-")
+    ]
     for fam in args.families:
         family = tuple(fam.split("/"))
         assert len(family) == 3, f"family must be W/A/J, got {fam}"
@@ -358,7 +381,7 @@ def main(argv: list[str] | None = None) -> None:
                 if rep == 0:
                     results[(case.key, s)] = {**evaluate(case, run), "status": run.status}
 
-    cols = [s for s in ("old", "new", "plain", "plain-tight", "ipopt", "fatrop") if s in solvers]
+    cols = [s for s in SOLVERS if s in solvers]
     print("\n| instance | n | " + " | ".join(f"{s} t" for s in cols) + " | "
           + " | ".join(f"{s} obj" for s in cols)
           + " | plain viol/tol | lower bound | new gap | new vs plain-tight |")
@@ -390,6 +413,19 @@ def main(argv: list[str] | None = None) -> None:
         print(f"| {s} | {sum(bool(r['ok']) for r in rs)}/{len(rs)} | {statistics.median(ts):.3f} "
               f"| {max(ts):.3f} | {sum(x > 1e-6 for x in rels)} "
               f"| {max(rels, default=float('nan')):+.1e} | {below} |")
+    names = list(STARTS)
+    if all(name in cols for name in names):
+        first, second = names[0], names[1]
+        agree = sum(
+            bool(results[(c.key, first)]["ok"] and results[(c.key, second)]["ok"]
+                 and abs(results[(c.key, first)]["obj"] - results[(c.key, second)]["obj"])
+                 <= AGREE * results[(c.key, first)]["obj"])
+            for c in cases)
+        print(f"\n{first} and {second} agree to {AGREE:g} on {agree}/{len(cases)} instances")
+    if "new" in cols:
+        viols = [float(results[(c.key, "new")]["viol"]) for c in cases
+                 if results[(c.key, "new")]["ok"]]
+        print(f"new: largest jerk-row violation of an accepted point {max(viols):.2e} jerk_tol")
     if "old" in cols and "new" in cols:
         both = [c for c in cases if results[(c.key, "old")]["ok"] and results[(c.key, "new")]["ok"]]
         ratio = [statistics.median(times[(c.key, "old")]) / statistics.median(times[(c.key, "new")])
