@@ -191,10 +191,11 @@ def run_start(case: Case, name: str) -> Run:
     return Run(res.status, res.success, res.w, time.perf_counter() - t0)
 
 
-def run_ipopt(case: Case) -> Run:
+def run_refine_ipopt(fn: Callable[[DiscreteProblem, FloatArray], Any], case: Case) -> Run:
+    """A ``refine_ipopt``-like function (this one or an earlier one) on ``case``, timed."""
     t0 = time.perf_counter()
     try:
-        res = refine_ipopt(case.unit, case.w0)
+        res = fn(case.unit, case.w0)
     except SolverError as exc:
         return Run(f"error: {exc}", False, None, time.perf_counter() - t0)
     return Run(res.status, res.success, res.w, time.perf_counter() - t0)
@@ -215,16 +216,7 @@ def load_old(commit: str) -> Callable[[Case], Run] | None:
     sys.modules[module.__name__] = module  # dataclasses look their module up
     exec(compile(src, f"{commit}:speedplan/solve/ipopt_.py", "exec"), module.__dict__)
     old_refine = module.refine_ipopt
-
-    def run_old(case: Case) -> Run:
-        t0 = time.perf_counter()
-        try:
-            res = old_refine(case.unit, case.w0)
-        except SolverError as exc:
-            return Run(f"error: {exc}", False, None, time.perf_counter() - t0)
-        return Run(res.status, res.success, res.w, time.perf_counter() - t0)
-
-    return run_old
+    return lambda case: run_refine_ipopt(old_refine, case)
 
 
 def _interior_bounds(p: DiscreteProblem) -> tuple[FloatArray, FloatArray]:
@@ -340,7 +332,8 @@ def main(argv: list[str] | None = None) -> None:
     args = ap.parse_args(argv)
 
     runners: dict[str, Callable[[Case], Run]] = {
-        "new": run_new, "plain": run_plain, "ipopt": run_ipopt, "fatrop": run_fatrop,
+        "new": run_new, "plain": run_plain, "fatrop": run_fatrop,
+        "ipopt": lambda case: run_refine_ipopt(refine_ipopt, case),
         "plain-tight": lambda case: run_plain(case, TIGHT),
     }
     for name in STARTS:
@@ -412,7 +405,7 @@ def main(argv: list[str] | None = None) -> None:
         below = sum(bool(r["ok"]) and float(r["gap"]) < 0 for r in rs)
         print(f"| {s} | {sum(bool(r['ok']) for r in rs)}/{len(rs)} | {statistics.median(ts):.3f} "
               f"| {max(ts):.3f} | {sum(x > 1e-6 for x in rels)} "
-              f"| {max(rels, default=float('nan')):+.1e} | {below} |")
+              f"| {f'{max(rels):+.1e}' if rels else '-'} | {below} |")
     names = list(STARTS)
     if all(name in cols for name in names):
         first, second = names[0], names[1]
