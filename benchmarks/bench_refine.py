@@ -1,68 +1,74 @@
-"""Refinement step: IPOPT (as speedplan runs it) against CasADi's structure-exploiting fatrop.
+"""Refinement step: speedplan's refinement against its previous IPOPT call and plain IPOPT.
 
 What it measures
 ----------------
-When the SOCP relaxation is not exact, speedplan refines its ``w`` with a local NLP solver on the
-original (nonconvex) problem (``speedplan/solve/ipopt_.py``). This script solves that refinement
-NLP on the same instances, from the same start, with
+When the SOCP relaxation is not exact, ``solve_problem`` refines the relaxed ``w`` on the
+original (nonconvex) problem. This script solves that refinement, from the same start and on
+the same unit-scaled problem ``solve_problem`` passes, with
 
+``new``
+    :func:`speedplan.solve.refine.refine`: the banded interior-point method from three starts,
+    the best accepted point; IPOPT only if none is accepted.
+``old``
+    The previous refinement, ``refine_ipopt`` as of commit ``--old-commit`` (rows divided by
+    their bound, adaptive barrier update, ``tol = 1e-10``), loaded from git; skipped when git
+    or the commit is unavailable.
+``plain``
+    CasADi + IPOPT with its default options on the plain formulation (``Σ τ_i / sqrt(w_i)``,
+    rows ``(c · w) sqrt(w_i) ∈ [-B_i, B_i]``), written here independently of speedplan.
+``plain-tight``
+    The same with ``tol = constr_viol_tol = 1e-10``: IPOPT's defaults stop while rows are
+    still violated by up to 90 % of speedplan's tolerance, which buys travel time that no
+    exactly feasible point has (below the certified lower bound on some instances).
 ``ipopt``
-    speedplan's own :func:`~speedplan.solve.ipopt_.refine_ipopt`, unchanged (exact Hessian,
-    ``IPOPT_OPTIONS``).
+    speedplan's IPOPT fallback (:func:`speedplan.solve.ipopt_.refine_ipopt`), alone.
 ``fatrop``
-    CasADi's ``fatrop`` plugin (Riccati-based interior point) on a stage-wise rewrite of the same
-    NLP: stage ``k = 1..n-2`` has the state ``x_k = (w_{k-1}, w_k)`` and the control
-    ``u_k = w_{k+1}``; the dynamics ``x_{k+1} = (x_k[1], u_k)`` are the gap-closing rows; each
-    stage carries the same acceleration row and the same normalised jerk row
-    ``w''_k sqrt(w_k) / J_k in [-1, 1]`` as speedplan's IPOPT NLP. Only copies of ``w`` are added.
-``fatrop-slope``
-    fatrop on the other natural stage-wise form: ``x_k = (w_k, sigma_{k-1})`` with the slope
-    ``sigma_k = (w_{k+1} - w_k) / h_k``, control ``u_k = sigma_k - sigma_{k-1}``. Acceleration
-    rows become bounds on ``sigma``; the jerk row is ``u_k sqrt(w_k) / (tau_k J_k)`` (exact on any
-    grid since ``w''_k = (sigma_k - sigma_{k-1}) / tau_k``).
+    CasADi's structure-exploiting ``fatrop`` on a stage-wise rewrite (state
+    ``(w_{k-1}, w_k)``, control ``w_{k+1}``); problems without lateral-jerk rows only.
+``near``, ``ipopt-default``, ``nearer``
+    One run of the banded interior-point method from that start
+    (:data:`speedplan.solve.banded_nlp.STARTS`); the summary then also counts the instances
+    where the first two agree to :data:`speedplan.solve.refine.AGREE` (``refine`` skips the
+    third there).
 
-Instances are :func:`speedplan.solve.paper.paper_instance` draws (default family
-``("rnd", "cnst", "logrnd")``, strongly varying ``J``, where the relaxation is not exact), seeds
-``seed, seed + 1, ...``. The start is the relaxed ``w`` of ``solve_discrete(..., refine="never")``
-(``relaxation.w``); every solver works on the problem scaled to unit ``h`` and ``w_max``
-exactly as ``solve_problem`` does, and every answer is re-checked by speedplan's own code on the
-original problem: ``ok`` is speedplan's acceptance test for a refinement (solver success, jerk
-violation <= ``jerk_tol``, linear violation <= the linear tolerance, after the same clipping into
-``[0, w_max]``).
+Every answer is checked with ``solve_problem``'s acceptance test on the original problem
+(clipped into ``[0, w_max]``, linear rows within ``1e-7 max(1, max w_max)``, jerk rows within
+``jerk_tol``); ``obj`` is then its travel time, else ``FAIL``. ``gap`` is
+``obj / lower_bound - 1`` with the relaxation's certified lower bound.
 
-Columns: objective ``sum tau_i / sqrt(w_i)``; gap to the relaxation's certified lower bound;
-largest jerk-row violation (:meth:`DiscreteProblem.jerk_violation`, tolerance ``jerk_tol``) and
-linear-row violation (:meth:`DiscreteProblem.linear_violation`); wall time split into ``build``
-(symbolic NLP and ``casadi.nlpsol`` construction; for ``ipopt`` only the ``casadi.nlpsol``
-call made inside ``refine_ipopt``, timed by wrapping it, so its few-ms symbolic setup counts as
-solve) and ``solve`` (the rest). ``fail`` counts
-runs where the solver reports failure or raises; ``infeas`` counts runs it reports as solved but
-whose ``w`` fails the check.
+Instances
+---------
+``benchmarks/data/refine_corpus.npz`` (``plan()`` problems with a braking start whose
+relaxation is not exact, built by ``benchmarks/refine_corpus.py``, relaxed start stored) and
+:func:`speedplan.solve.paper.paper_instance` draws (``--families``, ``--sizes``, ``--seeds``),
+relaxed here with ``solve_discrete(..., refine="never")``; exact ones are skipped.
 
-Two things to know about fatrop 1.1.8 inside CasADi 3.8.2. It relaxes every inequality bound by
-``1e-8 * max(1, |bound|)`` and the factor is not an option the CasADi plugin accepts, so bounds
-are tightened by that amount before the call (without it ``w`` overshoots ``w_max`` by 1e-8 and
-speedplan's clipping turns that into jerk violations of about 2e-6, a fifth of ``jerk_tol``).
-And the construction ``casadi.nlpsol(..., "fatrop", ...)`` grows quadratically with the horizon
-(with ``structure_detection`` ``"auto"`` or ``"manual"`` alike), which the ``build`` column
-shows; the ``solve only`` ratio is what a solver built once per grid size and reused (data
-passed as parameters) could reach.
+Timing
+------
+Each repetition runs every solver on every instance, interleaved (``--repeats``); times are
+medians over repetitions, objectives those of the first.
 
 Usage::
 
-    python benchmarks/bench_refine.py --sizes 200 1000 2000 --instances 5 --seed 0
+    python benchmarks/bench_refine.py --repeats 3
+    python benchmarks/refine_corpus.py --seed 2 --draws 800 --max-keep 40 --out /tmp/c2.npz
+    python benchmarks/bench_refine.py --corpus benchmarks/data/refine_corpus.npz /tmp/c2.npz
+    python benchmarks/bench_refine.py --solvers new plain --sizes 200 --seeds 0 1 --no-corpus
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import os
 import statistics
+import subprocess
+import sys
 import time
+import types
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import casadi as ca
@@ -71,440 +77,356 @@ import numpy as np
 from speedplan import solve_discrete
 from speedplan.core.checks import FloatArray
 from speedplan.core.errors import SolverError, SpeedplanWarning
+from speedplan.solve import banded_nlp
 from speedplan.solve.discrete import _linear_tol  # speedplan's own acceptance tolerance
-from speedplan.solve.ipopt_ import IPOPT_OPTIONS, refine_ipopt
+from speedplan.solve.ipopt_ import refine_ipopt
 from speedplan.solve.paper import paper_instance
-from speedplan.solve.problem import DiscreteProblem
+from speedplan.solve.problem import DiscreteProblem, StencilRows
+from speedplan.solve.refine import AGREE, refine
 
-#: fatrop options mirroring speedplan's IPOPT_OPTIONS (fatrop's names differ; it rejects unknown
-#: names such as ``acceptable_tol`` or ``mu_strategy``).
-FATROP_OPTIONS: dict[str, Any] = {
-    "print_level": 0,
-    "tolerance": IPOPT_OPTIONS["tol"],
-    "constr_viol_tol": IPOPT_OPTIONS["constr_viol_tol"],
-    "tol_acceptable": IPOPT_OPTIONS["acceptable_tol"],
-    "max_iter": IPOPT_OPTIONS["max_iter"],
-}
-#: fatrop's fixed bound relaxation (``bound_relax_factor_`` in its IpNlpOrig; not settable).
-FATROP_BOUND_RELAX = 1e-8
-#: Names of fatrop's ``IpSolverReturnFlag`` values (``stats["fatrop"]["return_flag"]``).
-FATROP_FLAGS = (
-    "Success", "MaxIterExceeded", "StopAtAcceptablePoint", "LocalInfeasibility",
-    "LineSearchFailed", "ErrorInStepComputation", "Unknown",
-)
-SOLVERS = ("ipopt", "fatrop", "fatrop-slope")
+CORPUS = Path(__file__).parent / "data" / "refine_corpus.npz"
+STARTS = {start.name: start for start in banded_nlp.STARTS}
+SOLVERS = ("old", "new", "plain", "plain-tight", "ipopt", "fatrop", *STARTS)
+TIGHT = {"tol": 1e-10, "constr_viol_tol": 1e-10}
+FATROP_BOUND_RELAX = 1e-8  # fatrop's fixed bound relaxation (not settable in CasADi)
 
 
 @dataclass(frozen=True)
 class Case:
-    """One instance: the original problem, its unit-scaled copy and the relaxed start."""
+    """One instance: the original problem, the unit-scaled one refined, the relaxed start."""
 
-    seed: int
+    key: str
     problem: DiscreteProblem
     unit: DiscreteProblem
     w_scale: float
-    w0: FloatArray  # relaxed w in unit scale
+    w0: FloatArray  # relaxed w, unit scale
     lower_bound: float
-    relaxed_violation: float
 
 
 @dataclass(frozen=True)
 class Run:
-    """What one solver returned on one case (``w`` in unit scale, ``None`` if it raised)."""
+    """One solver's answer (``w`` in unit scale, ``None`` if it raised) and its wall time."""
 
-    solver: str
     status: str
     success: bool
-    iterations: int
     w: FloatArray | None
-    build: float
-    solve: float
+    time: float
 
 
-@dataclass(frozen=True)
-class Row:
-    """A run checked on the original problem."""
-
-    n: int
-    seed: int
-    run: Run
-    ok: bool
-    objective: float
-    gap: float
-    jerk_violation: float
-    linear_violation: float
-
-    @property
-    def total(self) -> float:
-        """Wall time of the whole refinement call."""
-        return self.run.build + self.run.solve
+def unit_case(key: str, p: DiscreteProblem, w0_unit: FloatArray, lower_bound: float) -> Case:
+    """Scale ``p`` as ``solve_problem`` does (mean step 1, largest bound 1)."""
+    w_scale = float(np.max(p.w_max))
+    return Case(key, p, p.scaled(float(np.mean(p.h)), w_scale), w_scale,
+                np.asarray(w0_unit, dtype=np.float64), lower_bound)
 
 
-def make_case(family: tuple[str, str, str], n: int, seed: int) -> Case:
-    """Draw an instance and relax it with speedplan (the start both solvers share)."""
+def load_corpus(path: Path, prefix: str = "") -> list[Case]:
+    """The stored ``plan()`` problems (see ``refine_corpus.py``)."""
+    z = np.load(path)
+    cases = []
+    for i, label in enumerate(z["labels"]):
+        def get(name: str, i: int = i) -> Any:
+            return z[f"{i}/{name}"]
+        w_min = get("w_min")
+        lateral = (StencilRows(coef=get("lat_coef"), bound=get("lat_bound"))
+                   if f"{i}/lat_coef" in z else None)
+        p = DiscreteProblem(
+            s=get("s"), w_max=get("w_max"), accel=get("accel"), decel=get("decel"),
+            jerk=get("jerk"), w_start=float(get("ends")[0]), w_end=float(get("ends")[1]),
+            w_min=w_min if w_min.any() else None, lateral=lateral,
+        )
+        cases.append(unit_case(f"{prefix}plan{i} {label}", p, get("w0"),
+                               float(get("lower_bound"))))
+    return cases
+
+
+def paper_case(family: tuple[str, str, str], n: int, seed: int) -> Case | None:
+    """A paper instance relaxed by speedplan; ``None`` if the relaxation is exact."""
     inst = paper_instance(*family, n=n, seed=seed)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SpeedplanWarning)  # "relaxation not exact": expected
         sol = solve_discrete(inst.w_max, inst.A, inst.J, refine="never")
-    # The problem solve_discrete builds, and its scaling as in solve_problem.
-    problem = DiscreteProblem(
-        s=np.arange(n, dtype=np.float64), w_max=inst.w_max, accel=inst.A, decel=inst.A,
-        jerk=inst.J,
-    )
-    w_scale = float(np.max(problem.w_max))
-    unit = problem.scaled(float(np.mean(problem.h)), w_scale)
-    return Case(
-        seed=seed, problem=problem, unit=unit, w_scale=w_scale,
-        w0=np.asarray(sol.relaxation.w) / w_scale, lower_bound=sol.lower_bound,
-        relaxed_violation=float(sol.relaxation.jerk_violation),
-    )
+    if sol.exact:
+        return None
+    a = np.broadcast_to(inst.A, n - 1).astype(np.float64)
+    p = DiscreteProblem(s=np.arange(n, dtype=np.float64), w_max=inst.w_max, accel=a, decel=a,
+                        jerk=inst.J)
+    w_scale = float(np.max(p.w_max))
+    return unit_case(f"paper {'/'.join(family)} n={n} seed={seed}", p,
+                     np.asarray(sol.relaxation.w) / w_scale, sol.lower_bound)
 
 
-def check(n: int, case: Case, run: Run) -> Row:
-    """Apply speedplan's acceptance test for a refinement (``solve_problem``) to ``run``."""
+def accepted(case: Case, w_unit: FloatArray) -> bool:
+    """``solve_problem``'s acceptance test of a refined point."""
+    p = case.problem
+    w = np.clip(w_unit * case.w_scale, 0.0, p.w_max)
+    return bool(p.linear_violation(w) <= _linear_tol(p) and p.jerk_violation(w) <= p.jerk_tol)
+
+
+def evaluate(case: Case, run: Run) -> dict[str, float | bool]:
+    """Objective, gap and jerk violation (in units of ``jerk_tol``) of an accepted run."""
     p = case.problem
     if run.w is None or not np.all(np.isfinite(run.w)):
-        nan = float("nan")
-        return Row(n, case.seed, run, False, nan, nan, nan, nan)
+        return {"ok": False, "obj": float("nan"), "gap": float("nan"), "viol": float("nan")}
     w = np.clip(run.w * case.w_scale, 0.0, p.w_max)
-    jv, lv = p.jerk_violation(w), p.linear_violation(w)
-    ok = run.success and lv <= _linear_tol(p) and jv <= p.jerk_tol
+    ok = run.success and accepted(case, run.w)
     obj = p.travel_time(w)
-    gap = (obj - case.lower_bound) / case.lower_bound
-    return Row(n, case.seed, run, ok, obj, gap, jv, lv)
+    return {"ok": ok, "obj": obj, "gap": obj / case.lower_bound - 1.0,
+            "viol": p.jerk_violation(w) / p.jerk_tol}
 
 
-# --- IPOPT: speedplan's own function ----------------------------------------------------------
+# --- solvers ----------------------------------------------------------------------------------
 
 
-@contextlib.contextmanager
-def _timed_nlpsol() -> Iterator[list[float]]:
-    """Record how long each ``casadi.nlpsol`` construction takes while the context is open."""
-    original = ca.nlpsol
-    times: list[float] = []
-
-    def timed(*args: Any, **kwargs: Any) -> Any:
-        t0 = time.perf_counter()
-        try:
-            return original(*args, **kwargs)
-        finally:
-            times.append(time.perf_counter() - t0)
-
-    ca.nlpsol = timed
-    try:
-        yield times
-    finally:
-        ca.nlpsol = original
-
-
-def run_ipopt(unit: DiscreteProblem, w0: FloatArray) -> Run:
-    """speedplan's refinement, unchanged; build = its ``nlpsol`` construction."""
+def run_new(case: Case) -> Run:
     t0 = time.perf_counter()
-    with _timed_nlpsol() as build_times:
-        try:
-            res = refine_ipopt(unit, w0)
-        except SolverError as exc:
-            total = time.perf_counter() - t0
-            return Run("ipopt", f"error: {exc}", False, -1, None, sum(build_times),
-                       total - sum(build_times))
-    total = time.perf_counter() - t0
-    build = sum(build_times)
-    return Run("ipopt", res.status, res.success, res.iterations, res.w, build, total - build)
+    res = refine(case.unit, case.w0, accept=lambda w: accepted(case, w))
+    return Run(res.status, res.success, res.w, time.perf_counter() - t0)
 
 
-# --- fatrop: stage-wise formulations ----------------------------------------------------------
+def run_start(case: Case, name: str) -> Run:
+    """One run of the banded interior-point method from one of its starts."""
+    t0 = time.perf_counter()
+    res = banded_nlp.solve_banded_nlp(case.unit, case.w0, STARTS[name])
+    return Run(res.status, res.success, res.w, time.perf_counter() - t0)
 
 
-def _tighten(lo: FloatArray, hi: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Undo fatrop's bound relaxation on every finite, non-fixed bound."""
-    lo, hi = lo.astype(np.float64), hi.astype(np.float64)
-    free = lo < hi
-    m = free & np.isfinite(lo)
-    lo[m] += FATROP_BOUND_RELAX * np.maximum(1.0, np.abs(lo[m]))
-    m = free & np.isfinite(hi)
-    hi[m] -= FATROP_BOUND_RELAX * np.maximum(1.0, np.abs(hi[m]))
-    return lo, hi
+def run_refine_ipopt(fn: Callable[[DiscreteProblem, FloatArray], Any], case: Case) -> Run:
+    """A ``refine_ipopt``-like function (this one or an earlier one) on ``case``, timed."""
+    t0 = time.perf_counter()
+    try:
+        res = fn(case.unit, case.w0)
+    except SolverError as exc:
+        return Run(f"error: {exc}", False, None, time.perf_counter() - t0)
+    return Run(res.status, res.success, res.w, time.perf_counter() - t0)
 
 
-def _w_bounds(p: DiscreteProblem) -> tuple[FloatArray, FloatArray]:
-    """Bounds on every node's ``w`` as ``refine_ipopt`` sets them on the interior."""
-    wmin = 1e-9 * max(1.0, float(np.max(p.w_max)))
+def load_old(commit: str) -> Callable[[Case], Run] | None:
+    """``refine_ipopt`` as of ``commit``, executed inside the current ``speedplan.solve``."""
+    root = Path(__file__).resolve().parents[1]
+    try:
+        src = subprocess.run(
+            ["git", "-C", str(root), "show", f"{commit}:speedplan/solve/ipopt_.py"],
+            check=True, capture_output=True, text=True,
+        ).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    module = types.ModuleType("speedplan.solve._ipopt_old")
+    module.__package__ = "speedplan.solve"
+    sys.modules[module.__name__] = module  # dataclasses look their module up
+    exec(compile(src, f"{commit}:speedplan/solve/ipopt_.py", "exec"), module.__dict__)
+    old_refine = module.refine_ipopt
+    return lambda case: run_refine_ipopt(old_refine, case)
+
+
+def _interior_bounds(p: DiscreteProblem) -> tuple[FloatArray, FloatArray]:
+    """``[max(w_min, 1e-9 max(1, max w_max)), w_max]`` on every node (as speedplan bounds)."""
     ub = p.w_max.astype(np.float64)
-    lb = np.minimum(wmin, ub)
+    lb = np.minimum(1e-9 * max(1.0, float(np.max(p.w_max))), ub)
     if p.w_min is not None:
         lb = np.maximum(lb, p.w_min)
     return lb, ub
 
 
-def _inv_jerk(p: DiscreteProblem) -> FloatArray:
-    """``1 / J`` with ``0`` for absent rows (the row is then ``0 in [-1, 1]``)."""
-    with np.errstate(divide="ignore"):
-        return np.where(np.isfinite(p.jerk), 1.0 / p.jerk, 0.0)
+def run_plain(case: Case, options: dict[str, Any] | None = None) -> Run:
+    """CasADi + IPOPT, default options unless given, on the plain formulation."""
+    t0 = time.perf_counter()
+    p = case.unit
+    x = ca.SX.sym("w", p.n - 2)
+    wf = ca.vertcat(p.w_start, x, p.w_end)
+    rows, lbg, ubg = [wf[1:] - wf[:-1]], [-p.decel * p.h], [p.accel * p.h]
+    for fam in p.stencil_families():
+        keep = np.flatnonzero(np.isfinite(fam.bound))
+        if keep.size:
+            stencil = ca.DM(p.stencil_matrix(fam.coef)[keep].tocsc())
+            rows.append(ca.mtimes(stencil, wf) * ca.sqrt(x[keep.tolist()]))
+            lbg.append(-fam.bound[keep])
+            ubg.append(fam.bound[keep])
+    solver = ca.nlpsol("plain", "ipopt", {"x": x, "f": ca.sum1(ca.DM(p.tau) / ca.sqrt(x)),
+                                          "g": ca.vertcat(*rows)},
+                       {"ipopt": {"print_level": 0, "sb": "yes", **(options or {})},
+                        "print_time": False})
+    lb, ub = _interior_bounds(p)
+    sol = solver(x0=np.clip(case.w0[1:-1], lb[1:-1], ub[1:-1]), lbx=lb[1:-1], ubx=ub[1:-1],
+                 lbg=np.concatenate(lbg), ubg=np.concatenate(ubg))
+    stats = solver.stats()
+    w = np.concatenate(([p.w_start], np.asarray(sol["x"]).ravel(), [p.w_end]))
+    return Run(str(stats["return_status"]), bool(stats["success"]), w, time.perf_counter() - t0)
 
 
-@dataclass(frozen=True)
-class StageNlp:
-    """A stage-ordered NLP for fatrop with its bounds, start and ``w`` extraction."""
+def run_fatrop(case: Case) -> Run:
+    """fatrop on the lifted form: stage ``k`` has state ``(w_{k-1}, w_k)``, control ``w_{k+1}``.
 
-    x: ca.SX
-    f: ca.SX
-    g: ca.SX
-    equality: list[bool]
-    lbx: FloatArray
-    ubx: FloatArray
-    lbg: FloatArray
-    ubg: FloatArray
-    x0: FloatArray
-    stages: int
-    extract: Callable[[FloatArray], FloatArray]
-
-
-def lift_nlp(p: DiscreteProblem, w0: FloatArray) -> StageNlp:
-    """Lifted form: ``x_k = (w_{k-1}, w_k)``, ``u_k = w_{k+1}`` (``k = 1..n-2``).
-
-    The terminal stage ``n-1`` has the state ``(w_{n-2}, w_{n-1})`` and no control.
-
-    Variable order ``[x_1, u_1, x_2, u_2, ..., x_{n-2}, u_{n-2}, x_{n-1}]``; row order per stage:
-    the two gap-closing rows ``x_{k+1} - (x_k[1], u_k)``, then the acceleration row
-    ``w_k - w_{k-1}`` and the jerk row of node ``k``; last, the terminal acceleration row.
+    Per stage: two gap-closing rows, the acceleration row and the jerk row ``w''_k sqrt(w_k)``
+    (bounds ``±J_k``); fatrop relaxes every bound by 1e-8, undone here before the call.
     """
-    n, m = p.n, p.n - 2
+    p = case.unit
+    if p.lateral is not None or not np.isfinite(p.jerk).all():
+        return Run("skipped (lateral or absent rows)", False, None, 0.0)
+    t0 = time.perf_counter()
+    m = p.n - 2
     v = ca.SX.sym("v", 3 * m + 2)
     z = ca.reshape(v[: 3 * m], 3, m)  # column k-1 = (w_{k-1}, w_k, w_{k+1}) of stage k
-    x_last = v[3 * m:]
+    last = v[3 * m:]
     prev, cur, nxt = z[0, :], z[1, :], z[2, :]
-    gap = ca.horzcat(z[0:2, 1:], x_last) - ca.vertcat(cur, nxt)
-    d2 = p.second_difference
-    idx = np.arange(m)[:, None]
-    coef = np.asarray(d2[idx, idx + np.arange(3)[None, :]].todense())  # (m, 3)
-    wpp = (ca.DM(coef[:, 0]).T * prev + ca.DM(coef[:, 1]).T * cur
-           + ca.DM(coef[:, 2]).T * nxt)
-    jerk = wpp * ca.sqrt(cur) * ca.DM(_inv_jerk(p)).T
-    rows = ca.vertcat(gap, cur - prev, jerk)
-    g = ca.vertcat(ca.vec(rows), x_last[1] - x_last[0])
-    f = ca.dot(ca.DM(p.tau), ca.vec(1.0 / ca.sqrt(cur)))
-
-    zeros, ones = np.zeros(m), np.ones(m)
+    c = p.second_difference_weights
+    wpp = ca.DM(c[:, 0]).T * prev + ca.DM(c[:, 1]).T * cur + ca.DM(c[:, 2]).T * nxt
+    g = ca.vertcat(ca.vec(ca.vertcat(ca.horzcat(z[0:2, 1:], last) - ca.vertcat(cur, nxt),
+                                     cur - prev, wpp * ca.sqrt(cur))), last[1] - last[0])
+    zeros = np.zeros(m)
     lo_a, hi_a = -p.decel * p.h, p.accel * p.h
-    lbg = np.concatenate((np.column_stack((zeros, zeros, lo_a[:m], -ones)).ravel(), lo_a[m:]))
-    ubg = np.concatenate((np.column_stack((zeros, zeros, hi_a[:m], ones)).ravel(), hi_a[m:]))
-    lb, ub = _w_bounds(p)
+    lbg = np.concatenate((np.column_stack((zeros, zeros, lo_a[:m], -p.jerk)).ravel(), lo_a[m:]))
+    ubg = np.concatenate((np.column_stack((zeros, zeros, hi_a[:m], p.jerk)).ravel(), hi_a[m:]))
+    lb, ub = _interior_bounds(p)
     inf = np.full(m, np.inf)
     lbx = np.concatenate((np.column_stack((-inf, lb[1:-1], -inf)).ravel(), [-np.inf, p.w_end]))
     ubx = np.concatenate((np.column_stack((inf, ub[1:-1], inf)).ravel(), [np.inf, p.w_end]))
     lbx[0] = ubx[0] = p.w_start
-    w = np.clip(w0, lb, ub)
+    w = np.clip(case.w0, lb, ub)
     w[0], w[-1] = p.w_start, p.w_end
     x0 = np.concatenate((np.column_stack((w[:-2], w[1:-1], w[2:])).ravel(), w[-2:]))
-
-    def extract(xv: FloatArray) -> FloatArray:
-        return np.concatenate(([p.w_start], xv[1 : 3 * m : 3], [p.w_end]))
-
-    equality = [True, True, False, False] * m + [False]
-    return StageNlp(v, f, g, equality, lbx, ubx, lbg, ubg, x0, n - 2, extract)
-
-
-def slope_nlp(p: DiscreteProblem, w0: FloatArray) -> StageNlp:
-    """Slope form: ``x_k = (w_k, sigma_{k-1})``, ``u_k = sigma_k - sigma_{k-1}``.
-
-    States for ``k = 0..n-1`` (``sigma_{-1} = 0`` fixed), controls for ``k = 0..n-2``.
-
-    Dynamics ``w_{k+1} = w_k + h_k (sigma_{k-1} + u_k)``, ``sigma_k = sigma_{k-1} + u_k``;
-    acceleration rows are the state bounds ``-D_k <= sigma_k <= A_k``; stage ``k = 1..n-2``
-    carries the jerk row ``u_k sqrt(w_k) / (tau_k J_k)``.
-    """
-    n, m, stages = p.n, p.n - 2, p.n - 1
-    v = ca.SX.sym("v", 3 * stages + 2)
-    z = ca.reshape(v[: 3 * stages], 3, stages)
-    x_last = v[3 * stages:]
-    w_k, s_prev, u = z[0, :], z[1, :], z[2, :]
-    s_new = s_prev + u
-    gap = (ca.horzcat(z[0:2, 1:], x_last)
-           - ca.vertcat(w_k + ca.DM(p.h).T * s_new, s_new))
-    jerk = u[:, 1:] * ca.sqrt(w_k[:, 1:]) * ca.DM(_inv_jerk(p) / p.tau).T
-    g = ca.vertcat(gap[:, 0], ca.vec(ca.vertcat(gap[:, 1:], jerk)))
-    f = ca.dot(ca.DM(p.tau), ca.vec(1.0 / ca.sqrt(w_k[:, 1:])))
-
-    zeros, ones = np.zeros(m), np.ones(m)
-    lbg = np.concatenate(([0.0, 0.0], np.column_stack((zeros, zeros, -ones)).ravel()))
-    ubg = np.concatenate(([0.0, 0.0], np.column_stack((zeros, zeros, ones)).ravel()))
-    lb, ub = _w_bounds(p)
-    lo_s = np.concatenate(([0.0], -p.decel))
-    hi_s = np.concatenate(([0.0], p.accel))
-    inf = np.full(stages, np.inf)
-    lbx = np.concatenate((np.column_stack((lb[:-1], lo_s[:-1], -inf)).ravel(), [p.w_end, lo_s[-1]]))
-    ubx = np.concatenate((np.column_stack((ub[:-1], hi_s[:-1], inf)).ravel(), [p.w_end, hi_s[-1]]))
-    lbx[0] = ubx[0] = p.w_start
-    w = np.clip(w0, lb, ub)
-    w[0], w[-1] = p.w_start, p.w_end
-    sigma = np.diff(w) / p.h
-    s0 = np.concatenate(([0.0], sigma[:-1]))
-    x0 = np.concatenate((np.column_stack((w[:-1], s0, sigma - s0)).ravel(), [w[-1], sigma[-1]]))
-
-    def extract(xv: FloatArray) -> FloatArray:
-        return np.concatenate(([p.w_start], xv[3 : 3 * stages : 3], [p.w_end]))
-
-    equality = [True, True] + [True, True, False] * m
-    return StageNlp(v, f, g, equality, lbx, ubx, lbg, ubg, x0, n - 1, extract)
-
-
-def run_fatrop(name: str, build_nlp: Callable[[DiscreteProblem, FloatArray], StageNlp],
-               unit: DiscreteProblem, w0: FloatArray) -> Run:
-    """Build the stage-wise NLP, let CasADi detect its OCP structure, solve with fatrop."""
-    t0 = time.perf_counter()
     try:
-        nlp = build_nlp(unit, w0)
-        solver = ca.nlpsol(
-            "refine_" + name.replace("-", "_"), "fatrop", {"x": nlp.x, "f": nlp.f, "g": nlp.g},
-            {"structure_detection": "auto", "equality": nlp.equality, "print_time": False,
-             "fatrop": FATROP_OPTIONS},
-        )
+        solver = ca.nlpsol("refine_fatrop", "fatrop",
+                           {"x": v, "f": ca.dot(ca.DM(p.tau), ca.vec(1.0 / ca.sqrt(cur))), "g": g},
+                           {"structure_detection": "auto", "print_time": False,
+                            "equality": [True, True, False, False] * m + [False],
+                            "fatrop": {"print_level": 0, "tolerance": 1e-10,
+                                       "constr_viol_tol": 1e-10}})
+        tight = [np.where(np.isfinite(b) & (lbx < ubx), b + sgn * FATROP_BOUND_RELAX
+                          * np.maximum(1.0, np.abs(b)), b)
+                 for b, sgn in ((lbx, 1.0), (ubx, -1.0))]
+        tight_g = [np.where(np.isfinite(b) & (lbg < ubg), b + sgn * FATROP_BOUND_RELAX
+                            * np.maximum(1.0, np.abs(b)), b)
+                   for b, sgn in ((lbg, 1.0), (ubg, -1.0))]
+        sol = solver(x0=x0, lbx=tight[0], ubx=tight[1], lbg=tight_g[0], ubg=tight_g[1])
     except RuntimeError as exc:
-        return Run(name, f"build error: {str(exc).strip().splitlines()[-1]}", False, -1, None,
-                   time.perf_counter() - t0, 0.0)
-    t1 = time.perf_counter()
-    lbx, ubx = _tighten(nlp.lbx, nlp.ubx)
-    lbg, ubg = _tighten(nlp.lbg, nlp.ubg)
-    try:
-        sol = solver(x0=nlp.x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
-    except RuntimeError as exc:
-        return Run(name, f"solve error: {str(exc).strip().splitlines()[-1]}", False, -1, None,
-                   t1 - t0, time.perf_counter() - t1)
-    stats = solver.stats()
-    w = nlp.extract(np.asarray(sol["x"]).ravel())
-    t2 = time.perf_counter()
-    flag = int(stats.get("fatrop", {}).get("return_flag", len(FATROP_FLAGS) - 1))
-    status = FATROP_FLAGS[flag] if 0 <= flag < len(FATROP_FLAGS) else f"flag {flag}"
-    if int(stats.get("N", -1)) != nlp.stages:  # structure detection found something else
-        status += f" (N={stats.get('N')}, expected {nlp.stages})"
-    return Run(name, status, bool(stats.get("success", False)),
-               int(stats.get("iter_count", -1)), w, t1 - t0, t2 - t1)
-
-
-RUNNERS: dict[str, Callable[[DiscreteProblem, FloatArray], Run]] = {
-    "ipopt": run_ipopt,
-    "fatrop": lambda unit, w0: run_fatrop("fatrop", lift_nlp, unit, w0),
-    "fatrop-slope": lambda unit, w0: run_fatrop("fatrop-slope", slope_nlp, unit, w0),
-}
+        return Run(f"error: {str(exc).strip().splitlines()[-1]}", False, None,
+                   time.perf_counter() - t0)
+    xv = np.asarray(sol["x"]).ravel()
+    w_out = np.concatenate(([p.w_start], xv[1 : 3 * m : 3], [p.w_end]))
+    return Run("fatrop", bool(solver.stats().get("success", False)), w_out,
+               time.perf_counter() - t0)
 
 
 # --- report -----------------------------------------------------------------------------------
 
 
-def _median(xs: list[float]) -> float:
-    return statistics.median(xs) if xs else float("nan")
-
-
-def _total(r: Row) -> float:
-    return r.total
-
-
-def _solve(r: Row) -> float:
-    return r.run.solve
-
-
-def _build(r: Row) -> float:
-    return r.run.build
-
-
-def print_row(r: Row) -> None:
-    """One line of the per-run table (a long error status is printed in full above it)."""
-    status = r.run.status
-    if len(status) > 60:
-        print(f"# n={r.n} seed={r.seed} {r.run.solver}: {status}")
-        status = status[:57] + "..."
-    print(f"| {r.n} | {r.seed} | {r.run.solver} | {status} | {'yes' if r.ok else 'NO'} "
-          f"| {r.run.iterations} | {r.objective:.9g} | {100 * r.gap:.3g} "
-          f"| {r.jerk_violation:.2e} | {r.linear_violation:.2e} "
-          f"| {r.run.build:.3f} | {r.run.solve:.3f} | {r.total:.3f} |", flush=True)
-
-
-def print_summary(rows: list[Row], solvers: list[str], sizes: list[int]) -> None:
-    """Per size and solver: reliability counts and median times; time ratios ipopt/fatrop."""
-    print("\n## Summary (medians over instances; times in s)")
-    print("| n | solver | ok | fail | infeas | median iters | median build | median solve "
-          "| median total | obj/obj_ipopt - 1: min, max |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
-    ipopt_obj = {(r.n, r.seed): r.objective for r in rows if r.run.solver == "ipopt" and r.ok}
-    for n in sizes:
-        for s in solvers:
-            rs = [r for r in rows if r.n == n and r.run.solver == s]
-            if not rs:
-                continue
-            fail = sum(not r.run.success for r in rs)
-            infeas = sum(r.run.success and not r.ok for r in rs)
-            diffs = [r.objective / ipopt_obj[(n, r.seed)] - 1.0 for r in rs
-                     if r.ok and (n, r.seed) in ipopt_obj]
-            diff = f"{min(diffs):.1e}, {max(diffs):.1e}" if diffs else "-"
-            print(f"| {n} | {s} | {sum(r.ok for r in rs)}/{len(rs)} | {fail} | {infeas} "
-                  f"| {_median([r.run.iterations for r in rs]):g} "
-                  f"| {_median([r.run.build for r in rs]):.3f} "
-                  f"| {_median([r.run.solve for r in rs]):.3f} "
-                  f"| {_median([r.total for r in rs]):.3f} | {diff} |")
-    others = [s for s in solvers if s != "ipopt"]
-    if "ipopt" not in solvers or not others:
-        return
-    print("\n## Time ratio ipopt / fatrop: ratio of medians over the instances both solved ok "
-          "(> 1: fatrop faster)")
-    print("| n | solver | instances | total (build + solve) | solve only | build only |")
-    print("|---|---|---|---|---|---|")
-    for n in sizes:
-        ip = {r.seed: r for r in rows if r.n == n and r.run.solver == "ipopt" and r.ok}
-        for s in others:
-            fr = {r.seed: r for r in rows if r.n == n and r.run.solver == s and r.ok}
-            both = sorted(ip.keys() & fr.keys())
-            if not both:
-                print(f"| {n} | {s} | 0 | - | - | - |")
-                continue
-            ratios = [
-                _median([get(ip[k]) for k in both]) / _median([get(fr[k]) for k in both])
-                for get in (_total, _solve, _build)
-            ]
-            print(f"| {n} | {s} | {len(both)} | " + " | ".join(f"{x:.2f}" for x in ratios) + " |")
+def fmt(value: float, ok: bool) -> str:
+    return f"{value:.8g}" if ok else "FAIL"
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Run the comparison and print the tables."""
+    """Run every solver on every instance, interleaved, and print the tables."""
     ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
-    ap.add_argument("--sizes", type=int, nargs="+", default=[200, 1000, 2000])
-    ap.add_argument("--instances", type=int, default=5, help="instances per size")
-    ap.add_argument("--seed", type=int, default=0, help="first seed (then seed+1, ...)")
-    ap.add_argument("--family", nargs=3, default=["rnd", "cnst", "logrnd"],
-                    metavar=("W", "A", "J"), help="paper_instance family")
-    ap.add_argument("--solvers", nargs="+", choices=SOLVERS, default=list(SOLVERS))
+    ap.add_argument("--corpus", nargs="+", default=[str(CORPUS)],
+                    help="corpus files from refine_corpus.py")
+    ap.add_argument("--no-corpus", action="store_true")
+    ap.add_argument("--families", nargs="+", default=["rnd/cnst/logrnd", "pw lin/rnd/logrnd",
+                                                      "rnd/cnst/rnd"])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[1000, 4000])
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    ap.add_argument("--solvers", nargs="+", choices=SOLVERS,
+                    default=["old", "new", "plain", "plain-tight"])
+    ap.add_argument("--repeats", type=int, default=1)
+    ap.add_argument("--old-commit", default="2c8fb92")
     args = ap.parse_args(argv)
 
+    runners: dict[str, Callable[[Case], Run]] = {
+        "new": run_new, "plain": run_plain, "fatrop": run_fatrop,
+        "ipopt": lambda case: run_refine_ipopt(refine_ipopt, case),
+        "plain-tight": lambda case: run_plain(case, TIGHT),
+    }
+    for name in STARTS:
+        runners[name] = lambda case, name=name: run_start(case, name)
     solvers = list(args.solvers)
-    has_fatrop = ca.has_nlpsol("fatrop")
-    print(f"# refinement: ipopt vs fatrop | casadi {ca.CasadiMeta.version()} | fatrop plugin: "
-          f"{'available' if has_fatrop else 'NOT available'} | {os.cpu_count()} cores "
-          f"| family {tuple(args.family)} | {args.instances} instances/size, seeds from "
-          f"{args.seed}")
-    if not has_fatrop:
-        print("# casadi.has_nlpsol('fatrop') is False: this CasADi build ships no fatrop "
-              "plugin; only IPOPT is measured.")
-        solvers = [s for s in solvers if not s.startswith("fatrop")]
-    print("| n | seed | solver | status | ok | iters | objective | gap % | jerk viol | lin viol "
-          "| build s | solve s | total s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    rows: list[Row] = []
+    if "old" in solvers:
+        old = load_old(args.old_commit)
+        if old is None:
+            print(f"# old: commit {args.old_commit} not available through git; skipped")
+            solvers.remove("old")
+        else:
+            runners["old"] = old
+    cases = [] if args.no_corpus else [
+        c for k, path in enumerate(args.corpus)
+        for c in load_corpus(Path(path), prefix="" if len(args.corpus) == 1 else f"c{k}-")
+    ]
+    for fam in args.families:
+        family = tuple(fam.split("/"))
+        assert len(family) == 3, f"family must be W/A/J, got {fam}"
+        for n in args.sizes:
+            for seed in args.seeds:
+                c = paper_case((family[0], family[1], family[2]), n, seed)
+                if c is not None:
+                    cases.append(c)
+    print(f"# refinement benchmark | casadi {ca.CasadiMeta.version()} | {os.cpu_count()} cores "
+          f"| {len(cases)} instances | solvers {solvers} | {args.repeats} repeat(s), "
+          "interleaved; times are medians [s]")
     t_start = time.perf_counter()
-    family = (args.family[0], args.family[1], args.family[2])
-    warm = make_case(family, 50, args.seed)
-    for s in solvers:  # untimed: loads the plugins and warms caches
-        RUNNERS[s](warm.unit, warm.w0)
-    for n in args.sizes:
-        for k in range(args.instances):
-            case = make_case(family, n, args.seed + k)
-            if case.relaxed_violation <= case.problem.jerk_tol:
-                print(f"# n={n} seed={case.seed}: relaxation already exact (refinement "
-                      "would be skipped by refine='auto')")
+    results: dict[tuple[str, str], dict[str, Any]] = {}
+    times: dict[tuple[str, str], list[float]] = {}
+    for rep in range(args.repeats):
+        for case in cases:
             for s in solvers:
-                row = check(n, case, RUNNERS[s](case.unit, case.w0))
-                rows.append(row)
-                print_row(row)
-    print_summary(rows, solvers, args.sizes)
-    print(f"\n# total wall time {time.perf_counter() - t_start:.1f} s")
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    run = runners[s](case)
+                times.setdefault((case.key, s), []).append(run.time)
+                if rep == 0:
+                    results[(case.key, s)] = {**evaluate(case, run), "status": run.status}
+
+    cols = [s for s in SOLVERS if s in solvers]
+    print("\n| instance | n | " + " | ".join(f"{s} t" for s in cols) + " | "
+          + " | ".join(f"{s} obj" for s in cols)
+          + " | plain viol/tol | lower bound | new gap | new vs plain-tight |")
+    print("|" + "---|" * (2 * len(cols) + 6))
+    for case in cases:
+        r = {s: results[(case.key, s)] for s in cols}
+        t = {s: statistics.median(times[(case.key, s)]) for s in cols}
+        rel = "-"
+        if "new" in r and "plain-tight" in r and r["new"]["ok"] and r["plain-tight"]["ok"]:
+            rel = f"{r['new']['obj'] / r['plain-tight']['obj'] - 1:+.1e}"
+        viol = f"{r['plain']['viol']:.2f}" if "plain" in r else "-"
+        gap = f"{r['new']['gap']:.2e}" if "new" in r and r["new"]["ok"] else "-"
+        print(f"| {case.key} | {case.problem.n} | "
+              + " | ".join(f"{t[s]:.3f}" for s in cols) + " | "
+              + " | ".join(fmt(float(r[s]["obj"]), bool(r[s]["ok"])) for s in cols)
+              + f" | {viol} | {case.lower_bound:.8g} | {gap} | {rel} |", flush=True)
+
+    print("\n## Summary")
+    print("| solver | accepted | median t [s] | worst t [s] | worse than plain-tight by > 1e-6 "
+          "| worst relative to plain-tight | below the lower bound |")
+    print("|---|---|---|---|---|---|---|")
+    for s in cols:
+        rs = [results[(c.key, s)] for c in cases]
+        ts = [statistics.median(times[(c.key, s)]) for c in cases]
+        rels = [results[(c.key, s)]["obj"] / results[(c.key, "plain-tight")]["obj"] - 1
+                for c in cases if results[(c.key, s)]["ok"]
+                and "plain-tight" in cols and results[(c.key, "plain-tight")]["ok"]]
+        below = sum(bool(r["ok"]) and float(r["gap"]) < 0 for r in rs)
+        print(f"| {s} | {sum(bool(r['ok']) for r in rs)}/{len(rs)} | {statistics.median(ts):.3f} "
+              f"| {max(ts):.3f} | {sum(x > 1e-6 for x in rels)} "
+              f"| {f'{max(rels):+.1e}' if rels else '-'} | {below} |")
+    names = list(STARTS)
+    if all(name in cols for name in names):
+        first, second = names[0], names[1]
+        agree = sum(
+            bool(results[(c.key, first)]["ok"] and results[(c.key, second)]["ok"]
+                 and abs(results[(c.key, first)]["obj"] - results[(c.key, second)]["obj"])
+                 <= AGREE * results[(c.key, first)]["obj"])
+            for c in cases)
+        print(f"\n{first} and {second} agree to {AGREE:g} on {agree}/{len(cases)} instances")
+    if "new" in cols:
+        viols = [float(results[(c.key, "new")]["viol"]) for c in cases
+                 if results[(c.key, "new")]["ok"]]
+        print(f"new: largest jerk-row violation of an accepted point {max(viols):.2e} jerk_tol")
+    if "old" in cols and "new" in cols:
+        both = [c for c in cases if results[(c.key, "old")]["ok"] and results[(c.key, "new")]["ok"]]
+        ratio = [statistics.median(times[(c.key, "old")]) / statistics.median(times[(c.key, "new")])
+                 for c in both]
+        if ratio:
+            print(f"\nold/new time on the {len(both)} instances both solved: median "
+                  f"{statistics.median(ratio):.1f}x, min {min(ratio):.1f}x, max {max(ratio):.1f}x")
+    print(f"\n# total wall time {time.perf_counter() - t_start:.0f} s")
 
 
 if __name__ == "__main__":

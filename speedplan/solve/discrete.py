@@ -22,9 +22,9 @@ from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, c
 from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
 from .banded import check_grid_resolvable, kernel_for_auto, solve_unit_relaxation, unit_scales
 from .clarabel_ import RelaxationResult, solve_relaxation
-from .ipopt_ import refine_ipopt
 from .nojerk import check_reachable, max_feasible_w
 from .problem import DiscreteProblem
+from .refine import refine as refine_nlp
 from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
 __all__ = ["BACKENDS", "REFINE_MODES", "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
@@ -149,13 +149,15 @@ def solve_problem(
 
     if refine == "always" or (refine == "auto" and not exact):
         refined = True
-        ref = refine_ipopt(unit, relax.w)
+
+        def feasible(w_unit: FloatArray) -> bool:
+            w_ref = np.clip(w_unit * w_scale, 0.0, problem.w_max)
+            return bool(problem.linear_violation(w_ref) <= _linear_tol(problem)
+                        and problem.jerk_violation(w_ref) <= problem.jerk_tol)
+
+        ref = refine_nlp(unit, relax.w, accept=feasible)
         w_ref = np.clip(ref.w * w_scale, 0.0, problem.w_max)
-        ref_ok = (
-            ref.success
-            and problem.linear_violation(w_ref) <= _linear_tol(problem)
-            and problem.jerk_violation(w_ref) <= problem.jerk_tol
-        )
+        ref_ok = ref.success and feasible(ref.w)
         refinement = RefinementInfo(
             status=ref.status, accepted=ref_ok, iterations=ref.iterations, time=ref.solve_time,
             objective=problem.travel_time(w_ref) if ref_ok else None,
@@ -168,11 +170,11 @@ def solve_problem(
                 if fallback is None:
                     raise SolverError(
                         f"the relaxation is not exact (jerk violation {relaxed_violation:.3g}) "
-                        f"and IPOPT did not return a feasible point (status {ref.status})",
+                        f"and the refinement did not return a feasible point ({ref.status})",
                         backend="ipopt", status=ref.status,
                     )
                 warnings.warn(
-                    f"IPOPT refinement failed (status {ref.status}); returning the relaxed "
+                    f"the refinement failed ({ref.status}); returning the relaxed "
                     "solution scaled into the jerk bounds (status 'scaled')",
                     SpeedplanWarning, stacklevel=3,
                 )

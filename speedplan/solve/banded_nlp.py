@@ -1,0 +1,735 @@
+"""Local refinement of the original (nonconvex) problem by a banded interior-point method.
+
+The refinement NLP (minimise ``Σ τ_i / sqrt(w_i)`` under the acceleration rows, the bounds and
+the jerk-type rows ``|c_i · w_{i-1:i+2}| sqrt(w_i) <= B_i``) couples only neighbouring nodes:
+every row touches at most three consecutive ``w``. A primal-dual interior-point step on it
+condenses, after eliminating the row slacks and the bound multipliers, to one symmetric
+pentadiagonal system in the interior ``w`` (the Hessian of the Lagrangian is tridiagonal;
+``J' Σ J`` adds one band on each side), which LAPACK's banded Cholesky (``dpbtrf``) factors
+in ``O(n)``. IPOPT with MUMPS spends most of its time on the same systems as general sparse
+ones (``docs/performance.md`` has the measurements).
+
+The method is IPOPT's (Wächter & Biegler, Math. Program. 106, 2006, with its default
+constants) on this structure: a slack for every row, the monotone barrier update, the filter
+line search with second-order corrections, inertia correction by a multiple of the identity
+(the condensed matrix must be positive definite) and a feasibility-restoration phase (the
+elastic ``ℓ1`` problem with a proximity term) when the line search fails. The rows are the
+plain ones, ``(c · w) sqrt(w_i) ∈ [-B_i, B_i]``. The answer is re-checked by the caller,
+never trusted.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from itertools import pairwise
+from typing import NamedTuple
+
+import numpy as np
+from scipy.linalg.lapack import dpbtrf, dpbtrs
+
+from ..core.checks import FloatArray, IntArray
+from .problem import DiscreteProblem
+
+__all__ = ["STARTS", "BandedNlpResult", "Start", "solve_banded_nlp"]
+
+#: Lower bound on interior ``w`` (unit scale) when the problem has none: keeps ``sqrt(w)``
+#: and ``1/sqrt(w)`` finite; it never binds at a solution (``1/sqrt(w)`` would be huge).
+W_FLOOR = 1e-9
+#: Relative width to which a fixed node (``w_min = w_max``) is opened so the barrier exists.
+FIXED_WIDTH = 1e-10
+#: Scaled optimality tolerance (IPOPT's ``tol``) and the one a run stalled by round-off may
+#: stop at (IPOPT's ``acceptable_tol``); the caller checks the rows in any case.
+TOL = 1e-9
+ACCEPTABLE_TOL = 1e-6
+#: Iterations per run, restoration included: successful runs took at most 155 on the
+#: benchmark corpus; runs that fail (a locally infeasible problem) would go on for hundreds.
+MAX_ITER = 200
+MAX_RESTORATIONS = 50
+# IPOPT's algorithmic constants and defaults (same names).
+KAPPA_EPS, KAPPA_MU, THETA_MU, TAU_MIN = 10.0, 0.2, 1.5, 0.99
+GAMMA_THETA, GAMMA_PHI, DELTA, S_THETA, S_PHI, ETA_PHI = 1e-5, 1e-8, 1.0, 1.1, 2.3, 1e-8
+ALPHA_MIN_FRAC = 0.05
+KAPPA_SIGMA, MAX_SOC, KAPPA_SOC = 1e10, 4, 0.99
+DELTA_W_FIRST, DELTA_W_MIN, DELTA_W_MAX = 1e-4, 1e-20, 1e40
+KAPPA_W_PLUS_FIRST, KAPPA_W_PLUS, KAPPA_W_MINUS = 100.0, 8.0, 1.0 / 3.0
+#: Restoration phase: penalty on the elastic variables and the reduction of the row
+#: violation required before returning (IPOPT's resto_penalty_parameter, kappa_resto).
+RESTO_RHO, KAPPA_RESTO = 1000.0, 0.9
+#: Largest gradient entry after IPOPT's gradient-based scaling (nlp_scaling_max_gradient).
+SCALING_MAX_GRADIENT = 100.0
+
+
+@dataclass(frozen=True)
+class Start:
+    """How a run starts from the relaxed ``w``.
+
+    Attributes
+    ----------
+    name : str
+        Label used in statuses.
+    mu_init : float
+        First barrier parameter.
+    push : float
+        How far (relative) the start is moved into its bounds (IPOPT's ``bound_push`` and
+        ``bound_frac``).
+    gradient_scaling : bool
+        IPOPT's gradient-based scaling of the objective and of each row at the start.
+    """
+
+    name: str
+    mu_init: float
+    push: float
+    gradient_scaling: bool
+
+
+#: The starts :func:`speedplan.solve.refine.refine` runs, in this order, each a different path
+#: to a local optimum (the problem is nonconvex). ``near`` and ``nearer`` stay close to the
+#: relaxed ``w`` (small push, small first barrier parameter); ``ipopt-default`` is IPOPT's
+#: default start and scaling, slower, and it reaches feasibility where the near starts stall.
+#: On the benchmark corpus (150 instances) the best of the three was never worse than IPOPT
+#: (defaults, tight tolerances) by more than 2.5e-5, and better by up to 3.4 %.
+STARTS = (
+    Start("near", mu_init=1e-2, push=1e-4, gradient_scaling=False),
+    Start("ipopt-default", mu_init=0.1, push=1e-2, gradient_scaling=True),
+    Start("nearer", mu_init=1e-3, push=1e-4, gradient_scaling=False),
+)
+
+
+@dataclass(frozen=True)
+class BandedNlpResult:
+    """Raw result of :func:`solve_banded_nlp` (``w`` on the full grid, problem units).
+
+    Attributes
+    ----------
+    w : ndarray, shape (n,)
+        Last (or best acceptable) iterate, ends included.
+    status : str
+        ``"Solved"``, ``"Acceptable"``, ``"MaxIterations"``, ``"LocallyInfeasible"``,
+        ``"RestorationFailed"`` or ``"InertiaCorrectionFailed"``.
+    success : bool
+        ``status`` is ``"Solved"`` or ``"Acceptable"``.
+    iterations, factorizations, restorations : int
+        Counts (restoration iterations included in ``iterations``).
+    """
+
+    w: FloatArray
+    status: str
+    success: bool
+    iterations: int
+    factorizations: int
+    restorations: int
+
+
+@dataclass(frozen=True)
+class _Family:
+    """Rows ``r_k (c_k · w_{k:k+3}) sqrt(w_{k+1})`` on full-grid nodes ``k, k+1, k+2``.
+
+    ``at(j)`` indexes the nodes ``k + j``: a slice when ``k`` is contiguous (the usual case,
+    every row finite), which numpy serves without gathering.
+    """
+
+    k: IntArray
+    c: FloatArray
+    r: FloatArray
+
+    def at(self, j: int) -> slice | IntArray:
+        k = self.k
+        if k[-1] - k[0] + 1 == k.size:
+            return slice(int(k[0]) + j, int(k[-1]) + 1 + j)
+        return k + j
+
+
+class _Eval(NamedTuple):
+    """Row values at one point and, per family, the stencil ``D (k, 3)``, ``c · w``, ``sqrt(w)``."""
+
+    c: FloatArray
+    stencils: list[tuple[FloatArray, FloatArray, FloatArray]]
+
+
+class _Rows:
+    """Acceleration rows (the first ``n - 1``), then every jerk-type family, in ``w[1:-1]``."""
+
+    def __init__(self, p: DiscreteProblem) -> None:
+        self.n = p.n
+        self.w_start, self.w_end = p.w_start, p.w_end
+        self.fams: list[_Family] = []
+        lo, hi = [-p.decel * p.h], [p.accel * p.h]
+        for fam in p.stencil_families():
+            k = np.flatnonzero(np.isfinite(fam.bound))
+            if k.size:
+                self.fams.append(_Family(k=k, c=np.asarray(fam.coef, dtype=np.float64)[k],
+                                         r=np.ones(k.size)))
+                lo.append(-fam.bound[k])
+                hi.append(fam.bound[k])
+        self.lo, self.hi = np.concatenate(lo), np.concatenate(hi)
+        self.size = self.lo.size
+
+    def full(self, x: FloatArray) -> FloatArray:
+        return np.concatenate(([self.w_start], x, [self.w_end]))
+
+    def scale(self, ev: _Eval, max_gradient: float) -> None:
+        """Scale each family row so its largest derivative at ``ev`` is ``<= max_gradient``."""
+        lo, hi = [self.lo[: self.n - 1]], [self.hi[: self.n - 1]]
+        o = self.n - 1
+        fams = []
+        for fa, (d, _, _) in zip(self.fams, ev.stencils, strict=True):
+            k = fa.k.size
+            sc = np.minimum(1.0, max_gradient / np.maximum(np.abs(d).max(axis=1), 1e-300))
+            fams.append(_Family(k=fa.k, c=fa.c, r=fa.r * sc))
+            lo.append(self.lo[o : o + k] * sc)
+            hi.append(self.hi[o : o + k] * sc)
+            o += k
+        self.fams = fams
+        self.lo, self.hi = np.concatenate(lo), np.concatenate(hi)
+
+    def evaluate(self, x: FloatArray) -> _Eval:
+        w = self.full(x)
+        sx = np.sqrt(x)
+        parts = [np.diff(w)]
+        stencils = []
+        for fa in self.fams:
+            k0, k1, k2 = fa.at(0), fa.at(1), fa.at(2)
+            sq = sx[k0]
+            load = fa.c[:, 0] * w[k0] + fa.c[:, 1] * w[k1] + fa.c[:, 2] * w[k2]
+            parts.append(fa.r * load * sq)
+            d = np.empty((fa.k.size, 3))
+            d[:, 0] = fa.r * fa.c[:, 0] * sq
+            d[:, 1] = fa.r * (fa.c[:, 1] * sq + load / (2.0 * sq))
+            d[:, 2] = fa.r * fa.c[:, 2] * sq
+            stencils.append((d, load, sq))
+        return _Eval(np.concatenate(parts), stencils)
+
+    def jac_t(self, ev: _Eval, v: FloatArray) -> FloatArray:
+        """``J' v`` (one value per interior node)."""
+        out = np.zeros(self.n)
+        va = v[: self.n - 1]
+        out[1:] += va
+        out[:-1] -= va
+        o = self.n - 1
+        for fa, (d, _, _) in zip(self.fams, ev.stencils, strict=True):
+            vv = v[o : o + fa.k.size]
+            out[fa.at(0)] += vv * d[:, 0]
+            out[fa.at(1)] += vv * d[:, 1]
+            out[fa.at(2)] += vv * d[:, 2]
+            o += fa.k.size
+        return out[1:-1]
+
+    def jac(self, ev: _Eval, dx: FloatArray) -> FloatArray:
+        """``J dx`` (one value per row)."""
+        d = np.concatenate(([0.0], dx, [0.0]))
+        parts = [np.diff(d)]
+        for fa, (dd, _, _) in zip(self.fams, ev.stencils, strict=True):
+            parts.append(dd[:, 0] * d[fa.at(0)] + dd[:, 1] * d[fa.at(1)] + dd[:, 2] * d[fa.at(2)])
+        return np.concatenate(parts)
+
+    def condensed(self, ev: _Eval, y: FloatArray, sig: FloatArray, diag: FloatArray) -> FloatArray:
+        """``Σ_r y_r ∇²c_r + J' diag(sig) J + diag(diag)`` in LAPACK's lower band storage."""
+        n = self.n
+        dg, o1, o2 = np.zeros(n), np.zeros(n - 1), np.zeros(n - 2)
+        sa = sig[: n - 1]
+        dg[1:] += sa
+        dg[:-1] += sa
+        o1 -= sa
+        o = n - 1
+        for fa, (d, load, sq) in zip(self.fams, ev.stencils, strict=True):
+            k0, k1, k2 = fa.at(0), fa.at(1), fa.at(2)
+            s = sig[o : o + fa.k.size]
+            yr = y[o : o + fa.k.size] * fa.r
+            dg[k0] += s * d[:, 0] ** 2
+            dg[k1] += s * d[:, 1] ** 2 + yr * (fa.c[:, 1] / sq - load / (4.0 * sq**3))
+            dg[k2] += s * d[:, 2] ** 2
+            o1[k0] += s * d[:, 0] * d[:, 1] + yr * fa.c[:, 0] / (2.0 * sq)
+            o1[k1] += s * d[:, 1] * d[:, 2] + yr * fa.c[:, 2] / (2.0 * sq)
+            o2[k0] += s * d[:, 0] * d[:, 2]
+            o += fa.k.size
+        ab = np.zeros((3, n - 2))
+        ab[0] = dg[1:-1] + diag
+        ab[1, :-1] = o1[1:-1]
+        ab[2, :-2] = o2[1:-1]
+        return ab
+
+
+class _Objective(NamedTuple):
+    """A separable objective: value, gradient and (diagonal) Hessian."""
+
+    value: Callable[[FloatArray], float]
+    grad: Callable[[FloatArray], FloatArray]
+    hess: Callable[[FloatArray], FloatArray]
+
+
+def _travel_time(tau: FloatArray) -> _Objective:
+    """``Σ τ_i / sqrt(x_i)``."""
+    return _Objective(
+        value=lambda x: float(np.sum(tau / np.sqrt(x))),
+        grad=lambda x: -0.5 * tau / (x * np.sqrt(x)),
+        hess=lambda x: 0.75 * tau / (x * x * np.sqrt(x)),
+    )
+
+
+def _proximity(x_ref: FloatArray, zeta: float) -> _Objective:
+    """IPOPT's restoration objective without the penalty: ``ζ/2 ||D (x - x_ref)||²``."""
+    d2 = zeta * np.minimum(1.0, 1.0 / np.abs(x_ref)) ** 2
+    return _Objective(
+        value=lambda x: 0.5 * _dot(d2, (x - x_ref) ** 2),
+        grad=lambda x: d2 * (x - x_ref),
+        hess=lambda x: d2,
+    )
+
+
+class _Point(NamedTuple):
+    """Primal-dual iterate.
+
+    ``x``, row slacks ``s``, elastic ``p, q`` (``c - s + p - q = 0``), row multipliers ``y``
+    and the multipliers ``z`` of the stacked gaps (see ``_Phase``).
+    """
+
+    x: FloatArray
+    s: FloatArray
+    p: FloatArray
+    q: FloatArray
+    y: FloatArray
+    z: FloatArray
+
+
+class _Outcome(NamedTuple):
+    status: str
+    point: _Point
+    mu: float
+    filt: list[tuple[float, float]]
+    iterations: int
+    factorizations: int
+
+
+def _dot(a: FloatArray, b: FloatArray) -> float:
+    """``a · b`` without BLAS.
+
+    A threaded ``ddot`` took a fifth of the run time when the cores were shared: handing the
+    work to threads costs more than the sum itself.
+    """
+    return float(np.sum(a * b))
+
+
+def _push_inside(v: FloatArray, lo: FloatArray, hi: FloatArray, push: float) -> FloatArray:
+    """Clip into ``[lo, hi]`` and move away from each bound (IPOPT's bound_push, bound_frac)."""
+    frac = push * (hi - lo)
+    p_lo = np.minimum(push * np.maximum(1.0, np.abs(lo)), frac)
+    p_hi = np.minimum(push * np.maximum(1.0, np.abs(hi)), frac)
+    return np.clip(v, lo + p_lo, hi - p_hi)
+
+
+def _max_step(v: FloatArray, dv: FloatArray, tau: float) -> float:
+    """Largest ``α <= 1`` with ``v + α dv >= (1 - tau) v`` (fraction to the boundary)."""
+    ratio = np.divide(-v, dv, out=np.full_like(v, np.inf), where=dv < 0)
+    return float(min(1.0, tau * ratio.min()))
+
+
+def _factor(ab: FloatArray, delta_last: float) -> tuple[FloatArray | None, float, int]:
+    """Cholesky factor of ``ab`` (band storage), shifted by ``δ I`` if needed.
+
+    A matrix that is not positive definite gets IPOPT's inertia correction; returns
+    ``(factor, δ, factorizations)``.
+    """
+    factor, info = dpbtrf(ab, lower=1)
+    if info == 0:
+        return factor, 0.0, 1
+    count = 1
+    delta = DELTA_W_FIRST if delta_last == 0 else max(DELTA_W_MIN, KAPPA_W_MINUS * delta_last)
+    while delta <= DELTA_W_MAX:
+        shifted = ab.copy()
+        shifted[0] += delta
+        factor, info = dpbtrf(shifted, lower=1)
+        count += 1
+        if info == 0:
+            return factor, delta, count
+        delta *= KAPPA_W_PLUS_FIRST if delta_last == 0 else KAPPA_W_PLUS
+    return None, delta, count
+
+
+class _Newton(NamedTuple):
+    """The factored, condensed Newton system at one iterate (see ``_Phase.newton``)."""
+
+    factor: FloatArray
+    sig: FloatArray
+    sig_s: FloatArray
+    sig_e: FloatArray
+    r_x: FloatArray
+    r_s: FloatArray
+    r_p: FloatArray
+    r_q: FloatArray
+    r_extra: FloatArray
+
+
+class _Reference(NamedTuple):
+    """What the filter line search compares a trial point with."""
+
+    theta: float
+    phi: float
+    dphi: float
+    mu: float
+    theta_min: float
+    theta_max: float
+    filt: list[tuple[float, float]]
+
+
+class _Trial(NamedTuple):
+    point: _Point
+    ev: _Eval
+    residual: FloatArray
+
+
+class _Phase:
+    """One interior-point run on ``min f(x) + ρ Σ (p + q)``.
+
+    The constraints are ``c(x) - s + p - q = 0``, ``lo <= s <= hi``, ``lb <= x <= ub`` and
+    ``p, q >= 0``.
+
+    The elastic ``p, q`` exist only when ``elastic`` (the restoration phase). All gaps to
+    bounds are stacked as ``g = (x - lb, ub - x, s - lo, hi - s, p, q)`` with multipliers
+    ``z``, so complementarity, the fraction to the boundary and the barrier are single vector
+    operations. ``stop`` is asked after every accepted step; a status it returns ends the run.
+    """
+
+    def __init__(
+        self, rows: _Rows, lb: FloatArray, ub: FloatArray, objective: _Objective, *,
+        elastic: bool, rho: float = 0.0,
+        stop: Callable[[_Eval, _Point], str | None] | None = None,
+    ) -> None:
+        self.rows, self.lb, self.ub, self.obj = rows, lb, ub, objective
+        self.ne = rows.size if elastic else 0
+        self.rho, self.stop = rho, stop
+        m, r, e = lb.size, rows.size, self.ne
+        self.m = m
+        cuts = np.cumsum([0, m, m, r, r, e, e])
+        self.slices = tuple(slice(a, b) for a, b in pairwise(cuts))
+
+    def gaps(self, pt: _Point) -> FloatArray:
+        lo, hi = self.rows.lo, self.rows.hi
+        return np.concatenate((pt.x - self.lb, self.ub - pt.x, pt.s - lo, hi - pt.s, pt.p, pt.q))
+
+    def residual(self, ev: _Eval, pt: _Point) -> FloatArray:
+        r = ev.c - pt.s
+        return r + pt.p - pt.q if self.ne else r
+
+    def barrier(self, pt: _Point, g: FloatArray, mu: float) -> float:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            logs = float(np.log(g).sum())
+        return self.obj.value(pt.x) + self.rho * float(pt.p.sum() + pt.q.sum()) - mu * logs
+
+    def errors(self, pt: _Point, ev: _Eval, g: FloatArray, jty: FloatArray,
+               mu: float) -> tuple[float, float]:
+        """IPOPT's scaled optimality error for ``mu = 0`` and for the current ``mu``."""
+        i_xl, i_xu, i_sl, i_su, i_p, i_q = self.slices
+        z, y = pt.z, pt.y
+        dual = max(float(np.abs(self.obj.grad(pt.x) + jty - z[i_xl] + z[i_xu]).max()),
+                   float(np.abs(-y - z[i_sl] + z[i_su]).max()))
+        if self.ne:
+            dual = max(dual, float(np.abs(self.rho + y - z[i_p]).max()),
+                       float(np.abs(self.rho - y - z[i_q]).max()))
+        z_sum = float(z.sum())
+        s_d = max(1.0, (float(np.abs(y).sum()) + z_sum) / (100.0 * (self.m + y.size + g.size)))
+        s_c = max(1.0, z_sum / (100.0 * g.size))
+        rest = max(dual / s_d, float(np.abs(self.residual(ev, pt)).max()))
+        gz = g * z
+        return (max(rest, float(gz.max()) / s_c),
+                max(rest, float(np.abs(gz - mu).max()) / s_c))
+
+    def newton(self, pt: _Point, ev: _Eval, g: FloatArray, jty: FloatArray, mu: float,
+               delta_last: float) -> tuple[_Newton | None, float, int]:
+        """Condense and factor the Newton system (module docstring)."""
+        i_xl, i_xu, i_sl, i_su, i_p, i_q = self.slices
+        y = pt.y
+        sig, mg = pt.z / g, mu / g
+        sig_s = sig[i_sl] + sig[i_su]
+        r_x = self.obj.grad(pt.x) + jty - mg[i_xl] + mg[i_xu]
+        r_s = -y - mg[i_sl] + mg[i_su]
+        inv, r_extra = 1.0 / sig_s, r_s / sig_s
+        r_p = r_q = pt.p
+        if self.ne:
+            r_p, r_q = self.rho + y - mg[i_p], self.rho - y - mg[i_q]
+            inv = inv + 1.0 / sig[i_p] + 1.0 / sig[i_q]
+            r_extra = r_extra - r_p / sig[i_p] + r_q / sig[i_q]
+        sig_e = 1.0 / inv
+        diag = sig[i_xl] + sig[i_xu] + self.obj.hess(pt.x)
+        factor, delta, count = _factor(self.rows.condensed(ev, y, sig_e, diag), delta_last)
+        if factor is None:
+            return None, delta, count
+        return _Newton(factor, sig, sig_s, sig_e, r_x, r_s, r_p, r_q, r_extra), delta, count
+
+    def direction(self, nt: _Newton, ev: _Eval, r_c: FloatArray) -> _Point:
+        """Step for the row residual ``r_c`` as a ``_Point`` (``z`` holds the gaps' step)."""
+        rows = self.rows
+        r_t = r_c + nt.r_extra
+        dx, _ = dpbtrs(nt.factor, -nt.r_x - rows.jac_t(ev, nt.sig_e * r_t), lower=1)
+        dy = nt.sig_e * (rows.jac(ev, dx) + r_t)
+        ds = (dy - nt.r_s) / nt.sig_s
+        if not self.ne:
+            return _Point(dx, ds, nt.r_p, nt.r_q, dy, np.concatenate((dx, -dx, ds, -ds)))
+        dp = (-dy - nt.r_p) / nt.sig[self.slices[4]]
+        dq = (dy - nt.r_q) / nt.sig[self.slices[5]]
+        return _Point(dx, ds, dp, dq, dy, np.concatenate((dx, -dx, ds, -ds, dp, dq)))
+
+    def trial(self, pt: _Point, d: _Point, alpha: float) -> _Trial:
+        """The primal point ``pt + α d`` (multipliers unchanged), evaluated."""
+        x = pt.x + alpha * d.x
+        p, q = (pt.p + alpha * d.p, pt.q + alpha * d.q) if self.ne else (pt.p, pt.q)
+        tp = _Point(x, pt.s + alpha * d.s, p, q, pt.y, pt.z)
+        ev = self.rows.evaluate(x)
+        return _Trial(tp, ev, self.residual(ev, tp))
+
+    def verdict(self, tr: _Trial, alpha: float, ref: _Reference) -> bool | None:
+        """Filter test: True (accept, f-type), False (accept, h-type), None (reject)."""
+        theta_t = float(np.abs(tr.residual).sum())
+        phi_t = self.barrier(tr.point, self.gaps(tr.point), ref.mu)
+        if not np.isfinite(phi_t) or theta_t > ref.theta_max:
+            return None
+        if any(theta_t >= ft and phi_t >= fp for ft, fp in ref.filt):
+            return None
+        f_type = ref.dphi < 0 and alpha * (-ref.dphi) ** S_PHI > DELTA * ref.theta**S_THETA
+        if ref.theta <= ref.theta_min and f_type:
+            return True if phi_t <= ref.phi + ETA_PHI * alpha * ref.dphi else None
+        if (theta_t <= (1 - GAMMA_THETA) * ref.theta
+                or phi_t <= ref.phi - GAMMA_PHI * ref.theta):
+            return False
+        return None
+
+    def line_search(
+        self, pt: _Point, g: FloatArray, rp: FloatArray, nt: _Newton, ev: _Eval, d: _Point,
+        tau: float, ref: _Reference,
+    ) -> tuple[bool | None, _Trial, _Point, float]:
+        """IPOPT's filter line search with second-order corrections.
+
+        Returns ``(verdict, trial, step, α)``; a ``None`` verdict means no step was accepted.
+        """
+        theta, dphi = ref.theta, ref.dphi
+        alpha = _max_step(g, d.z, tau)
+        if float(np.max(np.abs(d.z) / (1.0 + g))) < 10 * np.finfo(float).eps:
+            return False, self.trial(pt, d, 1.0), d, 1.0  # tiny step: take it (tiny_step_tol)
+        # IPOPT's smallest step before restoration (its eq. 23).
+        alpha_min = GAMMA_THETA
+        if dphi < 0:
+            alpha_min = min(alpha_min, GAMMA_PHI * theta / -dphi)
+            if theta <= ref.theta_min:
+                alpha_min = min(alpha_min, DELTA * theta**S_THETA / (-dphi) ** S_PHI)
+        alpha_min *= ALPHA_MIN_FRAC
+        first = True
+        tr = self.trial(pt, d, alpha)
+        while alpha >= alpha_min:
+            tr = self.trial(pt, d, alpha)
+            accepted = self.verdict(tr, alpha, ref)
+            if accepted is not None:
+                return accepted, tr, d, alpha
+            if first and float(np.abs(tr.residual).sum()) >= theta:
+                # Second-order correction: aim the step at the rows' curvature.
+                c_soc, theta_old = alpha * rp + tr.residual, theta
+                for _ in range(MAX_SOC):
+                    soc = self.direction(nt, ev, c_soc)
+                    a_soc = _max_step(g, soc.z, tau)
+                    ts = self.trial(pt, soc, a_soc)
+                    accepted = self.verdict(ts, alpha, ref)
+                    if accepted is not None:
+                        return accepted, ts, soc, a_soc
+                    theta_soc = float(np.abs(ts.residual).sum())
+                    if theta_soc > KAPPA_SOC * theta_old:
+                        break
+                    theta_old, c_soc = theta_soc, a_soc * c_soc + ts.residual
+            first = False
+            alpha *= 0.5
+        return None, tr, d, alpha
+
+    def run(self, pt: _Point, mu: float, filt: list[tuple[float, float]],
+            max_iter: int) -> _Outcome:
+        """Iterate from ``pt`` until converged, stopped, failed or out of iterations."""
+        ev = self.rows.evaluate(pt.x)
+        g = self.gaps(pt)
+        rp = self.residual(ev, pt)
+        theta0 = float(np.abs(rp).sum())
+        theta_max, theta_min = 1e4 * max(1.0, theta0), 1e-4 * max(1.0, theta0)
+        delta_last = 0.0
+        n_fact = it = 0
+        status = "MaxIterations"
+        best_e, best = np.inf, pt
+        for it in range(max_iter + 1):
+            jty = self.rows.jac_t(ev, pt.y)
+            e0, e_mu = self.errors(pt, ev, g, jty, mu)
+            if e0 <= TOL:
+                status = "Solved"
+                break
+            if e0 < best_e:
+                best_e, best = e0, pt
+            if it == max_iter:
+                break
+            if e_mu <= KAPPA_EPS * mu and mu > TOL / 10:  # monotone barrier update
+                mu = max(TOL / 10, min(KAPPA_MU * mu, mu**THETA_MU))
+                filt = []
+            tau = max(TAU_MIN, 1.0 - mu)
+            nt, delta, count = self.newton(pt, ev, g, jty, mu, delta_last)
+            n_fact += count
+            if nt is None:
+                status = "InertiaCorrectionFailed"
+                break
+            if delta > 0:
+                delta_last = delta
+            d = self.direction(nt, ev, rp)
+            mg = mu / g
+            dz = mg - pt.z - nt.sig * d.z
+            a_dual = _max_step(pt.z, dz, tau)
+            dphi = _dot(self.obj.grad(pt.x), d.x) - _dot(mg, d.z)
+            if self.ne:
+                dphi += self.rho * float(d.p.sum() + d.q.sum())
+            theta = float(np.abs(rp).sum())
+            phi = self.barrier(pt, g, mu)
+            ref = _Reference(theta, phi, dphi, mu, theta_min, theta_max, filt)
+            accepted, tr, step, alpha = self.line_search(pt, g, rp, nt, ev, d, tau, ref)
+            if accepted is None:
+                if best_e <= ACCEPTABLE_TOL:  # stalled by round-off, near enough
+                    return _Outcome("Acceptable", best, mu, filt, it, n_fact)
+                filt.append((theta, phi))  # IPOPT adds the current point before restoring
+                status = "LineSearchFailed"
+                break
+            if not accepted:
+                filt.append(((1 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta))
+            ev, rp = tr.ev, tr.residual
+            g = self.gaps(tr.point)
+            # IPOPT's safeguard: keep each bound multiplier within a factor of mu / gap.
+            z = np.minimum(np.maximum(pt.z + a_dual * dz, mu / (KAPPA_SIGMA * g)),
+                           KAPPA_SIGMA * mu / g)
+            pt = tr.point._replace(y=pt.y + alpha * step.y, z=z)
+            if self.stop is not None:
+                stop = self.stop(ev, pt)
+                if stop is not None:
+                    status = stop
+                    break
+        if status == "MaxIterations" and best_e <= ACCEPTABLE_TOL:
+            return _Outcome("Acceptable", best, mu, filt, it, n_fact)
+        return _Outcome(status, pt, mu, filt, it, n_fact)
+
+
+def _bounds(p: DiscreteProblem) -> tuple[FloatArray, FloatArray]:
+    """Bounds on interior ``w``: ``[max(w_min, W_FLOOR), w_max]``, fixed nodes opened."""
+    ub = p.w_max[1:-1].astype(np.float64)
+    lb = np.minimum(W_FLOOR * max(1.0, float(np.max(p.w_max))), ub)
+    if p.w_min is not None:
+        lb = np.maximum(lb, p.w_min[1:-1])
+    width = FIXED_WIDTH * np.maximum(1.0, ub)
+    fixed = ub - lb <= width
+    return np.where(fixed, np.maximum(lb - width, 0.5 * lb), lb), np.where(fixed, ub + width, ub)
+
+
+def _elastic_split(r: FloatArray, a: float) -> tuple[FloatArray, FloatArray]:
+    """``p, q > 0`` with ``q - p = r`` and ``p q = a²``."""
+    root = np.sqrt(r * r + 4.0 * a * a)
+    return 0.5 * (root - r), 0.5 * (root + r)
+
+
+def solve_banded_nlp(
+    problem: DiscreteProblem, w0: FloatArray, start: Start = STARTS[0], *,
+    max_iter: int = MAX_ITER,
+) -> BandedNlpResult:
+    """Run the banded interior-point method from ``w0`` (interior nodes free, ends fixed).
+
+    Parameters
+    ----------
+    problem : DiscreteProblem
+        The problem, best in units where ``max(w_max) = 1`` and the mean step is 1 (as
+        :func:`speedplan.solve.solve_problem` passes it).
+    w0 : ndarray, shape (n,)
+        Start (the relaxed ``w``); clipped into the bounds.
+    start : Start
+        One of :data:`STARTS`.
+    max_iter : int
+        Iteration limit, restoration included.
+
+    Returns
+    -------
+    BandedNlpResult
+        ``success`` when IPOPT's scaled optimality error fell below ``TOL``, or below
+        ``ACCEPTABLE_TOL`` where round-off stalled the run.
+
+    Examples
+    --------
+    A rest-to-rest move whose relaxation violates jerk rows (``J`` varies strongly), in
+    units where ``max(w_max) = 1``:
+
+    >>> import numpy as np
+    >>> from speedplan.solve import DiscreteProblem
+    >>> from speedplan.solve.banded_nlp import solve_banded_nlp
+    >>> from speedplan.solve.clarabel_ import solve_relaxation
+    >>> from speedplan.solve.paper import paper_instance
+    >>> inst = paper_instance("rnd", "cnst", "logrnd", n=200, seed=0)
+    >>> scale = inst.w_max.max()
+    >>> p = DiscreteProblem(s=np.arange(200.0), w_max=inst.w_max / scale, accel=inst.A / scale,
+    ...                     decel=inst.A / scale, jerk=inst.J / scale**1.5)
+    >>> relaxed = solve_relaxation(p).w
+    >>> bool(p.jerk_violation(relaxed) > p.jerk_tol)
+    True
+    >>> res = solve_banded_nlp(p, relaxed)
+    >>> res.success, bool(p.jerk_violation(res.w) <= p.jerk_tol)
+    (True, True)
+    >>> bool(p.travel_time(res.w) >= solve_relaxation(p).dual_objective)
+    True
+    """
+    rows = _Rows(problem)
+    lb, ub = _bounds(problem)
+    x = _push_inside(np.asarray(w0, dtype=np.float64)[1:-1], lb, ub, start.push)
+    tau = problem.tau.astype(np.float64)
+    if start.gradient_scaling:
+        grad = _travel_time(tau).grad(x)
+        tau = tau * min(1.0, SCALING_MAX_GRADIENT / float(np.abs(grad).max()))
+        rows.scale(rows.evaluate(x), SCALING_MAX_GRADIENT)
+    main = _Phase(rows, lb, ub, _travel_time(tau), elastic=False)
+    s = _push_inside(rows.evaluate(x).c, rows.lo, rows.hi, start.push)
+    empty = np.zeros(0)
+    mu = start.mu_init
+    pt = _Point(x, s, empty, empty, np.zeros(rows.size), empty)
+    pt = pt._replace(z=mu / main.gaps(pt))
+    filt: list[tuple[float, float]] = []
+    iterations = factorizations = restorations = 0
+    while True:
+        out = main.run(pt, mu, filt, max_iter - iterations)
+        iterations += out.iterations
+        factorizations += out.factorizations
+        pt, mu, status, filt = out.point, out.mu, out.status, out.filt
+        if status != "LineSearchFailed":
+            break
+        if restorations == MAX_RESTORATIONS or iterations >= max_iter:
+            status = "RestorationFailed"
+            break
+        # Feasibility restoration (IPOPT, Section 3.3): reduce the row violation close to the
+        # current point until the original filter accepts the point.
+        restorations += 1
+        r0 = main.residual(rows.evaluate(pt.x), pt)
+        theta_r = float(np.abs(r0).sum())
+        mu_r = max(mu, float(np.abs(r0).max()))
+        pr, qr = _elastic_split(r0, mu_r / RESTO_RHO)
+
+        def leave(ev: _Eval, tp: _Point, theta_r: float = theta_r, mu: float = mu,
+                  filt: list[tuple[float, float]] = filt) -> str | None:
+            tp = tp._replace(p=empty, q=empty)
+            theta_t = float(np.abs(main.residual(ev, tp)).sum())
+            if theta_t > KAPPA_RESTO * theta_r:
+                return None
+            phi_t = main.barrier(tp, main.gaps(tp), mu)
+            if any(theta_t >= ft and phi_t >= fp for ft, fp in filt):
+                return None
+            return "Restored"
+
+        resto = _Phase(rows, lb, ub, _proximity(pt.x, np.sqrt(mu)), elastic=True,
+                       rho=RESTO_RHO, stop=leave)
+        rpt = _Point(pt.x, pt.s, pr, qr, np.zeros(rows.size), empty)
+        rout = resto.run(rpt._replace(z=mu_r / resto.gaps(rpt)), mu_r, [], max_iter - iterations)
+        iterations += rout.iterations
+        factorizations += rout.factorizations
+        if rout.status != "Restored":
+            status = "LocallyInfeasible" if rout.status in ("Solved", "Acceptable") \
+                else "RestorationFailed"
+            break
+        # Rows still violated leave their slacks on a bound, where the next step could only
+        # move a sliver (fraction to the boundary): push them back inside, as at the start.
+        s_back = _push_inside(rout.point.s, rows.lo, rows.hi, start.push)
+        pt = _Point(rout.point.x, s_back, empty, empty, np.zeros(rows.size), empty)
+        pt = pt._replace(z=mu / main.gaps(pt))
+    return BandedNlpResult(
+        w=rows.full(pt.x), status=status, success=status in ("Solved", "Acceptable"),
+        iterations=iterations, factorizations=factorizations, restorations=restorations,
+    )
