@@ -8,7 +8,9 @@ from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
-from .core.errors import LimitWarning
+import numpy as np
+
+from .core.errors import LimitWarning, SolverError
 from .core.limits import Limits
 from .geometry import Path, SpeedBound, SpeedZone
 from .model import ForcedLeg, Leg, PlanRequest, build_model
@@ -151,5 +153,10 @@ def _solve(leg: Leg | ForcedLeg) -> LegResult:
         )
         return LegResult(start=leg.start, s=leg.s, solution=solution, law=law)
     solution = leg.solve()
-    return LegResult(start=leg.start, s=leg.problem.s, solution=solution,
-                     law=law_for(leg.problem.s, solution.w, leg.time_law))
+    law = law_for(leg.problem.s, solution.w, leg.time_law)
+    if not np.isfinite(law.duration):  # never hand out a trajectory that does not arrive
+        raise SolverError(
+            f"the speed law between s={leg.start:.6g} m and s={leg.start + leg.length:.6g} m "
+            "comes to rest before its end (the grid does not resolve a boundary transient); "
+            "plan with the default grid (n=None, ds=None)")
+    return LegResult(start=leg.start, s=leg.problem.s, solution=solution, law=law)

@@ -274,3 +274,34 @@ def test_verify_uses_the_bounds_own_path_when_the_profile_has_another():
     moved = dataclasses.replace(short, path=other)
     generic = dataclasses.replace(moved, speed_bound=lambda s, b=short.speed_bound: b(s))
     assert moved.verify() == generic.verify()
+
+
+@pytest.mark.parametrize(
+    ("length", "lim"),
+    [  # final jerk phases of ~1e-9 of the length (flagged "limits_exceeded" on 1e-9 L steps)
+        (3796.2123365577972, Limits(v_max=11.919834443652514, a_max=0.1952355625560269,
+                                    a_lat_max=1, j_max=12.254342066055846,
+                                    a_decel=0.16360203180194188)),
+        (61732.559974150085, Limits(v_max=0.10403071386939479, a_max=0.05401326900394628,
+                                    a_lat_max=1, j_max=0.5945897176701356,
+                                    a_decel=0.056394461589217876)),
+    ],
+)
+def test_long_moves_resolve_their_final_jerk_phase(length, lim):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no LimitWarning
+        profile = plan(Path.from_segments([Line(length)]), lim)
+    assert profile.status == "optimal"
+    assert profile.duration >= ruckig_duration(length, lim) * (1 - 1e-9)
+
+
+def test_coarse_user_grid_for_a_braking_start_is_refused_by_name():
+    # 2 m at 1/16 mm/s, braking at the start: the law reached rest in the first half cell
+    # of n=120 and the duration was infinite (a NaN-free but never-arriving trajectory).
+    lim = Limits(v_max=6.25e-5, a_max=1e-3, a_lat_max=1e-3, j_max=2e-3)
+    line = Path.from_segments([Line(2.0)])
+    with pytest.raises(InvalidInputError, match=r"too coarse for the start state .* default"):
+        plan(line, lim, v0=3.125e-5, a0=-3e-4, n=120)
+    with pytest.raises(InvalidInputError, match=r"too coarse for the end state"):
+        plan(line, lim, vf=3.125e-5, af=3e-4, n=120)
+    assert np.isfinite(plan(line, lim, v0=3.125e-5, a0=-3e-4).duration)

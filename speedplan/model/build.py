@@ -192,6 +192,7 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
     if request.n is not None or request.ds is not None:
         n = None if request.n is None else request.n
         s = uniform_grid(length, n=n, ds=request.ds)
+        _check_moving_ends_resolved(s, lo, v0, a0, vf, af)
     elif request.jerk_limited:
         low = [v for v in (v0, vf) if v > 0] + [
             turnaround_speed(v, a, lim.j_max) for v, a in ((v0, a0), (vf, -af))
@@ -241,6 +242,30 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
                backend=request.backend)
+
+
+def _check_moving_ends_resolved(s: FloatArray, lo: float, v0: float, a0: float, vf: float,
+                                af: float) -> None:
+    """A user grid must let the speed stay positive over the first (last) half cell.
+
+    The time law keeps the prescribed acceleration at a moving end; a braking start
+    (accelerating arrival) then loses ``|a| h`` of ``w`` over the half cell, so a step
+    ``h >= v² / |a|`` would bring the vehicle to rest inside the cell: that transient is
+    shorter than the grid can resolve.
+    """
+    for name, v, slowing, h, where in (("start", v0, -a0, s[1] - s[0], lo),
+                                       ("end", vf, af, s[-1] - s[-2], lo + s[-1])):
+        if v > 0 and slowing > 0 and h >= 0.5 * v * v / slowing:
+            h_max = 0.5 * v * v / slowing
+            n_min = int(np.ceil(float(s[-1]) / h_max)) + 1
+            state = (f"v0={v:.6g} m/s, a0={-slowing:.6g} m/s²" if name == "start"
+                     else f"vf={v:.6g} m/s, af={slowing:.6g} m/s²")
+            raise InvalidInputError(
+                f"the grid step {h:.3g} m is too coarse for the {name} state {state} at "
+                f"s={where:.6g} m: its transient lasts less than one step (steps below "
+                f"{h_max:.3g} m resolve it); use the default grid (n=None and ds=None), "
+                f"n >= {n_min} or ds < {h_max:.3g}"
+            )
 
 
 def _zero_cause(bound: SpeedBound) -> str:
