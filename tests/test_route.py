@@ -111,13 +111,13 @@ def test_paths_must_meet_at_a_node_without_position():
     (lambda p: RouteEdge("E", 1, "A", "B", p, yaw_rate_max=float("nan")),
      "`yaw_rate_max` must be a finite number"),
     (lambda p: RouteEdge("E", 1, "A", "B", "path"), "`path` must be a speedplan.Path"),
-    (lambda p: RouteEdge("E", 1, "A", "B", p, reverse=1), "`reverse` must be True or False"),
+    (lambda p: RouteEdge("E", 1, "A", "B", p, reverse=1), "`reverse` must be true or false"),
     (lambda p: RouteEdge(3, 1, "A", "B", p), "`edge_id` must be a string"),
     (lambda p: RouteNode("A", -2), "`sequence_id` must be an integer >= 0"),
     (lambda p: RouteNode("A", 0, position=(1.0,)), "`position` must be (x, y) or None"),
     (lambda p: RouteNode("A", 0, position=(1.0, float("inf"))), "`position[1]` must be a finite"),
-    (lambda p: RouteNode("A", 0, allowed_deviation_xy=-0.1), "`allowed_deviation_xy` must be a "
-     "finite number >= 0.0"),
+    (lambda p: RouteNode("A", 0, allowed_deviation_xy=-0.1),
+     "`allowed_deviation_xy` must be >= 0.0"),
 ])
 def test_node_and_edge_fields_are_validated(make, message):
     with pytest.raises(InvalidInputError) as info:

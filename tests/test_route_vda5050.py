@@ -437,6 +437,10 @@ MALFORMED = [
      "`nodes` must be a JSON array"),
     ("orderUpdateId negative", with_(straight_order(), ("orderUpdateId",), -1),
      "`orderUpdateId` must be an integer >= 0"),
+    ("headerId as text", with_(straight_order(), ("headerId",), "1"),
+     "`headerId` must be an integer >= 0; got '1'"),
+    ("serialNumber as number", with_(straight_order(), ("serialNumber",), 42),
+     "`serialNumber` must be a string; got 42"),
     # released base
     ("first node in the horizon", with_(straight_order(), ("nodes", 0, "released"), False),
      "`nodes[0].released` must be true"),

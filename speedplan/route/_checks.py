@@ -7,19 +7,66 @@ names ``nodes[2].sequence_id`` and an order names ``nodes[2].sequenceId``.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 from ..core.checks import FloatArray
 from ..core.errors import InvalidInputError
 
-__all__ = ["NODE_TOLERANCE", "check_meets_node", "check_released", "check_sequence",
-           "node_tolerance"]
+__all__ = ["NODE_TOLERANCE", "boolean", "check_meets_node", "check_released", "check_sequence",
+           "integer", "node_tolerance", "number", "positive", "string"]
 
 #: Smallest distance [m] within which an edge's geometry must meet its nodes: the default when
 #: a node gives no (or a zero) allowed deviation — "within the normal tolerance of the
 #: vehicle", VDA 5050 2.x.
 NODE_TOLERANCE = 0.01
+
+
+# ---- typed fields: `where` names the field in the message ------------------------------------
+def number(value: Any, where: str, *, minimum: float | None = None) -> float:
+    """A finite number (not a bool), at least ``minimum`` if given."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+        raise InvalidInputError(f"`{where}` must be a number; got {value!r}")
+    x = float(value)
+    if not np.isfinite(x):
+        raise InvalidInputError(f"`{where}` must be a finite number; got {value!r}")
+    if minimum is not None and not x >= minimum:
+        raise InvalidInputError(f"`{where}` must be >= {minimum}; got {value!r}")
+    return x
+
+
+def positive(value: Any, where: str) -> float:
+    """A finite number > 0."""
+    x = number(value, where)
+    if not x > 0:
+        raise InvalidInputError(f"`{where}` must be > 0; got {value!r}")
+    return x
+
+
+def integer(value: Any, where: str, minimum: int = 0) -> int:
+    """An integer >= ``minimum``.
+
+    Integral floats count: JSON Schema's rule, and VDA 5050 2.x even types ``degree`` as float64.
+    """
+    ok = not isinstance(value, bool | np.bool_) and isinstance(value, int | float | np.number)
+    if not ok or not np.isfinite(value) or int(value) != value or value < minimum:
+        raise InvalidInputError(f"`{where}` must be an integer >= {minimum}; got {value!r}")
+    return int(value)
+
+
+def string(value: Any, where: str) -> str:
+    """A string."""
+    if not isinstance(value, str):
+        raise InvalidInputError(f"`{where}` must be a string; got {value!r}")
+    return value
+
+
+def boolean(value: Any, where: str) -> bool:
+    """``True`` or ``False`` (no 0/1, no strings)."""
+    if not isinstance(value, bool | np.bool_):
+        raise InvalidInputError(f"`{where}` must be true or false; got {value!r}")
+    return bool(value)
 
 
 def node_tolerance(allowed_deviation_xy: float) -> float:

@@ -15,10 +15,15 @@ from ..core.errors import InvalidInputError
 from ..geometry import Path
 from ..geometry._checks import wrap_angle
 from ._checks import (
+    boolean,
     check_meets_node,
     check_released,
     check_sequence,
+    integer,
     node_tolerance,
+    number,
+    positive,
+    string,
 )
 
 __all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode"]
@@ -27,41 +32,9 @@ __all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode"]
 HEADING_TOLERANCE = 1e-6
 
 
-def _finite(name: str, value: Any, *, minimum: float | None = None) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float | np.floating):
-        raise InvalidInputError(f"`{name}` must be a number; got {value!r}")
-    x = float(value)
-    if not np.isfinite(x) or (minimum is not None and not x >= minimum):
-        need = "a finite number" if minimum is None else f"a finite number >= {minimum}"
-        raise InvalidInputError(f"`{name}` must be {need}; got {value!r}")
-    return x
-
-
-def _positive_or_none(name: str, value: Any) -> float | None:
-    if value is None:
-        return None
-    x = _finite(name, value)
-    if not x > 0:
-        raise InvalidInputError(f"`{name}` must be > 0 (or None: no limit); got {value!r}")
-    return x
-
-
-def _flag(name: str, value: Any) -> bool:
-    if not isinstance(value, bool | np.bool_):
-        raise InvalidInputError(f"`{name}` must be True or False; got {value!r}")
-    return bool(value)
-
-
-def _identifier(name: str, value: Any) -> str:
-    if not isinstance(value, str):
-        raise InvalidInputError(f"`{name}` must be a string; got {value!r}")
-    return value
-
-
-def _sequence_id(name: str, value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 0:
-        raise InvalidInputError(f"`{name}` must be an integer >= 0; got {value!r}")
-    return int(value)
+def _limit(value: Any, where: str) -> float | None:
+    """An optional limit: ``None`` (no limit) or a number > 0."""
+    return None if value is None else positive(value, where)
 
 
 @dataclass(frozen=True)
@@ -106,19 +79,19 @@ class RouteNode:
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
-        set_(self, "node_id", _identifier("node_id", self.node_id))
-        set_(self, "sequence_id", _sequence_id("sequence_id", self.sequence_id))
+        set_(self, "node_id", string(self.node_id, "node_id"))
+        set_(self, "sequence_id", integer(self.sequence_id, "sequence_id"))
         if self.position is not None:
             pos = self.position
             if isinstance(pos, str) or not hasattr(pos, "__len__") or len(pos) != 2:
                 raise InvalidInputError(f"`position` must be (x, y) or None; got {pos!r}")
-            set_(self, "position", (_finite("position[0]", pos[0]), _finite("position[1]", pos[1])))
+            set_(self, "position", (number(pos[0], "position[0]"), number(pos[1], "position[1]")))
         if self.theta is not None:
-            set_(self, "theta", _finite("theta", self.theta))
+            set_(self, "theta", number(self.theta, "theta"))
         set_(self, "allowed_deviation_xy",
-             _finite("allowed_deviation_xy", self.allowed_deviation_xy, minimum=0.0))
-        set_(self, "stop", _flag("stop", self.stop))
-        set_(self, "released", _flag("released", self.released))
+             number(self.allowed_deviation_xy, "allowed_deviation_xy", minimum=0.0))
+        set_(self, "stop", boolean(self.stop, "stop"))
+        set_(self, "released", boolean(self.released, "released"))
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,19 +147,19 @@ class RouteEdge:
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
-        set_(self, "edge_id", _identifier("edge_id", self.edge_id))
-        set_(self, "sequence_id", _sequence_id("sequence_id", self.sequence_id))
-        set_(self, "start_node", _identifier("start_node", self.start_node))
-        set_(self, "end_node", _identifier("end_node", self.end_node))
+        set_(self, "edge_id", string(self.edge_id, "edge_id"))
+        set_(self, "sequence_id", integer(self.sequence_id, "sequence_id"))
+        set_(self, "start_node", string(self.start_node, "start_node"))
+        set_(self, "end_node", string(self.end_node, "end_node"))
         if not isinstance(self.path, Path):
             raise InvalidInputError(
                 f"`path` must be a speedplan.Path; got {type(self.path).__name__}"
             )
-        set_(self, "v_max", _positive_or_none("v_max", self.v_max))
-        set_(self, "yaw_rate_max", _positive_or_none("yaw_rate_max", self.yaw_rate_max))
-        set_(self, "reverse", _flag("reverse", self.reverse))
-        set_(self, "released", _flag("released", self.released))
-        set_(self, "stop", _flag("stop", self.stop))
+        set_(self, "v_max", _limit(self.v_max, "v_max"))
+        set_(self, "yaw_rate_max", _limit(self.yaw_rate_max, "yaw_rate_max"))
+        set_(self, "reverse", boolean(self.reverse, "reverse"))
+        set_(self, "released", boolean(self.released, "released"))
+        set_(self, "stop", boolean(self.stop, "stop"))
 
 
 def _heading_change(incoming: Path, outgoing: Path) -> float:
@@ -296,9 +269,9 @@ class Route:
             self._check_ends(i, e)
         for name, value in (("order_id", self.order_id), ("version", self.version)):
             if value is not None:
-                _identifier(name, value)
+                string(value, name)
         if self.order_update_id is not None:
-            _sequence_id("order_update_id", self.order_update_id)
+            integer(self.order_update_id, "order_update_id")
         object.__setattr__(self, "_stops", self._find_stops())
 
     def _check_ends(self, i: int, edge: RouteEdge) -> None:

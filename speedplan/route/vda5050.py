@@ -17,8 +17,9 @@ node deviation [m]            ``allowedDeviationXY`` number   ``allowedDeviation
 action ``blockingType``       NONE, SOFT, HARD                NONE, SOFT, SINGLE, HARD
 ============================  ==============================  ================================
 
-Both: header ``version`` (required here: it selects the names above) and ``orderId``,
-``orderUpdateId``; nodes ``nodeId``, ``sequenceId``, ``released``, ``nodePosition{x, y,
+Both: header ``version`` (required here: it selects the names above), ``orderId``,
+``orderUpdateId`` (``headerId``, ``timestamp``, ``manufacturer``, ``serialNumber``: type
+checked when present); nodes ``nodeId``, ``sequenceId``, ``released``, ``nodePosition{x, y,
 theta, mapId}``, ``actions[]{actionType, actionId, blockingType}``; edges ``edgeId``,
 ``sequenceId``, ``released``, ``maxRotationSpeed``, ``orientation``, ``orientationType``
 (GLOBAL or TANGENTIAL, default TANGENTIAL), ``trajectory``, ``length``, ``actions``. A field
@@ -54,7 +55,17 @@ import numpy as np
 from ..core.errors import InvalidInputError
 from ..geometry import Line, Path
 from ..geometry._checks import wrap_angle
-from ._checks import check_meets_node, check_released, check_sequence, node_tolerance
+from ._checks import (
+    boolean,
+    check_meets_node,
+    check_released,
+    check_sequence,
+    integer,
+    node_tolerance,
+    number,
+    positive,
+    string,
+)
 from .route import Route, RouteEdge, RouteNode
 
 __all__ = ["load_order", "route_from_vda5050", "trajectory_path", "uniform_clamped_knots"]
@@ -104,42 +115,6 @@ def _required(obj: dict[str, Any], key: str, where: str, why: str = "") -> Any:
     if key not in obj:
         raise InvalidInputError(f"`{where}.{key}` is missing{why}")
     return obj[key]
-
-
-def _number(value: Any, where: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InvalidInputError(f"`{where}` must be a number; got {value!r}")
-    x = float(value)
-    if not np.isfinite(x):
-        raise InvalidInputError(f"`{where}` must be a finite number; got {value!r}")
-    return x
-
-
-def _positive(value: Any, where: str) -> float:
-    x = _number(value, where)
-    if not x > 0:
-        raise InvalidInputError(f"`{where}` must be > 0; got {value!r}")
-    return x
-
-
-def _integer(value: Any, where: str, minimum: int = 0) -> int:
-    # JSON Schema counts 2.0 as an integer; VDA 5050 2.x even types `degree` as float64.
-    ok = not isinstance(value, bool) and isinstance(value, int | float)
-    if not ok or not np.isfinite(value) or int(value) != value or value < minimum:
-        raise InvalidInputError(f"`{where}` must be an integer >= {minimum}; got {value!r}")
-    return int(value)
-
-
-def _string(value: Any, where: str) -> str:
-    if not isinstance(value, str):
-        raise InvalidInputError(f"`{where}` must be a string; got {value!r}")
-    return value
-
-
-def _bool(value: Any, where: str) -> bool:
-    if not isinstance(value, bool):
-        raise InvalidInputError(f"`{where}` must be true or false; got {value!r}")
-    return value
 
 
 # ---- documents -----------------------------------------------------------------------------------
@@ -198,7 +173,7 @@ def route_from_vda5050(order: Any) -> Route:
 
 
 def _dialect(doc: dict[str, Any]) -> _Dialect:
-    version = _string(_required(doc, "version", "order",
+    version = string(_required(doc, "version", "order",
                                 ' (the protocol version, e.g. "2.0.0" or "3.0.0", selects the '
                                 "field names)"), "version")
     parts = version.split(".")
@@ -214,8 +189,14 @@ def _dialect(doc: dict[str, Any]) -> _Dialect:
 def _route(doc: Any) -> Route:
     doc = _obj(doc, "order")
     dialect = _dialect(doc)
-    order_id = _string(doc["orderId"], "orderId") if "orderId" in doc else None
-    update = _integer(doc["orderUpdateId"], "orderUpdateId") if "orderUpdateId" in doc else None
+    # Header fields are not needed to plan; when present they must still have their types.
+    if "headerId" in doc:
+        integer(doc["headerId"], "headerId")
+    for key in ("timestamp", "manufacturer", "serialNumber"):
+        if key in doc:
+            string(doc[key], key)
+    order_id = string(doc["orderId"], "orderId") if "orderId" in doc else None
+    update = integer(doc["orderUpdateId"], "orderUpdateId") if "orderUpdateId" in doc else None
     raw_nodes = _list(_required(doc, "nodes", "order"), "nodes")
     raw_edges = _list(_required(doc, "edges", "order"), "edges")
     if len(raw_nodes) < 2:
@@ -225,20 +206,20 @@ def _route(doc: Any) -> Route:
         )
     nodes_obj = [_obj(n, f"nodes[{i}]") for i, n in enumerate(raw_nodes)]
     edges_obj = [_obj(e, f"edges[{i}]") for i, e in enumerate(raw_edges)]
-    check_sequence([_integer(_required(n, "sequenceId", f"nodes[{i}]"), f"nodes[{i}].sequenceId")
+    check_sequence([integer(_required(n, "sequenceId", f"nodes[{i}]"), f"nodes[{i}].sequenceId")
                     for i, n in enumerate(nodes_obj)],
-                   [_integer(_required(e, "sequenceId", f"edges[{i}]"), f"edges[{i}].sequenceId")
+                   [integer(_required(e, "sequenceId", f"edges[{i}]"), f"edges[{i}].sequenceId")
                     for i, e in enumerate(edges_obj)], "sequenceId")
-    check_released([_bool(_required(n, "released", f"nodes[{i}]"), f"nodes[{i}].released")
+    check_released([boolean(_required(n, "released", f"nodes[{i}]"), f"nodes[{i}].released")
                     for i, n in enumerate(nodes_obj)],
-                   [_bool(_required(e, "released", f"edges[{i}]"), f"edges[{i}].released")
+                   [boolean(_required(e, "released", f"edges[{i}]"), f"edges[{i}].released")
                     for i, e in enumerate(edges_obj)])
     nodes = [_node(n, i, dialect) for i, n in enumerate(nodes_obj)]
     _check_maps(nodes_obj)
     ids = {n.node_id for n in nodes}
     edges = [_edge(e, i, nodes[i], nodes[i + 1], ids, dialect) for i, e in enumerate(edges_obj)]
     return Route(tuple(nodes), tuple(edges), order_id=order_id, order_update_id=update,
-                 version=_string(doc["version"], "version"))
+                 version=string(doc["version"], "version"))
 
 
 def _stops_driving(obj: dict[str, Any], where: str, dialect: _Dialect) -> bool:
@@ -249,8 +230,8 @@ def _stops_driving(obj: dict[str, Any], where: str, dialect: _Dialect) -> bool:
         at = f"{where}.actions[{j}]"
         action = _obj(raw, at)
         for key in ("actionType", "actionId"):
-            _string(_required(action, key, at), f"{at}.{key}")
-        blocking = _string(_required(action, "blockingType", at), f"{at}.blockingType")
+            string(_required(action, key, at), f"{at}.{key}")
+        blocking = string(_required(action, "blockingType", at), f"{at}.blockingType")
         if blocking not in dialect.blocking:
             raise InvalidInputError(
                 f"`{at}.blockingType` must be one of {', '.join(dialect.blocking)} in VDA 5050 "
@@ -278,40 +259,35 @@ def _deviation(pos: dict[str, Any], where: str, dialect: _Dialect) -> float:
                 f"got {pos[keys[0]]!r}"
             )
         ellipse = pos[keys[0]]
-        a, b = (_number(_required(ellipse, k, at), f"{at}.{k}") for k in ("a", "b"))
+        a, b = (number(_required(ellipse, k, at), f"{at}.{k}", minimum=0.0) for k in ("a", "b"))
         if "theta" in ellipse:
-            _number(ellipse["theta"], f"{at}.theta")
-        if a < 0 or b < 0:
-            raise InvalidInputError(f"`{at}`: a and b must be >= 0; got a={a!r}, b={b!r}")
+            number(ellipse["theta"], f"{at}.theta")
         return min(a, b)  # the largest circle inside the ellipse
     # 2.0's schema spells it allowedDeviationXy, its specification allowedDeviationXY.
-    values = {k: _number(pos[k], f"{where}.{k}") for k in keys}
+    values = {k: number(pos[k], f"{where}.{k}", minimum=0.0) for k in keys}
     if len(set(values.values())) > 1:
         raise InvalidInputError(
             f"`{where}` gives both allowedDeviationXY and allowedDeviationXy with different "
             "values; give one"
         )
-    value = next(iter(values.values()))
-    if value < 0:
-        raise InvalidInputError(f"`{where}.{keys[0]}` must be >= 0; got {value!r}")
-    return value
+    return next(iter(values.values()))
 
 
 def _node(raw: dict[str, Any], i: int, dialect: _Dialect) -> RouteNode:
     where = f"nodes[{i}]"
-    node_id = _string(_required(raw, "nodeId", where), f"{where}.nodeId")
+    node_id = string(_required(raw, "nodeId", where), f"{where}.nodeId")
     position: tuple[float, float] | None = None
     theta = None
     deviation = 0.0
     if "nodePosition" in raw:
         at = f"{where}.nodePosition"
         pos = _obj(raw["nodePosition"], at)
-        position = (_number(_required(pos, "x", at), f"{at}.x"),
-                    _number(_required(pos, "y", at), f"{at}.y"))
+        position = (number(_required(pos, "x", at), f"{at}.x"),
+                    number(_required(pos, "y", at), f"{at}.y"))
         if "theta" in pos:
-            theta = _number(pos["theta"], f"{at}.theta")
+            theta = number(pos["theta"], f"{at}.theta")
         if "mapId" in pos:
-            _string(pos["mapId"], f"{at}.mapId")
+            string(pos["mapId"], f"{at}.mapId")
         deviation = _deviation(pos, at, dialect)
     return RouteNode(node_id, int(raw["sequenceId"]), position, theta, deviation,
                      _stops_driving(raw, where, dialect), raw["released"])
@@ -332,7 +308,7 @@ def _check_maps(nodes: list[dict[str, Any]]) -> None:
 def _edge(raw: dict[str, Any], i: int, start: RouteNode, end: RouteNode, ids: set[str],
           dialect: _Dialect) -> RouteEdge:
     where = f"edges[{i}]"
-    edge_id = _string(_required(raw, "edgeId", where), f"{where}.edgeId")
+    edge_id = string(_required(raw, "edgeId", where), f"{where}.edgeId")
     for key, node, j in (("startNodeId", start, i), ("endNodeId", end, i + 1)):
         if key not in raw:
             if dialect.node_ids_required:
@@ -340,7 +316,7 @@ def _edge(raw: dict[str, Any], i: int, start: RouteNode, end: RouteNode, ids: se
                     f"`{where}.{key}` is missing (required in VDA 5050 {dialect.version})"
                 )
             continue
-        named = _string(raw[key], f"{where}.{key}")
+        named = string(raw[key], f"{where}.{key}")
         if named not in ids:
             raise InvalidInputError(
                 f"`{where}.{key}` names node {named!r}, which is not in `nodes`"
@@ -356,12 +332,12 @@ def _edge(raw: dict[str, Any], i: int, start: RouteNode, end: RouteNode, ids: se
             f"`{where}.{dialect.other_speed}` is not a VDA 5050 {dialect.version} field; the "
             f"edge speed limit is `{dialect.speed}` in this version"
         )
-    v_max = _positive(raw[dialect.speed], f"{where}.{dialect.speed}") \
+    v_max = positive(raw[dialect.speed], f"{where}.{dialect.speed}") \
         if dialect.speed in raw else None
-    yaw = _positive(raw["maxRotationSpeed"], f"{where}.maxRotationSpeed") \
+    yaw = positive(raw["maxRotationSpeed"], f"{where}.maxRotationSpeed") \
         if "maxRotationSpeed" in raw else None
-    if "length" in raw and _number(raw["length"], f"{where}.length") < 0:
-        raise InvalidInputError(f"`{where}.length` must be >= 0; got {raw['length']!r}")
+    if "length" in raw:
+        number(raw["length"], f"{where}.length", minimum=0.0)
     return RouteEdge(edge_id, int(raw["sequenceId"]), start.node_id, end.node_id,
                      _edge_path(raw, i, start, end, dialect), v_max, yaw,
                      _reverse(raw, where), raw["released"], _stops_driving(raw, where, dialect))
@@ -376,7 +352,7 @@ def _reverse(raw: dict[str, Any], where: str) -> bool:
         )
     if "orientation" not in raw:
         return False
-    orientation = _number(raw["orientation"], f"{where}.orientation")
+    orientation = number(raw["orientation"], f"{where}.orientation")
     return kind == "TANGENTIAL" and bool(abs(wrap_angle(orientation)) > np.pi / 2)
 
 
@@ -468,18 +444,18 @@ def _nurbs(traj: dict[str, Any], dialect: _Dialect | None) -> Path:
         for key in ("x", "y"):
             if key not in p:
                 raise InvalidInputError(f"`{at}` lacks '{key}'")
-        ctrl.append([_number(p["x"], f"{at}.x"), _number(p["y"], f"{at}.y")])
-        weights.append(_positive(p["weight"], f"{at}.weight") if "weight" in p else 1.0)
+        ctrl.append([number(p["x"], f"{at}.x"), number(p["y"], f"{at}.y")])
+        weights.append(positive(p["weight"], f"{at}.weight") if "weight" in p else 1.0)
     defaults = dialect is None or dialect.trajectory_defaults
     why = "" if dialect is None else f" (required in VDA 5050 {dialect.version})"
     if "degree" in traj:
-        degree = _integer(traj["degree"], "degree", minimum=1)
+        degree = integer(traj["degree"], "degree", minimum=1)
     elif defaults:
         degree = 1
     else:
         raise InvalidInputError(f"`degree` is missing{why}")
     if "knotVector" in traj:
-        knots = [_number(x, f"knotVector[{j}]")
+        knots = [number(x, f"knotVector[{j}]")
                  for j, x in enumerate(_list(traj["knotVector"], "knotVector"))]
     elif defaults:
         if len(ctrl) < degree + 1:
