@@ -21,10 +21,13 @@ JSON segments (``.json``)
     with ``"reverse": true`` is driven in reverse, ``heading`` is the vehicle's). Instead of
     ``segments`` a file may give ``"waypoints": [[x, y], ...]`` with an optional ``"kind"``
     (default ``"g2"``).
-VDA 5050 (``.json``)
+VDA 5050 trajectory (``.json``)
     An edge ``trajectory`` object ``{"degree": d, "knotVector": [...], "controlPoints":
-    [{"x": .., "y": .., "weight": ..}, ...]}`` (``weight`` optional, default 1): bare, under
-    ``"trajectory"``, or in the first entry of an ``"edges"`` list that carries one.
+    [{"x": .., "y": .., "weight": ..}, ...]}``, bare or under ``"trajectory"``; as in VDA 5050
+    3.0, ``weight`` defaults to 1, ``degree`` to 1 and ``knotVector`` to uniform clamped knots.
+VDA 5050 order (``.json``)
+    A whole order (``nodes`` and ``edges``) is a route, not a path: :func:`read_route` reads it
+    (each edge's geometry, speed limit and stops); :func:`read_path` refuses it and says so.
 
 The readers take a file name or an open text stream (``sys.stdin``, ``io.StringIO``); the
 format comes from ``format=``, else the file extension, else (a stream without a name) the
@@ -56,6 +59,8 @@ from .geometry import Path, SpeedZone
 from .geometry.bounds import check_zones
 from .geometry.fitting import DEFAULT_KIND, KINDS
 from .geometry.primitives import ClothoidPiece
+from .route import Route
+from .route.vda5050 import trajectory_path
 from .timing.trajectory import COLUMNS, Trajectory, text_output
 
 __all__ = [
@@ -64,6 +69,7 @@ __all__ = [
     "path_from_dict",
     "path_to_dict",
     "read_path",
+    "read_route",
     "read_trajectory",
     "read_zones",
     "write_nurbs",
@@ -208,17 +214,17 @@ def _read_csv(text: str, name: str, kind: str | None) -> Path:
 
 
 def _vda5050(doc: Any) -> Any:
-    """The VDA 5050 ``trajectory`` object inside ``doc``, or ``None``."""
+    """The VDA 5050 ``trajectory`` object inside ``doc``, or ``None``; refuses whole orders."""
     if not isinstance(doc, dict):
         return None
-    if "edges" in doc:
-        edges = doc["edges"]
-        if not isinstance(edges, list):
-            raise InvalidInputError("'edges' must be a list of VDA 5050 edges")
-        for edge in edges:
-            if isinstance(edge, dict) and "trajectory" in edge:
-                return edge["trajectory"]
-        raise InvalidInputError("no entry of 'edges' carries a 'trajectory'")
+    if "edges" in doc or "nodes" in doc:
+        # Reading one edge of an order as "the path" dropped the others, their speed limits and
+        # the stops without a word.
+        raise InvalidInputError(
+            "this is a VDA 5050 order ('nodes'/'edges'), a route rather than one path: read it "
+            "with speedplan.io.read_route, which keeps every edge, its speed limit and the "
+            "stops (read_path reads a single trajectory)"
+        )
     if "trajectory" in doc:
         return doc["trajectory"]
     if "knotVector" in doc or "controlPoints" in doc:
@@ -227,20 +233,7 @@ def _vda5050(doc: Any) -> Any:
 
 
 def _nurbs_from_trajectory(traj: Any) -> Path:
-    if not isinstance(traj, dict):
-        raise InvalidInputError("'trajectory' must be an object")
-    missing = [k for k in ("degree", "knotVector", "controlPoints") if k not in traj]
-    if missing:
-        raise InvalidInputError(f"the VDA 5050 trajectory lacks {missing}")
-    pts = traj["controlPoints"]
-    if not isinstance(pts, list) or not all(isinstance(p, dict) for p in pts):
-        raise InvalidInputError("'controlPoints' must be a list of {x, y, weight} objects")
-    for i, p in enumerate(pts):
-        if "x" not in p or "y" not in p:
-            raise InvalidInputError(f"controlPoints[{i}] lacks 'x' or 'y'")
-    ctrl = [[p["x"], p["y"]] for p in pts]
-    weights = [p.get("weight", 1.0) for p in pts]
-    return Path.from_nurbs(traj["degree"], traj["knotVector"], ctrl, weights)
+    return trajectory_path(traj, "trajectory")
 
 
 def path_from_dict(doc: Any, name: str = "document") -> Path:
@@ -368,6 +361,46 @@ def read_path(file: Source, *, kind: str | None = None, format: str | None = Non
             else path_from_dict(_parse_json(name, text), name))
     logger.debug("path from %s: %d pieces, %.6g m", name, len(path.pieces), path.length)
     return path
+
+
+def read_route(file: Source) -> Route:
+    """Read a VDA 5050 order file (versions 2.0, 2.1 and 3.0) as a :class:`~speedplan.route.Route`.
+
+    Parameters
+    ----------
+    file : str, os.PathLike or text stream
+        A JSON file (or an open stream) holding one order message.
+
+    Raises
+    ------
+    InvalidInputError
+        The file is missing or the order malformed; the message names the file and the
+        element (e.g. ``order.json: `edges[1].trajectory`: ...``).
+
+    Examples
+    --------
+    >>> import json, os, tempfile
+    >>> from speedplan.io import read_route
+    >>> node = lambda i, x, actions: {"nodeId": f"N{i}", "sequenceId": 2 * i, "released": True,
+    ...     "nodePosition": {"x": x, "y": 0.0, "mapId": "m"}, "actions": actions}
+    >>> pick = [{"actionType": "pick", "actionId": "p1", "blockingType": "HARD"}]
+    >>> edge = lambda i: {"edgeId": f"E{i}", "sequenceId": 2 * i + 1, "released": True,
+    ...     "startNodeId": f"N{i}", "endNodeId": f"N{i + 1}", "maxSpeed": 1.0 + i, "actions": []}
+    >>> f = os.path.join(tempfile.mkdtemp(), "order.json")
+    >>> with open(f, "w") as fh:
+    ...     json.dump({"version": "2.0.0", "nodes": [node(0, 0.0, []), node(1, 5.0, pick),
+    ...                node(2, 10.0, [])], "edges": [edge(0), edge(1)]}, fh)
+    >>> route = read_route(f)
+    >>> route.length, [e.v_max for e in route.edges], route.stop_s.tolist()
+    (10.0, [1.0, 2.0], [0.0, 5.0, 10.0])
+    """
+    if not hasattr(file, "read"):
+        return Route.from_vda5050(FsPath(file))
+    name, _, text = _load_text(file, "json")
+    try:
+        return Route.from_vda5050(_parse_json(name, text))
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{name}: {exc}") from exc
 
 
 def read_zones(file: Source, *, format: str | None = None) -> list[SpeedZone]:

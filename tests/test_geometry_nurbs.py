@@ -117,15 +117,66 @@ def test_nurbs_with_a_corner_is_refused():
         Path.from_nurbs(1, [0, 0, 0.5, 1, 1], [[0, 0], [1, 0], [1, 1]])
 
 
-def test_plain_bspline_default_weights_and_vda5050_unclamped_domain():
+def test_plain_bspline_default_weights():
     p = Path.from_nurbs(K, KNOTS, CTRL)
     q = Path.from_nurbs(K, KNOTS, CTRL, np.ones(6))
     s = np.linspace(0, p.length, 7)
     np.testing.assert_array_equal(p.point(s), q.point(s))
-    # Unclamped uniform knots: the curve lives on [t_k, t_m].
+
+
+def test_unclamped_knots_whose_curve_starts_off_its_control_point_are_refused():
+    # Uniform unclamped cubic knots: the curve starts at (3, 1/12) by de Boor, 3 m from the
+    # first control point (0, 0) — a path that does not start at its VDA 5050 node.
     t = np.arange(10, dtype=float)
-    u = Path.from_nurbs(K, t, CTRL)
-    np.testing.assert_allclose(u.point(0.0), nurbs_point(K, t, CTRL, np.ones(6), 3.0),
-                               atol=1e-12)
-    np.testing.assert_allclose(u.point(u.length), nurbs_point(K, t, CTRL, np.ones(6), 6.0 - 1e-15),
+    start = nurbs_point(K, t, CTRL, np.ones(6), 3.0)
+    assert np.linalg.norm(start - CTRL[0]) > 2.9  # the oracle agrees it is off
+    with pytest.raises(InvalidInputError, match=r"`knots` are not clamped.*first knot"):
+        Path.from_nurbs(K, t, CTRL)
+    end_only = np.array([0, 0, 0, 0, 0.4, 0.7, 0.8, 1.0, 1.2, 1.4])  # clamped start only
+    end = nurbs_point(K, end_only, CTRL, np.ones(6), 0.8 - 1e-15)  # domain ends at knots[6]
+    assert np.linalg.norm(end - CTRL[-1]) > 0.1
+    with pytest.raises(InvalidInputError, match=r"`knots` are not clamped.*last knot"):
+        Path.from_nurbs(K, end_only, CTRL)
+    # The last knot repeated only `degree` times still ends on the last control point (the
+    # domain ends at knots[m]): accepted.
+    Path.from_nurbs(K, np.concatenate((KNOTS[:-1], [1.5])), CTRL)
+
+
+def test_unclamped_knots_whose_curve_meets_its_end_points_are_the_clamped_curve():
+    # Degree 1 meets its end control points on any knot vector: accepted, and on its domain
+    # the same curve (up to parametrisation) as with clamped knots — a straight 5 m segment.
+    u = Path.from_nurbs(1, [0, 0.2, 0.5, 1], [[0, 0], [3, 4]])
+    c = Path.from_nurbs(1, [0, 0, 1, 1], [[0, 0], [3, 4]])
+    assert u.length == pytest.approx(5.0, rel=1e-14)
+    s = np.linspace(0, 5.0, 11)
+    np.testing.assert_allclose(u.point(s), c.point(s), atol=1e-12)
+    np.testing.assert_allclose(u.point(s), np.outer(s / 5.0, [3, 4]), atol=1e-12)
+
+
+def test_inner_knot_repeated_more_than_degree_with_a_position_jump_is_refused():
+    # Degree 1, knot 0.5 twice: the left piece ends at control point 1 = (1, 0), the right one
+    # starts at control point 2 = (5, 5) (de Boor on each side confirms it).
+    t = np.array([0, 0, 0.5, 0.5, 1, 1], dtype=float)
+    ctrl = np.array([[0, 0], [1, 0], [5, 5], [6, 5]], dtype=float)
+    np.testing.assert_allclose(nurbs_point(1, t, ctrl, np.ones(4), 0.5 - 1e-12), [1, 0],
                                atol=1e-9)
+    np.testing.assert_allclose(nurbs_point(1, t, ctrl, np.ones(4), 0.5), [5, 5], atol=1e-9)
+    with pytest.raises(InvalidInputError,
+                       match=r"`knots`: knot 0.5 is repeated 2 times.*from \(1, 0\) to \(5, 5\)"):
+        Path.from_nurbs(1, t, ctrl)
+    # Cubic, knot 0.5 four times, control points 3 and 4 apart: refused as well.
+    t3 = np.array([0, 0, 0, 0, 0.5, 0.5, 0.5, 0.5, 1, 1, 1, 1], dtype=float)
+    c3 = np.array([[0, 0], [1, 0], [2, 0], [3, 0], [3, 2], [4, 2], [5, 2], [6, 2]], dtype=float)
+    with pytest.raises(InvalidInputError, match=r"`knots`: knot 0.5 is repeated 4 times"):
+        Path.from_nurbs(3, t3, c3)
+
+
+def test_inner_knot_repeated_more_than_degree_without_a_jump_is_only_a_corner_check():
+    # The two sides meet (control points 1 and 2 coincide): no jump. Collinear: accepted, a
+    # 6 m straight; turning there: refused as a corner, like a knot repeated `degree` times.
+    t = [0, 0, 0.5, 0.5, 1, 1]
+    p = Path.from_nurbs(1, t, [[0, 0], [1, 0], [1, 0], [6, 0]])
+    assert p.length == pytest.approx(6.0, rel=1e-14)
+    np.testing.assert_allclose(p.point([0.5, 1.0, 3.0]), [[0.5, 0], [1, 0], [3, 0]], atol=1e-12)
+    with pytest.raises(InvalidInputError, match=r"`knots`.*corner"):
+        Path.from_nurbs(1, t, [[0, 0], [1, 0], [1, 0], [1, 5]])

@@ -87,9 +87,9 @@ def test_json_segments_waypoints_and_zones(tmp_path):
     assert w.length == pytest.approx(5.0, rel=1e-14)
 
 
-@pytest.mark.parametrize("wrap", [lambda t: t, lambda t: {"trajectory": t},
-                                  lambda t: {"edges": [{"edgeId": "e0"}, {"trajectory": t}]}])
-def test_vda5050_trajectory_bare_nested_or_in_edges(tmp_path, wrap):
+# A whole order (`edges`) is a route: read_path refuses it (tests/test_route_io.py).
+@pytest.mark.parametrize("wrap", [lambda t: t, lambda t: {"trajectory": t}])
+def test_vda5050_trajectory_bare_or_nested(tmp_path, wrap):
     p = read_path(write(tmp_path, "edge.json", wrap(TRAJ)))
     assert p.length == pytest.approx(np.pi / 2, rel=1e-12)  # weight defaults to 1
     np.testing.assert_allclose(p.curvature([0.0, 1.0]), 1.0, rtol=1e-9)

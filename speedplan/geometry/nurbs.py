@@ -15,6 +15,10 @@ from .pieces import CurvePiece
 
 __all__ = ["NurbsCurve", "nurbs_piece"]
 
+#: Positions closer than this fraction of the control polygon's extent count as equal (end
+#: points against control points, the two sides of a repeated knot).
+_POSITION_TOLERANCE = 1e-9
+
 
 @dataclass(frozen=True, eq=False)
 class NurbsCurve:
@@ -86,11 +90,27 @@ class NurbsCurve:
 def nurbs_piece(degree: Any, knots: Any, control_points: Any, weights: Any = None) -> CurvePiece:
     """Arc-length parametrised piece of a NURBS curve (see :meth:`Path.from_nurbs`).
 
+    Knot checks (VDA 5050 3.0 requires clamped trajectories whose inner knots repeat at most
+    ``degree`` times):
+
+    * the curve must start at the first control point and end at the last one. A clamped knot
+      vector (first and last knot repeated ``degree + 1`` times) guarantees it; an unclamped
+      one is accepted only when the curve still meets its end control points (e.g. degree 1):
+      on its domain ``[knots[degree], knots[m]]`` it then *is* the clamped curve with those
+      ends, so nothing is changed. Otherwise it is refused — the path would start off its
+      node.
+    * an inner knot repeated more than ``degree`` times lets the position jump: refused
+      unless the positions on both sides agree (to ``1e-9`` of the control polygon's
+      extent); then, as for a knot repeated ``degree`` times, only a heading jump (a corner)
+      is refused.
+
     Raises
     ------
     InvalidInputError
-        Bad degree, shapes, knots (decreasing, wrong length, empty domain), weights (not > 0),
-        a curve of zero length, or a corner (heading jump at a repeated knot).
+        Bad degree, shapes, knots (decreasing, wrong length, empty domain, a curve that does
+        not start / end at its end control points, a position jump at a repeated knot),
+        weights (not > 0), a curve of zero length, or a corner (heading jump at a repeated
+        knot). Every knot message names ``knots``.
 
     Examples
     --------
@@ -129,6 +149,11 @@ def nurbs_piece(degree: Any, knots: Any, control_points: Any, weights: Any = Non
             i = int(np.flatnonzero(~(w > 0))[0])
             raise InvalidInputError(f"`weights` must all be > 0; weights[{i}]={w[i]!r}")
     curve = NurbsCurve(k, t, ctrl, w)
+    # Before the arc-length table: a jump or an unclamped start would otherwise surface as a
+    # misleading cusp message, or not at all.
+    tol = _POSITION_TOLERANCE * max(float(np.ptp(ctrl, axis=0).max()), 1e-300)
+    _reject_loose_ends(curve, t, k, ctrl, tol)
+    _reject_jumps(curve, t, k, tol)
     piece = CurvePiece(curve)
     if not piece.length > 1e-12 * max(float(np.ptp(ctrl, axis=0).max()), 1e-300):
         raise InvalidInputError("`control_points` give a NURBS curve of zero length")
@@ -152,4 +177,50 @@ def _reject_corners(curve: NurbsCurve, t: FloatArray, k: int) -> None:
             f"`knots`: the NURBS curve has a corner at parameter {inner[i]:.6g} (heading jumps "
             f"by {jump[i]:.3g} rad, a knot repeated {k} times); a vehicle must stop there — "
             "split the edge at that knot"
+        )
+
+
+def _point_text(p: FloatArray) -> str:
+    return f"({p[0]:.6g}, {p[1]:.6g})"
+
+
+def _reject_loose_ends(
+    curve: NurbsCurve, t: FloatArray, k: int, ctrl: FloatArray, tol: float
+) -> None:
+    """The curve must start at the first control point and end at the last one."""
+    lo, hi = curve.domain
+    ends = curve(np.array([lo, hi]), 0)
+    for end, target, which, mult in ((ends[0], ctrl[0], "start", int(np.sum(t == t[0]))),
+                                     (ends[1], ctrl[-1], "end", int(np.sum(t == t[-1])))):
+        gap = float(np.linalg.norm(end - target))
+        if gap > tol:
+            first = "first" if which == "start" else "last"
+            raise InvalidInputError(
+                f"`knots` are not clamped: the {first} knot is repeated {mult} times (a clamped "
+                f"knot vector repeats it degree + 1 = {k + 1} times), so the curve's {which} "
+                f"{_point_text(end)} is {gap:.3g} m from the {first} control point "
+                f"{_point_text(target)}; repeat the {first} knot degree + 1 times (VDA 5050 "
+                "trajectories are clamped NURBS)"
+            )
+
+
+def _reject_jumps(curve: NurbsCurve, t: FloatArray, k: int, tol: float) -> None:
+    """An inner knot repeated more than ``degree`` times may leave the position discontinuous."""
+    values, counts = np.unique(t, return_counts=True)
+    lo, hi = curve.domain
+    inner = values[(counts > k) & (values > lo) & (values < hi)]
+    if inner.size == 0:
+        return
+    # The left limit: BSpline evaluates at a knot with the piece on its right.
+    left = curve(np.nextafter(inner, -np.inf), 0)
+    right = curve(inner, 0)
+    gap = np.linalg.norm(right - left, axis=1)
+    if (gap > tol).any():
+        i = int(np.argmax(gap))
+        mult = int(counts[values == inner[i]][0])
+        raise InvalidInputError(
+            f"`knots`: knot {inner[i]:.6g} is repeated {mult} times, more than degree = {k}, "
+            f"and the NURBS curve jumps there from {_point_text(left[i])} to "
+            f"{_point_text(right[i])} ({gap[i]:.3g} m); an inner knot may repeat at most "
+            "`degree` times (VDA 5050) — remove the extra repeats or split the edge there"
         )

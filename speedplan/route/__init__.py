@@ -1,0 +1,13 @@
+"""Routes: chains of edges between nodes with per-edge limits and stops (VDA 5050 orders).
+
+* :mod:`~speedplan.route.route` — :class:`Route`, :class:`RouteNode`, :class:`RouteEdge`: the
+  released base's length, node positions ``node_s``, edge spans, stops and stop-to-stop legs;
+* :mod:`~speedplan.route.vda5050` — reading VDA 5050 2.0, 2.1 and 3.0 orders
+  (:meth:`Route.from_vda5050`), trajectories included.
+
+This layer sits between ``timing`` and the top level; it imports ``core`` and ``geometry``.
+"""
+
+from .route import HEADING_TOLERANCE, Route, RouteEdge, RouteNode
+
+__all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode"]
