@@ -14,8 +14,10 @@ from .core.errors import (
     SpeedplanWarning,
 )
 from .core.limits import Limits
-from .geometry import Path, SpeedZone, speed_bounds
+from .geometry import Path, SpanLimit, SpeedZone, speed_bounds
 from .plan import plan
+from .route import Route, RouteProfile
+from .route_plan import plan_route
 from .solve import DiscreteProblem, DiscreteSolution, solve_discrete
 from .timing import SpeedProfile, Trajectory, Verification
 from .waypoints import profile_from_waypoints
@@ -29,7 +31,10 @@ __all__ = [
     "LimitWarning",
     "Limits",
     "Path",
+    "Route",
+    "RouteProfile",
     "SolverError",
+    "SpanLimit",
     "SpeedProfile",
     "SpeedZone",
     "SpeedplanError",
@@ -39,6 +44,7 @@ __all__ = [
     "__version__",
     "plan",
     "plan_many",
+    "plan_route",
     "profile_from_waypoints",
     "solve_discrete",
     "speed_bounds",

@@ -113,6 +113,10 @@ def _add_limits(p: argparse.ArgumentParser, defaults: dict[str, float] | None = 
                        metavar="X", help=help_ + ("" if key in d else " (required)"))
     g.add_argument("--a-decel", type=float, default=None, metavar="X",
                    help="braking limit [m/s²] (default: a-max)")
+    g.add_argument("--j-lat-max", type=float, default=None, metavar="X",
+                   help="lateral jerk limit [m/s³] (default: none)")
+    g.add_argument("--yaw-rate-max", type=float, default=None, metavar="X",
+                   help="yaw-rate limit [rad/s] (default: none)")
 
 
 def _add_common(p: argparse.ArgumentParser, out: str | None = None,
@@ -123,6 +127,9 @@ def _add_common(p: argparse.ArgumentParser, out: str | None = None,
                    help="start acceleration [m/s²]")
     g.add_argument("--vf", type=float, default=0.0, metavar="V", help="end speed [m/s]")
     g.add_argument("--af", type=float, default=0.0, metavar="A", help="end acceleration [m/s²]")
+    g.add_argument("--start-s", type=float, default=0.0, metavar="S",
+                   help="VDA 5050 order only: where the vehicle is along the route [m] (an "
+                   "order update while driving; --v0/--a0 its state there)")
     g.add_argument("--standstill", choices=tuple(STANDSTILL_HELP), default="smooth",
                    help="model at a standstill: "
                    + "; ".join(f"{k}: {v}" for k, v in STANDSTILL_HELP.items()))
@@ -168,12 +175,14 @@ def _parser() -> argparse.ArgumentParser:
     _add_verbose(ap, False)
     sub = ap.add_subparsers(dest="command", required=True, metavar="{plan,demo,bench}")
     p = sub.add_parser(
-        "plan", help="plan a path file (CSV waypoints, JSON segments, VDA 5050)",
-        description="Plan the minimum-time speed law along a path file and report it.",
+        "plan", help="plan a path file (CSV waypoints, JSON segments, VDA 5050 edge or order)",
+        description="Plan the minimum-time speed law along a path file and report it; a VDA "
+        "5050 order (nodes and edges) is planned as a route: stops at blocking actions, edge "
+        "speed limits, node times.",
         epilog=EPILOG, formatter_class=_HelpFormatter)
     p.add_argument("pathfile",
-                   help="path file: .csv waypoints, .json segments or VDA 5050 NURBS; - reads "
-                   "standard input")
+                   help="path file: .csv waypoints, .json segments, a VDA 5050 NURBS edge or a "
+                   "whole VDA 5050 order; - reads standard input")
     p.add_argument("--format", choices=("csv", "json"), default=None,
                    help="format of the path file (default: from the extension; on standard "
                    "input from the first character, { or [ meaning JSON)")
@@ -285,11 +294,47 @@ def _with_metadata(traj: Trajectory, meta: dict[str, Any]) -> Trajectory:
     return replace(traj, metadata={**meta, **traj.metadata})
 
 
+def _stdin_text(args: argparse.Namespace) -> str:
+    """Standard input, read once (an order check and the path reader both look at it)."""
+    if getattr(args, "_stdin", None) is None:
+        args._stdin = sys.stdin.read()
+    text: str = args._stdin
+    return text
+
+
+def _read_order(args: argparse.Namespace, pathfile: str | FsPath) -> Any:
+    """The :class:`~speedplan.route.Route` when the input is a VDA 5050 order, else ``None``."""
+    import json
+
+    from .io import read_route
+
+    if str(pathfile) == "-":
+        text, name = _stdin_text(args), "<stdin>"
+    else:
+        fs = FsPath(pathfile)
+        if fs.suffix.lower() != ".json" or not fs.is_file():
+            return None
+        try:
+            text = fs.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            return None  # the path reader reports it
+        name = fs.name
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError:
+        return None
+    if not (isinstance(doc, dict) and "nodes" in doc and "edges" in doc):
+        return None
+    buf = io.StringIO(text)
+    buf.name = name
+    return read_route(buf)
+
+
 def _read_input(args: argparse.Namespace, pathfile: str | FsPath) -> tuple[Any, Any, str]:
     from .io import read_path, read_zones
 
     if str(pathfile) == "-":
-        text = sys.stdin.read()
+        text = _stdin_text(args)
 
         def stream() -> io.StringIO:
             buf = io.StringIO(text)
@@ -303,14 +348,86 @@ def _read_input(args: argparse.Namespace, pathfile: str | FsPath) -> tuple[Any, 
         FsPath(pathfile).name
 
 
+def _limits(args: argparse.Namespace) -> Limits:
+    return Limits(v_max=args.v_max, a_max=args.a_max, a_lat_max=args.a_lat_max,
+                  j_max=args.j_max, a_decel=args.a_decel, j_lat_max=args.j_lat_max,
+                  yaw_rate_max=args.yaw_rate_max)
+
+
+def _write_outputs(args: argparse.Namespace, traj: Trajectory, info: IO[str]) -> None:
+    out_format = _output_format(args)
+    if out_format is None:
+        return
+    target: Any = sys.stdout if args.output == "-" else FsPath(args.output)
+    if out_format == "json":
+        traj.to_json(target)
+        if args.output == "-":
+            sys.stdout.write("\n")
+    else:
+        traj.to_csv(target)
+    where = "standard output" if args.output == "-" else args.output
+    print(f"wrote     {where} ({len(traj)} samples every {args.dt} s)", file=info)
+
+
+def _run_route(args: argparse.Namespace, route: Any, name: str, info: IO[str]) -> int:
+    """``speedplan plan order.json``: plan the order's released base, print the node times."""
+    from .route_plan import plan_route
+
+    if args.vf != 0.0 or args.af != 0.0:
+        raise InvalidInputError(
+            "--vf/--af: an order ends at rest on its last released node; drop them"
+        )
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        profile = plan_route(route, _limits(args), start_s=args.start_s, v0=args.v0,
+                             a0=args.a0, n=args.n, ds=args.ds, standstill=args.standstill,
+                             backend=args.backend, refine=args.refine)
+    elapsed = time.perf_counter() - t0
+    check = profile.verification
+    order = f" (order {route.order_id})" if route.order_id else ""
+    print(f"route     {name}{order}: {route.length:.3f} m, {len(route.base_edges)} edges, "
+          f"{len(profile.legs)} stop-to-stop legs", file=info)
+    print(f"duration  {profile.duration:.4f} s   (planned in {elapsed:.3f} s)", file=info)
+    print(f"status    {profile.status}   gap={profile.gap:.2e}", file=info)
+    print("node      s [m]      t [s]   stop", file=info)
+    stops = set(np.round(route.stop_s, 9).tolist())
+    for node, s, t_node in zip(route.base_nodes, route.node_s, profile.node_times,
+                               strict=True):
+        when = "passed" if np.isnan(t_node) else f"{t_node:9.3f}"
+        print(f"  {node.node_id:8s}{s:9.3f}  {when:>9s}   "
+              f"{'yes' if round(float(s), 9) in stops else ''}", file=info)
+    print("realised maxima / limits:", file=info)
+    print("  " + check.summary().replace("\n", "\n  "), file=info)
+    traj = profile.sample(args.dt)
+    traj = replace(traj, metadata={**traj.metadata, "path_file": name, "dt": args.dt})
+    _write_outputs(args, traj, info)
+    if args.plot:
+        from .plot import plot_route
+
+        plot_route(profile, args.plot, trajectory=traj, dpi=args.dpi)
+        print(f"wrote     {args.plot}", file=info)
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
+    code, reason = exit_status(profile.status, check.violations, strict=args.strict)
+    if reason:
+        print(f"speedplan: {reason}", file=sys.stderr)
+    return code
+
+
 def _run_plan(args: argparse.Namespace, pathfile: str | FsPath) -> int:
     from .plan import plan
 
-    out_format = _output_format(args)
+    _output_format(args)
     _check_plot(args.plot)
     info: IO[str] = sys.stderr if args.output == "-" else sys.stdout
-    limits = Limits(v_max=args.v_max, a_max=args.a_max, a_lat_max=args.a_lat_max,
-                    j_max=args.j_max, a_decel=args.a_decel)
+    limits = _limits(args)
+    route = _read_order(args, pathfile)
+    if route is not None:
+        name = "<stdin>" if str(pathfile) == "-" else FsPath(pathfile).name
+        return _run_route(args, route, name, info)
+    if args.start_s != 0.0:
+        raise InvalidInputError("--start-s applies to VDA 5050 orders only")
     with warnings.catch_warnings(record=True) as caught:  # printed as one line each, below
         warnings.simplefilter("always")
         path, zones, name = _read_input(args, pathfile)
@@ -326,17 +443,9 @@ def _run_plan(args: argparse.Namespace, pathfile: str | FsPath) -> int:
           file=info)
     print("realised maxima / limits:", file=info)
     print("  " + check.summary().replace("\n", "\n  "), file=info)
-    if out_format is not None:
+    if _output_format(args) is not None:
         traj = _with_metadata(profile.sample(args.dt), _metadata(profile, args, name))
-        target: Any = sys.stdout if args.output == "-" else FsPath(args.output)
-        if out_format == "json":
-            traj.to_json(target)
-            if args.output == "-":
-                sys.stdout.write("\n")
-        else:
-            traj.to_csv(target)
-        where = "standard output" if args.output == "-" else args.output
-        print(f"wrote     {where} ({len(traj)} samples every {args.dt} s)", file=info)
+        _write_outputs(args, traj, info)
     if args.plot:
         from .plot import plot_profile
 

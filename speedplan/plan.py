@@ -10,9 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from .core.errors import LimitWarning, SolverError
+from .core.errors import LimitWarning, SolverError, SpeedplanWarning
 from .core.limits import Limits
-from .geometry import Path, SpeedBound, SpeedZone
+from .geometry import Path, SpanLimit, SpeedBound, SpeedZone
 from .model import ForcedLeg, Leg, PlanRequest, build_model
 from .model.build import leg_on_grid
 from .model.refine import refined_grid
@@ -42,6 +42,8 @@ def plan(
     refine: str = "auto",
     standstill: str = "smooth",
     backend: str = "auto",
+    stops: Sequence[float] | None = None,
+    spans: Sequence[SpanLimit] | None = None,
 ) -> SpeedProfile:
     """Plan the minimum-time speed law along ``path`` under ``limits``.
 
@@ -71,6 +73,15 @@ def plan(
         (moving boundary states stay jerk-limited).
     backend : {"auto", "clarabel", "banded"}
         Relaxation backend (see :func:`speedplan.solve_discrete`).
+    stops : sequence of float, optional
+        Positions [m] strictly inside the path where the vehicle must come to rest
+        (v = 0, a = 0), e.g. a route node with a blocking action. The vehicle also stops at
+        every cusp of the path (:attr:`Path.cusps`, where it reverses) and, when
+        ``limits.j_lat_max`` is set, at every curvature jump (:meth:`Path.curvature_jumps`;
+        a :class:`~speedplan.SpeedplanWarning` says where — G2 paths, the default of
+        :meth:`Path.from_waypoints`, have none).
+    spans : sequence of SpanLimit, optional
+        Speed and yaw-rate limits over stretches of the path (e.g. a route's edges).
 
     Returns
     -------
@@ -105,7 +116,7 @@ def plan(
     """
     request = PlanRequest.create(
         path, limits, n=n, ds=ds, v0=v0, a0=a0, vf=vf, af=af, zones=zones, v_limit=v_limit,
-        refine=refine, standstill=standstill, backend=backend,
+        refine=refine, standstill=standstill, backend=backend, stops=stops, spans=spans,
     )
     return plan_request(request)
 
@@ -113,6 +124,15 @@ def plan(
 def plan_request(request: PlanRequest) -> SpeedProfile:
     """:func:`plan` for an already validated :class:`~speedplan.model.PlanRequest`."""
     model = build_model(request)
+    jumps = [r.s for r in model.rests if r.reason == "curvature jump"]
+    if jumps:
+        shown = ", ".join(f"{s:.6g}" for s in jumps[:5]) + (", ..." if len(jumps) > 5 else "")
+        warnings.warn(
+            f"the path's curvature jumps at s = {shown} m: with j_lat_max set the lateral "
+            "acceleration cannot step, so the vehicle stops there; use a curvature-continuous "
+            "path (Path.from_waypoints with the default kind='g2') to drive through",
+            SpeedplanWarning, stacklevel=3,
+        )
     legs = [_solve(leg) for leg in model.legs]
     profile = SpeedProfile(path=request.path, limits=request.limits, legs=tuple(legs),
                            speed_bound=model.bound, request=request)

@@ -17,6 +17,7 @@ from .core.errors import InvalidInputError, SpeedplanError
 
 if TYPE_CHECKING:
     from .core.limits import Limits
+    from .route import RouteProfile
     from .timing import SpeedProfile, Trajectory
 
 __all__ = [
@@ -25,6 +26,7 @@ __all__ = [
     "plot_lateral",
     "plot_path",
     "plot_profile",
+    "plot_route",
     "plot_speed",
 ]
 
@@ -291,6 +293,95 @@ def plot_profile(
     plot_path(traj, axes["path"], v_max=lim.v_max, zones=zones)
     plot_speed(profile, traj, axes["speed"])
     plot_lateral(traj, lim, axes["lateral"])
+    plot_acceleration(traj, lim, axes["acceleration"])
+    plot_jerk(traj, lim, axes["jerk"])
+    if file is not None:
+        fig.savefig(file, dpi=dpi)
+    return getattr(fig, "figure", None) or fig
+
+
+#: Panel names of :func:`plot_route`, in ``fig.axes`` order (colour bar last).
+ROUTE_PANELS = ("path", "speed", "acceleration", "jerk")
+
+
+def plot_route(
+    profile: RouteProfile,
+    file: str | PathLike[str] | None = None,
+    *,
+    trajectory: Trajectory | None = None,
+    dt: float = 0.01,
+    fig: Any = None,
+    dpi: float = DPI,
+) -> Any:
+    """Draw a planned route in four panels, optionally saved to ``file``.
+
+    The path with its nodes (labelled with their times) and stops; ``v(s)`` against the
+    limits (edge speed limits included) with the nodes marked; acceleration and jerk in time.
+
+    Parameters
+    ----------
+    profile : RouteProfile
+        What :func:`speedplan.plan_route` returned.
+    file, trajectory, dt, fig, dpi
+        As in :func:`plot_profile`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The panels' axes first in ``fig.axes``, in the order of :data:`ROUTE_PANELS`.
+
+    Examples
+    --------
+    >>> from speedplan import Limits, plan_route
+    >>> from speedplan.geometry import Line, Path
+    >>> from speedplan.route import Route, RouteEdge, RouteNode
+    >>> nodes = [RouteNode("A", 0, (0.0, 0.0)), RouteNode("B", 2, (6.0, 0.0), stop=True),
+    ...          RouteNode("C", 4, (12.0, 0.0))]
+    >>> edges = [RouteEdge("AB", 1, "A", "B", Path.from_segments([Line(6.0)]), v_max=1.0),
+    ...          RouteEdge("BC", 3, "B", "C", Path.from_segments([Line(6.0)], start=(6, 0)))]
+    >>> from speedplan.plot import plot_route
+    >>> fig = plot_route(plan_route(Route(nodes, edges), Limits(2, 1, 1, 0.5)))
+    >>> [ax.get_xlabel() for ax in fig.axes[:4]]
+    ['x [m]', 's [m]', 't [s]', 't [s]']
+    """
+    traj = trajectory if trajectory is not None else profile.sample(dt)
+    if fig is None:
+        fig = _figure(figsize=(11, 8.5), layout="constrained")
+    elif not hasattr(fig, "subplot_mosaic"):
+        raise InvalidInputError(
+            f"`fig` must be a matplotlib Figure or SubFigure; got {type(fig).__name__}"
+        )
+    axes = fig.subplot_mosaic([["path", "path"], ["speed", "speed"], ["acceleration", "jerk"]],
+                              height_ratios=[1.3, 1, 1])
+    lim = profile.legs[0].limits
+    route = profile.route
+    ax = plot_path(traj, axes["path"], v_max=lim.v_max)
+    node_xy = route.path.point(route.node_s)
+    stops = np.isin(np.round(route.node_s, 9), np.round(route.stop_s, 9))
+    ax.plot(node_xy[~stops, 0], node_xy[~stops, 1], "o", ms=5, color="k", zorder=6,
+            label="node (driven through)")
+    ax.plot(node_xy[stops, 0], node_xy[stops, 1], "s", ms=7, color="tab:red", zorder=6,
+            label="stop")
+    for node, (x, y), t_node in zip(route.base_nodes, node_xy, profile.node_times, strict=True):
+        when = "" if np.isnan(t_node) else f" {t_node:.1f} s"
+        ax.annotate(f"{node.node_id}{when}", (x, y), xytext=(4, 4), textcoords="offset points",
+                    fontsize=8, zorder=7)
+    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=5, fontsize=8, frameon=False,
+              borderaxespad=0.2)
+    ax.set_title("route coloured by speed", loc="left")
+    sp_ax = axes["speed"]
+    for k, (leg, lo) in enumerate(zip(profile.legs, profile.leg_starts, strict=True)):
+        s_fine = np.linspace(0.0, leg.path.length, 800)
+        sp_ax.plot(lo + s_fine, np.sqrt(leg.speed_bound(s_fine)), "k--", lw=1,
+                   label="speed limit (v_max, lateral, edge limits)" if k == 0 else None)
+    sp_ax.plot(traj.s, traj.v, "C0", lw=2, label="speed v(s)")
+    for node, s in zip(route.base_nodes, route.node_s, strict=True):
+        sp_ax.axvline(float(s), color="0.6", lw=0.8, zorder=0)
+        sp_ax.annotate(node.node_id, (float(s), 0.0), xytext=(2, 2), textcoords="offset points",
+                       fontsize=8, color="0.35")
+    sp_ax.set(xlabel="s [m]", ylabel="v [m/s]",
+              title=f"speed along the route, duration {profile.duration:.3f} s")
+    _legend_on_top(sp_ax, HEADROOM * lim.v_max, -0.04 * lim.v_max)
     plot_acceleration(traj, lim, axes["acceleration"])
     plot_jerk(traj, lim, axes["jerk"])
     if file is not None:

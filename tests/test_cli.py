@@ -201,3 +201,35 @@ def test_file_warnings_are_one_line_messages(tmp_path):
     assert res.returncode == 0, res.stderr
     assert "warning: ros.csv: ignored columns ['frame_id']" in res.stderr
     assert "SpeedplanWarning" not in res.stderr  # not Python's file:line: Category: format
+
+
+def test_an_order_is_planned_as_a_route_with_node_times(root, tmp_path):
+    order = root / "paths" / "orders" / "order_v2.json"
+    out, fig = tmp_path / "route.csv", tmp_path / "route.png"
+    res = run("plan", str(order), *LGV_ARGS, "-o", str(out), "--plot", str(fig))
+    assert res.returncode == 0, res.stderr
+    route = sp.Route.from_vda5050(order)
+    reference = sp.plan_route(route, sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    for node, t_node in zip(route.base_nodes, reference.node_times, strict=True):
+        assert f"{node.node_id:8s}" in res.stdout and f"{t_node:9.3f}" in res.stdout
+    text = out.read_text()
+    header = next(ln for ln in text.splitlines() if not ln.startswith("#"))
+    assert header.endswith(",edge [1]")
+    assert "# node_times: " in text and fig.stat().st_size > 10_000
+    # The same order on standard input; an update part-way along it.
+    res = run("plan", "-", *LGV_ARGS, "--start-s", "20", "--v0", "1.0", stdin=order.read_text())
+    assert res.returncode == 0, res.stderr
+    assert "passed" in res.stdout  # N0 and N1 lie behind the vehicle
+    res = run("plan", str(root / "paths" / "u_turn.json"), *LGV_ARGS, "--start-s", "3")
+    assert res.returncode == 2 and "--start-s applies to VDA 5050 orders" in res.stderr
+    res = run("plan", str(order), *LGV_ARGS, "--vf", "1")
+    assert res.returncode == 2 and "--vf/--af" in res.stderr
+
+
+def test_comfort_limits_on_the_command_line(root):
+    res = run("plan", str(root / "paths" / "u_turn.json"), *LGV_ARGS, "--j-lat-max", "0.3",
+              "--yaw-rate-max", "0.4")
+    assert res.returncode == 0, res.stderr
+    ratio = {line.split()[0]: float(line.split()[1]) for line in res.stdout.splitlines()
+             if line.startswith("  ") and "of limit" in line}
+    assert 0.5 < ratio["yaw_rate"] <= 1.001 and 0.5 < ratio["lateral_jerk"] <= 1.05

@@ -15,12 +15,12 @@ Modules, one job each:
   spline, rounded polyline) and their options;
 * :mod:`~speedplan.geometry.nurbs` — NURBS (VDA 5050 ``trajectory``);
 * :mod:`~speedplan.geometry.bounds` — :func:`speed_bounds` ``mu+(s)``, :class:`SpeedBound`,
-  :class:`SpeedZone`, :func:`zone_intervals`.
+  :class:`SpeedZone`, :class:`SpanLimit`, :func:`zone_intervals`.
 
 This layer imports only ``errors``, ``_checks`` and ``limits``.
 """
 
-from .bounds import SpeedBound, SpeedZone, speed_bounds, zone_intervals
+from .bounds import SpanLimit, SpeedBound, SpeedZone, speed_bounds, zone_intervals
 from .path import Arc, Clothoid, Line, Path, PathSamples
 
 __all__ = [
@@ -29,6 +29,7 @@ __all__ = [
     "Line",
     "Path",
     "PathSamples",
+    "SpanLimit",
     "SpeedBound",
     "SpeedZone",
     "speed_bounds",

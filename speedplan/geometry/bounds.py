@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -14,7 +14,8 @@ from ..core.errors import InvalidInputError
 from ..core.limits import Limits
 from .path import Path
 
-__all__ = ["SpeedBound", "SpeedZone", "check_zones", "speed_bounds", "zone_intervals"]
+__all__ = ["SpanLimit", "SpeedBound", "SpeedZone", "check_spans", "check_zones", "speed_bounds",
+           "zone_intervals"]
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,67 @@ class SpeedZone:
         object.__setattr__(self, "v_max", as_scalar("v_max", self.v_max, nonnegative=True))
 
 
+@dataclass(frozen=True)
+class SpanLimit:
+    """Limits over a stretch ``[start, end]`` of the path (e.g. one edge of a route).
+
+    Parameters
+    ----------
+    start, end : float
+        The stretch [m], ``0 <= start < end``; both ends included (where two spans meet, the
+        lower limit applies at the join).
+    v_max : float, optional
+        Speed limit on the stretch [m/s], > 0 (``None``: none).
+    yaw_rate_max : float, optional
+        Yaw-rate limit on the stretch [rad/s], > 0: ``|κ| v <= yaw_rate_max`` (``None``: none).
+
+    Examples
+    --------
+    >>> from speedplan.geometry import SpanLimit
+    >>> SpanLimit(5.0, 12.0, v_max=1.2)
+    SpanLimit(start=5.0, end=12.0, v_max=1.2, yaw_rate_max=None)
+    """
+
+    start: float
+    end: float
+    v_max: float | None = None
+    yaw_rate_max: float | None = None
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "start", as_scalar("start", self.start, nonnegative=True))
+        set_(self, "end", as_scalar("end", self.end))
+        if not self.end > self.start:
+            raise InvalidInputError(
+                f"a SpanLimit needs end > start; got start={self.start!r}, end={self.end!r}"
+            )
+        for name in ("v_max", "yaw_rate_max"):
+            value = getattr(self, name)
+            if value is not None:
+                set_(self, name, as_scalar(name, value, positive=True, allow_inf=True))
+
+
+def check_spans(spans: Any, length: float | None = None) -> list[SpanLimit]:
+    """``spans`` as a list of :class:`SpanLimit` (one, a sequence, or ``None``)."""
+    if spans is None:
+        return []
+    items = [spans] if isinstance(spans, SpanLimit) else spans
+    if isinstance(items, str | bytes) or not hasattr(items, "__iter__"):
+        raise InvalidInputError(f"`spans` must be a sequence of SpanLimit; got {spans!r}")
+    out = list(items)
+    for i, span in enumerate(out):
+        if not isinstance(span, SpanLimit):
+            raise InvalidInputError(
+                f"`spans[{i}]` must be a SpanLimit; got {type(span).__name__}"
+            )
+        if length is not None and span.end > length * (1 + 1e-9):
+            raise InvalidInputError(
+                f"`spans[{i}]` ends at {span.end:.9g} m, beyond the path's length "
+                f"{length:.9g} m"
+            )
+    return out
+
+
 def speed_bounds(
     path: Path,
     limits: Limits,
@@ -79,13 +141,14 @@ def speed_bounds(
     *,
     zones: Sequence[SpeedZone] | SpeedZone | None = None,
     v_limit: Any = None,
+    spans: Sequence[SpanLimit] | SpanLimit | None = None,
 ) -> FloatArray:
     """Upper bound ``mu+(s)`` on ``w = v²`` [m²/s²] at arc lengths ``s`` [m].
 
     ``mu+(s) = min(v_max², a_lat_max / |k(s)|, (yaw_rate_max / |k(s)|)²)``; where a limit is
     ``inf`` or the curvature is 0 that term is absent. It is further lowered to
     ``zone.v_max²`` wherever the path point lies inside or on the boundary of a zone's
-    polygon, and by ``v_limit``.
+    polygon, by ``v_limit``, and over each span by its own ``v_max`` and ``yaw_rate_max``.
 
     Parameters
     ----------
@@ -103,6 +166,8 @@ def speed_bounds(
         the ends (``numpy.interp``); for a step, repeat the position with a tiny offset. Linear
         because a limit sampled from another profile (a previous plan, a sensor map) is then
         reproduced without staircase artefacts.
+    spans : SpanLimit or sequence of SpanLimit, optional
+        Speed and yaw-rate limits over stretches of the path (a route's edges).
 
     Returns
     -------
@@ -126,14 +191,15 @@ def speed_bounds(
     if not isinstance(limits, Limits):
         raise InvalidInputError(f"`limits` must be a speedplan.Limits; got {type(limits).__name__}")
     zone_list = check_zones(zones)
+    span_list = check_spans(spans)
     q = as_array("s", s)
     # path.curvature also checks that s lies on the path.
-    return _bounds(path, limits, q, path.curvature(q), zone_list, v_limit)
+    return _bounds(path, limits, q, path.curvature(q), zone_list, v_limit, span_list)
 
 
 def _bounds(
     path: Path, limits: Limits, q: FloatArray, curvature: FloatArray,
-    zone_list: list[SpeedZone], v_limit: Any,
+    zone_list: list[SpeedZone], v_limit: Any, span_list: Sequence[SpanLimit] = (),
 ) -> FloatArray:
     """:func:`speed_bounds` at ``q`` once the path's curvature there is known."""
     w = np.full(q.shape, limits.v_max**2)
@@ -152,6 +218,14 @@ def _bounds(
         sk, vk = _check_v_limit(v_limit)
         v = np.interp(q, sk, vk)
         w = np.minimum(w, np.where(np.isnan(v), np.inf, v) ** 2)  # inf knots may give inf*0
+    for span in span_list:
+        inside = (q >= span.start) & (q <= span.end)
+        cap = np.full(q.shape, np.inf if span.v_max is None else span.v_max**2)
+        if span.yaw_rate_max is not None:
+            with np.errstate(divide="ignore"):
+                cap = np.minimum(cap, np.where(kappa > 0, (span.yaw_rate_max / kappa) ** 2,
+                                               np.inf))
+        w = np.where(inside, np.minimum(w, cap), w)
     return w
 
 
@@ -176,16 +250,17 @@ class SpeedBound:
     zones: list[SpeedZone] | None = None
     v_limit: Any = None
     offset: float = 0.0
+    spans: tuple[SpanLimit, ...] = ()
 
     def at_offset(self, offset: float) -> SpeedBound:
         """The same bound read from ``offset`` [m] on: ``s -> mu+(offset + s)``."""
-        return SpeedBound(self.path, self.limits, self.zones, self.v_limit,
-                          self.offset + float(offset))
+        return replace(self, offset=self.offset + float(offset))
 
     def __call__(self, s: FloatArray) -> FloatArray:
         """Bound at arc lengths ``s`` [m²/s²]."""
         q = as_array("s", s) + self.offset if self.offset else s
-        return speed_bounds(self.path, self.limits, q, zones=self.zones, v_limit=self.v_limit)
+        return speed_bounds(self.path, self.limits, q, zones=self.zones, v_limit=self.v_limit,
+                            spans=self.spans)
 
     def given_curvature(self, s: Any, curvature: Any) -> FloatArray:
         """Bound at arc lengths ``s`` [m] where the path's ``curvature`` [1/m] is known.
@@ -200,7 +275,8 @@ class SpeedBound:
             raise InvalidInputError(
                 f"`curvature` must have the shape of `s` {q.shape}; got {kappa.shape}"
             )
-        return _bounds(self.path, self.limits, q, kappa, check_zones(self.zones), self.v_limit)
+        return _bounds(self.path, self.limits, q, kappa, check_zones(self.zones), self.v_limit,
+                       self.spans)
 
 
 def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:

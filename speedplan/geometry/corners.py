@@ -43,7 +43,7 @@ from ._checks import wrap_angle
 from .primitives import ClothoidPiece
 
 __all__ = ["CUSP_ANGLE", "DEFAULT_DEVIATION", "DEFAULT_TRANSITION", "CornerShape",
-           "as_deviation", "corner_shape", "find_reversal", "g2_corners", "leg_turns"]
+           "as_deviation", "corner_shape", "find_reversal", "g2_chain", "g2_corners", "leg_turns"]
 
 #: Default largest distance between a waypoint and the path [m] (``max_deviation``).
 DEFAULT_DEVIATION = 0.25
@@ -225,6 +225,42 @@ def g2_corners(
     [(0.0, 0.0), (0.0, 1.8014), (1.8014, 1.8014), (1.8014, 0.0), (0.0, 0.0)]
     """
     dev = DEFAULT_DEVIATION if max_deviation is None else as_deviation(max_deviation)
+    return g2_chain(pts, np.full(pts.shape[0], dev), transition)[0]
+
+
+def g2_chain(
+    pts: FloatArray, deviations: FloatArray, transition: float | None = None,
+) -> tuple[tuple[ClothoidPiece, ...], FloatArray]:
+    """:func:`g2_corners` with one deviation per waypoint, and where each waypoint lies.
+
+    Parameters
+    ----------
+    pts : ndarray, shape (n, 2)
+        Checked waypoints [m].
+    deviations : ndarray, shape (n,)
+        Largest distance from each inner waypoint to the path [m] (> 0; the ends' values are
+        not used). A route's nodes each have their own (VDA 5050 ``allowedDeviationXY``).
+    transition : float, optional
+        As in :func:`g2_corners`.
+
+    Returns
+    -------
+    pieces : tuple of ClothoidPiece
+        As :func:`g2_corners`.
+    waypoint_s : ndarray, shape (n,)
+        Arc length [m] of the path's point nearest to each waypoint: the midpoint of its
+        corner (0 and the length at the ends; at a cusp, the cusp point).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.geometry.corners import g2_chain
+    >>> pts = np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])
+    >>> pieces, at = g2_chain(pts, np.array([0.0, 0.5, 0.0]))
+    >>> round(float(at[2] - sum(p.length for p in pieces)), 12), bool(at[1] < 10.0)
+    (0.0, True)
+    """
+    dev = np.asarray(deviations, dtype=np.float64)
     share = DEFAULT_TRANSITION if transition is None else as_scalar(
         "transition", transition, positive=True)
     if share > 1.0:
@@ -250,12 +286,13 @@ def g2_corners(
         shapes[i] = shape
         # A corner stays within `dev` of its waypoint; a cusp's corners within `dev` of it
         # too: their far end, the cusp point, is the tangent length beyond the waypoint.
-        want[i] = dev if cusp[i] else dev * shape.tangent / shape.deviation
+        want[i] = dev[i] if cusp[i] else dev[i] * shape.tangent / shape.deviation
     before, after = _leg_room(legs, want)
     tangent = np.minimum(want, np.minimum(before, after))
 
     unit = np.diff(pts, axis=0) / legs[:, None]
     pieces: list[ClothoidPiece] = []
+    waypoint_s = np.zeros(n)
     direction = 1
     theta = float(head[0])  # vehicle heading, unwrapped along the path
     for i in range(n - 1):
@@ -275,9 +312,12 @@ def g2_corners(
         # The corner at waypoint i + 1; exactly at the first waypoint if it takes the leg.
         start = pts[i + 1] - unit[i] * t_in if i > 0 or has_straight else pts[0]
         corner, bent = shapes[i + 1], float(bend[i + 1])
+        entry = _length(pieces)
         if corner is not None:
             radius = t_in / corner.tangent
             pieces += _corner_pieces(start, theta, bent, radius, corner, direction)
+        # The symmetric corner's middle; at a cusp its end, the cusp point.
+        waypoint_s[i + 1] = _length(pieces) if cusp[i + 1] else 0.5 * (entry + _length(pieces))
         if not cusp[i + 1]:
             theta += bent
             continue
@@ -289,4 +329,9 @@ def g2_corners(
             pieces += _corner_pieces(q, theta + bent, bent, radius, corner, -direction)
         theta += 2.0 * bent
         direction = -direction
-    return tuple(pieces)
+    waypoint_s[-1] = _length(pieces)
+    return tuple(pieces), waypoint_s
+
+
+def _length(pieces: list[ClothoidPiece]) -> float:
+    return float(sum(p.length for p in pieces))

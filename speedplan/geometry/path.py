@@ -13,7 +13,7 @@ import numpy as np
 from ..core.checks import FloatArray, IntArray, as_array, as_scalar, grid_size
 from ..core.errors import InvalidInputError
 from ._checks import as_int
-from .pieces import Piece
+from .pieces import Piece, SubPiece
 from .primitives import Arc, Clothoid, Line, as_segment, segment_piece
 
 __all__ = ["Arc", "Clothoid", "Line", "Path", "PathSamples"]
@@ -201,6 +201,50 @@ class Path:
         """
         return self._dispatch(s, "curvature")
 
+    def curvature_rate(self, s: Any) -> FloatArray:
+        """``dκ/ds`` [1/m²] at arc lengths ``s`` [m], within each piece.
+
+        At a join the value is that of the piece after it; where the curvature jumps there
+        (:meth:`curvature_jumps`) it is not defined, and a vehicle must stop to pass with a
+        lateral-jerk limit.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Clothoid, Line, Path
+        >>> p = Path.from_segments([Line(1.0), Clothoid(2.0, 0.0, 0.5)])
+        >>> p.curvature_rate([0.5, 2.0]).tolist()
+        [0.0, 0.25]
+        """
+        return self._dispatch(s, "curvature_rate")
+
+    def curvature_jumps(self, tol: float = 1e-9) -> tuple[FloatArray, FloatArray]:
+        """Joins of pieces where the curvature jumps: ``(s [m], jump [1/m])``.
+
+        A jump is a change larger than ``tol × (1/length + |κ|)`` from the end of one piece
+        to the start of the next (a G1 path: a line onto an arc, a clothoid chain's joins);
+        cusps are not listed. G2 paths (the default of :meth:`from_waypoints`) have none.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Arc, Line, Path
+        >>> s, jump = Path.from_segments([Line(2.0), Arc(radius=4.0, angle=1.0)]).curvature_jumps()
+        >>> s.tolist(), jump.tolist()
+        ([2.0], [0.25])
+        """
+        joins = []
+        jumps = []
+        for k in range(1, len(self.pieces)):
+            before, after = self.pieces[k - 1], self.pieces[k]
+            if before.direction != after.direction:
+                continue
+            k_end = float(before.curvature(np.array(before.length)))
+            k_start = float(after.curvature(np.array(0.0)))
+            scale = 1.0 / self.length + max(abs(k_end), abs(k_start))
+            if abs(k_start - k_end) > tol * scale:
+                joins.append(float(self.offsets[k]))
+                jumps.append(k_start - k_end)
+        return np.array(joins, dtype=np.float64), np.array(jumps, dtype=np.float64)
+
     def direction(self, s: Any) -> IntArray:
         """Direction of travel at arc lengths ``s`` [m]: ``+1`` forward, ``-1`` reverse.
 
@@ -252,6 +296,41 @@ class Path:
             return (self,)
         bounds = np.concatenate(([0], flips, [len(self.pieces)]))
         return tuple(Path(self.pieces[a:b]) for a, b in pairwise(bounds.tolist()))
+
+    def sub(self, lo: float, hi: float | None = None) -> Path:
+        """The stretch ``[lo, hi]`` [m] of the path (to the end by default), ``s`` from 0.
+
+        Pieces cut by ``lo`` or ``hi`` become :class:`~speedplan.geometry.pieces.SubPiece`
+        views of the originals: positions, headings and curvature are the path's, exactly.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Arc, Line, Path
+        >>> p = Path.from_segments([Line(2.0), Arc(radius=1.0, angle=1.0)])
+        >>> q = p.sub(1.5, 2.5)
+        >>> q.length, q.point(0.0).tolist(), float(q.curvature(0.75))
+        (1.0, [1.5, 0.0], 1.0)
+        """
+        length = self.length
+        lo_v = as_scalar("lo", lo, nonnegative=True)
+        hi_v = length if hi is None else as_scalar("hi", hi)
+        if not lo_v < hi_v <= length * (1 + S_TOLERANCE):
+            raise InvalidInputError(
+                f"`lo` and `hi` must satisfy 0 <= lo < hi <= length = {length:.9g} m; got "
+                f"lo={lo_v!r}, hi={hi_v!r}"
+            )
+        hi_v = min(hi_v, length)
+        out: list[Piece] = []
+        for k, piece in enumerate(self.pieces):
+            a, b = float(self.offsets[k]), float(self.offsets[k + 1])
+            cut_lo, cut_hi = max(a, lo_v), min(b, hi_v)
+            if cut_hi - cut_lo <= 1e-15 * length:
+                continue
+            if cut_lo == a and cut_hi == b:
+                out.append(piece)
+            else:
+                out.append(SubPiece(piece, cut_lo - a, cut_hi - cut_lo))
+        return Path(tuple(out))
 
     def evaluate(self, s: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``(point, heading, curvature)`` at arc lengths ``s`` in one pass.

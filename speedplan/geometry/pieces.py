@@ -28,7 +28,7 @@ from ..core.numerics import GAUSS_NODES, GAUSS_WEIGHTS, SHORT_NODES, SHORT_WEIGH
 from ._checks import as_direction
 
 __all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "CurvePiece", "ParametricCurve", "Piece",
-           "ReversedPiece"]
+           "ReversedPiece", "SubPiece"]
 
 #: Sub-intervals per polynomial piece in the arc-length table of a :class:`CurvePiece`.
 _TABLE_SPLIT = 8
@@ -64,6 +64,18 @@ class Piece:
     def curvature(self, u: FloatArray) -> FloatArray:  # pragma: no cover - interface
         """Signed curvatures [1/m] (positive: turning left, in the direction of travel)."""
         raise NotImplementedError
+
+    def curvature_rate(self, u: FloatArray) -> FloatArray:
+        """``dκ/du`` [1/m²]: a central difference inside the piece (one-sided at its ends).
+
+        The step is ``1e-5`` of the piece (error of order step² times the third derivative
+        of the curvature); pieces whose curvature is linear in ``u`` override it exactly.
+        """
+        u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
+        step = 1e-5 * self.length
+        lo, hi = np.maximum(u - step, 0.0), np.minimum(u + step, self.length)
+        out: FloatArray = (self.curvature(hi) - self.curvature(lo)) / (hi - lo)
+        return out
 
     def evaluate(self, u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``(point, heading, curvature)`` at once (pieces share work where they can)."""
@@ -317,8 +329,56 @@ class ReversedPiece(Piece):
         out: FloatArray = -self.piece.curvature(self._mirror(u))
         return out
 
+    def curvature_rate(self, u: FloatArray) -> FloatArray:
+        """``d(-κ(L - u))/du = κ'(L - u)`` [1/m²]."""
+        return self.piece.curvature_rate(self._mirror(u))
+
     def reversed(self, swap_direction: bool = False) -> Piece:
         """The original piece when reversed the same way; otherwise a nested reversal."""
         if swap_direction == self.swap_direction:
             return self.piece
         return ReversedPiece(self, swap_direction)
+
+
+@dataclass(frozen=True, eq=False)
+class SubPiece(Piece):
+    """The stretch ``[lo, lo + length]`` of ``piece``, with its own arc length from 0."""
+
+    piece: Piece
+    lo: float
+    sub_length: float
+
+    @property
+    def length(self) -> float:  # type: ignore[override]
+        """Length of the stretch [m]."""
+        return self.sub_length
+
+    @property
+    def direction(self) -> int:  # type: ignore[override]
+        """Direction of travel of the underlying piece."""
+        return self.piece.direction
+
+    def _shift(self, u: FloatArray) -> FloatArray:
+        out: FloatArray = self.lo + np.clip(np.asarray(u, dtype=np.float64), 0.0,
+                                            self.sub_length)
+        return out
+
+    def evaluate(self, u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``(point, heading, curvature)`` of the underlying piece."""
+        return self.piece.evaluate(self._shift(u))
+
+    def point(self, u: FloatArray) -> FloatArray:
+        """Positions [m]."""
+        return self.piece.point(self._shift(u))
+
+    def heading(self, u: FloatArray) -> FloatArray:
+        """Vehicle headings [rad]."""
+        return self.piece.heading(self._shift(u))
+
+    def curvature(self, u: FloatArray) -> FloatArray:
+        """Curvatures [1/m]."""
+        return self.piece.curvature(self._shift(u))
+
+    def curvature_rate(self, u: FloatArray) -> FloatArray:
+        """``dκ/du`` [1/m²]."""
+        return self.piece.curvature_rate(self._shift(u))

@@ -223,6 +223,10 @@ class ClothoidPiece(Piece):
         out: FloatArray = self.k0 + (self.k1 - self.k0) * (u / self.length)
         return out
 
+    def curvature_rate(self, u: FloatArray) -> FloatArray:
+        """The sharpness ``(k1 - k0) / length`` [1/m²], constant along the piece."""
+        return np.full(np.shape(u), (self.k1 - self.k0) / self.length)
+
     def _integrate(self, a: FloatArray, b: FloatArray) -> FloatArray:
         """Displacements from ``a`` to ``b`` (direction of travel included)."""
         width = (b - a)[:, None] * self.direction

@@ -16,8 +16,8 @@ Modules, one job each:
 This layer imports ``core``, ``geometry`` and ``solve``.
 """
 
-from .build import ForcedLeg, Leg, Model, TimeLawSpec, build_model
+from .build import ForcedLeg, Leg, Model, Rest, TimeLawSpec, build_model, rest_points
 from .request import STANDSTILL_MODES, PlanRequest
 
-__all__ = ["STANDSTILL_MODES", "ForcedLeg", "Leg", "Model", "PlanRequest", "TimeLawSpec",
-           "build_model"]
+__all__ = ["STANDSTILL_MODES", "ForcedLeg", "Leg", "Model", "PlanRequest", "Rest", "TimeLawSpec",
+           "build_model", "rest_points"]

@@ -19,15 +19,16 @@ import numpy as np
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
 from ..core.limits import Limits
-from ..geometry import SpeedBound
+from ..geometry import Path, SpeedBound
 from ..solve import DiscreteProblem, DiscreteSolution, solve_problem
+from ..solve.problem import StencilRows
 from .boundary import check_reachable_states, jerk_motion_w, turnaround_speed
 from .grid import adaptive_grid, uniform_grid
 from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
 
-__all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "TimeLawSpec", "build_leg",
-           "build_model", "node_bounds"]
+__all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
+           "build_model", "node_bounds", "rest_points"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
@@ -121,6 +122,24 @@ class ForcedLeg:
 
 
 @dataclass(frozen=True)
+class Rest:
+    """A point inside the path where the vehicle must be at rest (v = 0, a = 0).
+
+    Attributes
+    ----------
+    s : float
+        Position along the path [m].
+    reason : str
+        Why: ``"cusp"`` (the direction of travel flips), ``"stop"`` (asked for, e.g. a route
+        node with a blocking action) or ``"curvature jump"`` (a G1 join with ``j_lat_max``
+        set: the lateral acceleration would step).
+    """
+
+    s: float
+    reason: str
+
+
+@dataclass(frozen=True)
 class Model:
     """A request modelled as legs between standstills.
 
@@ -132,15 +151,46 @@ class Model:
         ``s -> mu+(s)`` [m²/s²] along the whole path.
     legs : tuple of Leg or ForcedLeg
         In order; consecutive legs meet at rest.
+    rests : tuple of Rest
+        The points inside the path where the vehicle stops, in order.
     """
 
     request: PlanRequest
     bound: SpeedBound
     legs: tuple[Leg | ForcedLeg, ...] = field(default_factory=tuple)
+    rests: tuple[Rest, ...] = ()
+
+
+def rest_points(request: PlanRequest) -> tuple[Rest, ...]:
+    """Where the vehicle must be at rest inside the path: cusps, asked stops, curvature jumps.
+
+    Points closer than ``1e-9`` of the length merge (the first reason listed wins: a cusp,
+    then a stop, then a curvature jump).
+    """
+    path = request.path
+    length = float(path.length)
+    found = [Rest(float(s), "cusp") for s in path.cusps]
+    found += [Rest(float(s), "stop") for s in request.stops]
+    if np.isfinite(request.limits.j_lat_max):
+        found += [Rest(float(s), "curvature jump") for s in path.curvature_jumps()[0]]
+    order = {"cusp": 0, "stop": 1, "curvature jump": 2}
+    out: list[Rest] = []
+    for rest in sorted(found, key=lambda r: (r.s, order[r.reason])):
+        if not 0.0 < rest.s < length:
+            continue
+        if out and rest.s - out[-1].s <= 1e-9 * length:
+            continue
+        out.append(rest)
+    return tuple(out)
 
 
 def build_model(request: PlanRequest) -> Model:
     """Model ``request``: split it into legs and build each leg's discrete problem.
+
+    The path is cut at every :class:`Rest` (:func:`rest_points`); each stretch between two
+    cuts runs from its start state (the request's at ``s = 0``, rest elsewhere) to its end
+    state, and becomes one :class:`Leg`, preceded (followed) by a :class:`ForcedLeg` where
+    its start (end) state forces a stop on the way.
 
     Raises
     ------
@@ -148,36 +198,67 @@ def build_model(request: PlanRequest) -> Model:
         A boundary speed above the speed bound, or a speed bound of 0 inside the path.
     InfeasibleError
         A boundary state no jerk-limited motion can leave or reach (which state, which
-        limit), or a path too short to join them.
+        limit), or a stretch too short to join the states at its ends (which, where).
     """
     lim = request.limits
     path = request.path
     length = float(path.length)
     bound = SpeedBound(path, lim, None if request.zones is None else list(request.zones),
-                       request.v_limit)
+                       request.v_limit, spans=request.spans)
     _check_end_speeds(request, bound, length)
-    if request.jerk_limited:
-        check_reachable_states(request.v0, request.a0, request.vf, request.af, length,
-                               lim.v_max, lim.a_max, lim.a_decel, lim.j_max)
+    rests = rest_points(request)
+    cuts = [0.0, *(r.s for r in rests), length]
     legs: list[Leg | ForcedLeg] = []
-    v0, a0, vf, af = request.v0, request.a0, request.vf, request.af
-    lo, hi = 0.0, length
+    for j in range(len(cuts) - 1):
+        first, last = j == 0, j == len(cuts) - 2
+        legs += _stretch_legs(
+            request, bound, cuts[j], cuts[j + 1],
+            (request.v0, request.a0) if first else (0.0, 0.0),
+            (request.vf, request.af) if last else (0.0, 0.0),
+            None if first else rests[j - 1], None if last else rests[j],
+        )
+    return Model(request=request, bound=bound, legs=tuple(legs), rests=rests)
+
+
+def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
+                  start: tuple[float, float], end: tuple[float, float], rest_before: Rest | None,
+                  rest_after: Rest | None) -> list[Leg | ForcedLeg]:
+    """The legs of the stretch ``[lo, hi]`` between two cuts (the path's ends or rests)."""
+    lim = request.limits
+    (v0, a0), (vf, af) = start, end
+    length = hi - lo
+    if request.jerk_limited:
+        try:
+            check_reachable_states(v0, a0, vf, af, length, lim.v_max, lim.a_max, lim.a_decel,
+                                   lim.j_max)
+        except InfeasibleError as exc:
+            if rest_before is None and rest_after is None:
+                raise
+            ends = " and ".join(
+                f"the {r.reason} at s={r.s:.6g} m" for r in (rest_before, rest_after)
+                if r is not None)
+            raise InfeasibleError(
+                f"between s={lo:.6g} m and s={hi:.6g} m ({ends}, where the vehicle must be at "
+                f"rest): {exc}", constraint=exc.constraint,
+                s=None if exc.s is None else lo + exc.s) from exc
+    legs: list[Leg | ForcedLeg] = []
     head = _forced_stop(v0, a0, lim, end=False) if request.jerk_limited else None
     tail = _forced_stop(vf, af, lim, end=True) if request.jerk_limited else None
+    inner_lo, inner_hi = lo, hi
     if head is not None:
-        legs.append(head)
-        lo, v0, a0 = head.length, 0.0, 0.0
+        legs.append(_shifted(head, lo))
+        inner_lo, v0, a0 = lo + head.length, 0.0, 0.0
     if tail is not None:
-        hi, vf, af = length - tail.length, 0.0, 0.0
-    if hi - lo > 1e-12 * length:
-        legs.append(build_leg(request, bound, lo, hi, v0, a0, vf, af))
+        inner_hi, vf, af = hi - tail.length, 0.0, 0.0
+    if inner_hi - inner_lo > 1e-12 * length:
+        legs.append(build_leg(request, bound, inner_lo, inner_hi, v0, a0, vf, af))
     elif head is not None and tail is not None:
         raise InfeasibleError(
             "the path is too short: both boundary states force a stop and the two stops "
-            "overlap", constraint="length", s=length)
+            "overlap", constraint="length", s=hi)
     if tail is not None:
-        legs.append(_shifted(tail, length - tail.length))
-    return Model(request=request, bound=bound, legs=tuple(legs))
+        legs.append(_shifted(tail, hi - tail.length))
+    return legs
 
 
 def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0: float,
@@ -233,6 +314,7 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
         s=s, w_max=w_max,
         accel=np.full(m - 1, lim.A), decel=np.full(m - 1, lim.A_decel),
         jerk=jerk, w_start=v0 * v0, w_end=vf * vf, w_min=floor,
+        lateral=lateral_jerk_rows(request.path, lo, s, lim.j_lat_max),
     )
     law = TimeLawSpec(
         j_max=lim.j_max if request.smooth_standstill else None,
@@ -242,6 +324,28 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
                backend=request.backend)
+
+
+def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float
+                      ) -> StencilRows | None:
+    """Rows ``|κ' w_i + κ w'_i| sqrt(w_i) <= j_lat_max`` at the interior nodes (or ``None``).
+
+    Lateral jerk is ``d(κ v²)/dt = sqrt(w) (κ' w + κ w')``; ``w'`` at node ``i`` is the
+    three-point first difference of the (non-uniform) grid, exact for quadratic ``w``. ``κ``
+    and ``κ' = dκ/ds`` are the path's at ``lo + s`` (at a join of pieces, those after it).
+    """
+    if not np.isfinite(j_lat_max):
+        return None
+    q = lo + s[1:-1]
+    kappa = path.curvature(q)
+    rate = path.curvature_rate(q)
+    h = np.diff(s)
+    h0, h1 = h[:-1], h[1:]
+    first = np.column_stack((-h1 / (h0 * (h0 + h1)), (h1 - h0) / (h0 * h1),
+                             h0 / (h1 * (h0 + h1))))
+    coef = kappa[:, None] * first
+    coef[:, 1] += rate
+    return StencilRows(coef=coef, bound=np.full(s.size - 2, float(j_lat_max)))
 
 
 def _check_moving_ends_resolved(s: FloatArray, lo: float, v0: float, a0: float, vf: float,

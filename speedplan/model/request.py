@@ -8,11 +8,11 @@ from typing import Any
 
 import numpy as np
 
-from ..core.checks import as_scalar, choice
+from ..core.checks import as_array, as_scalar, choice
 from ..core.errors import InvalidInputError
 from ..core.limits import Limits
 from ..geometry import Path, SpeedZone
-from ..geometry.bounds import check_zones
+from ..geometry.bounds import SpanLimit, check_spans, check_zones
 from ..solve.discrete import BACKENDS, REFINE_MODES
 
 __all__ = ["MIN_RELATIVE_LENGTH", "STANDSTILL_MODES", "PlanRequest"]
@@ -58,6 +58,8 @@ class PlanRequest:
     refine: str = "auto"
     standstill: str = "smooth"
     backend: str = "auto"
+    stops: tuple[float, ...] = ()
+    spans: tuple[SpanLimit, ...] = ()
 
     @classmethod
     def create(
@@ -76,6 +78,8 @@ class PlanRequest:
         refine: str = "auto",
         standstill: str = "smooth",
         backend: str = "auto",
+        stops: Any = None,
+        spans: Any = None,
     ) -> PlanRequest:
         """Check every argument; raise :class:`~speedplan.InvalidInputError` naming a bad one."""
         if not isinstance(path, Path):
@@ -109,6 +113,8 @@ class PlanRequest:
             refine=refine,
             standstill=standstill,
             backend=backend,
+            stops=_check_stops(stops, float(path.length)),
+            spans=tuple(check_spans(spans, float(path.length))),
         )
         request._check_accelerations()
         request._check_length()
@@ -150,3 +156,17 @@ class PlanRequest:
                 "(1e-9 v_max²/a_max): there is no motion to plan (nearly coincident "
                 "waypoints?); skip the move or check the path"
             )
+
+
+def _check_stops(stops: Any, length: float) -> tuple[float, ...]:
+    """``stops`` as sorted positions strictly inside ``(0, length)`` [m]."""
+    if stops is None:
+        return ()
+    arr = as_array("stops", stops, ndim=1)
+    bad = arr[(arr <= 0.0) | (arr >= length)]
+    if bad.size:
+        raise InvalidInputError(
+            f"`stops` must lie strictly inside the path (0, {length:.9g}) m; got {bad[0]!r} "
+            "(the ends are always at the boundary states v0/vf)"
+        )
+    return tuple(float(s) for s in np.unique(arr))

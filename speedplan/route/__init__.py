@@ -2,12 +2,17 @@
 
 * :mod:`~speedplan.route.route` — :class:`Route`, :class:`RouteNode`, :class:`RouteEdge`: the
   released base's length, node positions ``node_s``, edge spans, stops and stop-to-stop legs;
+* :mod:`~speedplan.route.profile` — :class:`RouteProfile` (what :func:`speedplan.plan_route`
+  returns: the legs' profiles stitched, node times) and :class:`RouteTrajectory`;
 * :mod:`~speedplan.route.vda5050` — reading VDA 5050 2.0, 2.1 and 3.0 orders
   (:meth:`Route.from_vda5050`), trajectories included.
 
-This layer sits between ``timing`` and the top level; it imports ``core`` and ``geometry``.
+This layer sits between ``timing`` and the top level; it imports ``core``, ``geometry`` and
+``timing``.
 """
 
+from .profile import RouteProfile, RouteTrajectory
 from .route import HEADING_TOLERANCE, Route, RouteEdge, RouteNode
 
-__all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode"]
+__all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode", "RouteProfile",
+           "RouteTrajectory"]

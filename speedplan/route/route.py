@@ -14,6 +14,8 @@ from ..core.checks import FloatArray
 from ..core.errors import InvalidInputError
 from ..geometry import Path
 from ..geometry._checks import wrap_angle
+from ..geometry.corners import CUSP_ANGLE, g2_chain
+from ..geometry.primitives import ClothoidPiece
 from ._checks import (
     boolean,
     check_meets_node,
@@ -169,18 +171,39 @@ def _heading_change(incoming: Path, outgoing: Path) -> float:
     return float(abs(wrap_angle(after - before)))
 
 
-def _join_at_node(incoming: Path, node: RouteNode, outgoing: Path) -> bool:
-    """Whether the vehicle must stop on ``node`` to pass from ``incoming`` to ``outgoing``.
+def _is_straight(path: Path) -> bool:
+    """Whether ``path`` is one straight piece driven forward (an edge between node positions)."""
+    if len(path.pieces) != 1:
+        return False
+    piece = path.pieces[0]
+    return isinstance(piece, ClothoidPiece) and piece.k0 == 0.0 and piece.k1 == 0.0 \
+        and piece.direction == 1
 
-    The one place that decides how a route passes a node between two edges. For now the
-    edges are joined as they are, with a stop wherever the heading changes by more than
-    :data:`HEADING_TOLERANCE` (safe and correct: a vehicle turns on the spot, or at least
-    passes the corner at zero speed). The corner is not rounded within
-    ``node.allowed_deviation_xy`` yet; once it is (G2 corners, built where the route's edges
-    are built), the rounded edges meet with equal headings and this test no longer stops.
+
+def _can_round(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
+    """Whether the corner on ``node`` between two straight edges is rounded (G2).
+
+    Both edges run straight between node positions, the node allows a deviation, the turn is
+    not a reversal (:data:`~speedplan.geometry.corners.CUSP_ANGLE`) and the vehicle keeps
+    its driving direction.
     """
-    del node  # the rounding will use its allowed deviation
-    return _heading_change(incoming, outgoing) > HEADING_TOLERANCE
+    return (_is_straight(before.path) and _is_straight(after.path)
+            and node.allowed_deviation_xy > 0.0 and before.reverse == after.reverse
+            and _heading_change(before.path, after.path) <= CUSP_ANGLE)
+
+
+def _join_at_node(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
+    """Whether the vehicle must stop on ``node`` to pass from ``before`` to ``after``.
+
+    The one place that decides how a route passes a node between two edges: where the
+    heading changes by more than :data:`HEADING_TOLERANCE`, the corner is rounded within
+    ``node.allowed_deviation_xy`` when both edges are straight (:func:`_can_round`: a G2
+    clothoid–arc–clothoid corner, as :meth:`Path.from_waypoints` builds them), else the
+    vehicle stops there (it turns on the spot).
+    """
+    if _heading_change(before.path, after.path) <= HEADING_TOLERANCE:
+        return False
+    return not _can_round(before, node, after)
 
 
 @dataclass(frozen=True, eq=False)
@@ -303,7 +326,7 @@ class Route:
                 reasons.append(f"edge {after.edge_id!r} has a blocking (SOFT/HARD) action")
             if before.reverse != after.reverse:
                 reasons.append("the driving direction changes (cusp)")
-            if _join_at_node(before.path, node, after.path):
+            if _join_at_node(before, node, after):
                 turn = _heading_change(before.path, after.path)
                 reasons.append(f"the heading changes by {turn:.3g} rad")
             if reasons:
@@ -323,15 +346,70 @@ class Route:
         return self.nodes[: len(self.base_edges) + 1]
 
     @cached_property
+    def _geometry(self) -> tuple[Path, FloatArray, tuple[int, ...]]:
+        """The base as one path, the arc length of each released node, the rounded nodes."""
+        edges, nodes = self.base_edges, self.base_nodes
+        pieces: list[Any] = []
+        node_s = np.zeros(len(nodes))
+        rounded: list[int] = []
+        i = 0
+        while i < len(edges):
+            # A run of straight edges whose inner nodes are all rounded: one G2 chain.
+            j = i
+            while j + 1 < len(edges) and _heading_change(edges[j].path, edges[j + 1].path) \
+                    > HEADING_TOLERANCE and _can_round(edges[j], nodes[j + 1], edges[j + 1]):
+                j += 1
+            offset = float(sum(p.length for p in pieces))
+            if j > i:
+                pts = np.array([e.path.point(0.0) for e in edges[i:j + 1]]
+                               + [edges[j].path.point(edges[j].path.length)])
+                dev = np.array([nodes[k].allowed_deviation_xy for k in range(i, j + 2)])
+                chain, at = g2_chain(pts, dev)
+                run = Path(chain)
+                if edges[i].reverse:
+                    run = run.reversed(swap_direction=True).reversed()
+                pieces += run.pieces
+                node_s[i + 1:j + 2] = offset + at[1:]
+                rounded += list(range(i + 1, j + 1))
+            else:
+                path = edges[i].path
+                if edges[i].reverse:
+                    path = path.reversed(swap_direction=True).reversed()
+                pieces += path.pieces
+                node_s[i + 1] = offset + path.length
+            i = j + 1
+        node_s.flags.writeable = False
+        return Path(tuple(pieces)), node_s, tuple(rounded)
+
+    @property
+    def path(self) -> Path:
+        """The released base as one :class:`~speedplan.Path`: what ``plan_route`` plans.
+
+        The edges' paths in order (driven in reverse where the edge says so), with the corners
+        between straight edges rounded within their node's allowed deviation.
+        """
+        return self._geometry[0]
+
+    @property
     def node_s(self) -> FloatArray:
-        """Arc length [m] of each released node along the base (0 first, :attr:`length` last)."""
-        out = np.concatenate(([0.0], np.cumsum([e.path.length for e in self.base_edges])))
-        out.flags.writeable = False
-        return out
+        """Arc length [m] of each released node along :attr:`path`.
+
+        0 first, :attr:`length` last; on a rounded corner, the corner's middle (its point
+        nearest the node).
+        """
+        return self._geometry[1]
+
+    @property
+    def rounded_nodes(self) -> tuple[int, ...]:
+        """Indices of the released nodes whose corner is rounded (see :attr:`path`)."""
+        return self._geometry[2]
 
     @property
     def length(self) -> float:
-        """Length of the released base [m] (the sum of its edges' lengths)."""
+        """Length of the released base [m].
+
+        The sum of its edges' lengths, less what the rounded corners cut.
+        """
         return float(self.node_s[-1])
 
     @property

@@ -214,9 +214,18 @@ class Trajectory:
         """Time of the last sample [s]."""
         return float(self.t[-1])
 
+    @property
+    def units(self) -> dict[str, str]:
+        """Column names with their units, in export order.
+
+        :data:`COLUMNS`; a subclass such as :class:`speedplan.route.RouteTrajectory` appends
+        its own.
+        """
+        return dict(COLUMNS)
+
     def to_dict(self) -> dict[str, FloatArray]:
-        """Arrays by column name, heading continuous (see :data:`COLUMNS` for units)."""
-        return {name: getattr(self, name) for name in COLUMNS}
+        """Arrays by column name, heading continuous (see :attr:`units`)."""
+        return {name: getattr(self, name) for name in self.units}
 
     def _export_columns(self) -> dict[str, FloatArray]:
         cols = self.to_dict()
@@ -269,7 +278,7 @@ class Trajectory:
         cols = self._export_columns()
         data = np.column_stack(list(cols.values()))
         lines = [f"# {k}: {_comment_value(v)}" for k, v in self._export_metadata().items()]
-        lines.append(",".join(f"{name} [{unit}]" for name, unit in COLUMNS.items()))
+        lines.append(",".join(f"{name} [{unit}]" for name, unit in self.units.items()))
         with text_output(file, "trajectory CSV") as fh:
             fh.write("\n".join(lines) + "\n")
             _write_rows(fh, data)
@@ -303,7 +312,7 @@ class Trajectory:
         """
         doc: dict[str, Any] = {
             "metadata": self._export_metadata(),
-            "units": dict(COLUMNS),
+            "units": self.units,
             "columns": {k: v.tolist() for k, v in self._export_columns().items()},
         }
         text = json.dumps(doc)
