@@ -42,7 +42,7 @@ def sample_paths() -> None:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 prof = sp.plan(path, lim, zones=zones)
-            print(f"{f.name:22s} {j_lat:5.1f}  {prof.status:9s} {str(prof.exact):5s}  "
+            print(f"{f.name:22s} {j_lat:5.1f}  {prof.status:9s} {prof.exact!s:5s}  "
                   f"{prof.gap:8.2e}  {prof.duration / plain.duration - 1:+7.1%}  "
                   f"{prof.verification.ok}")
 

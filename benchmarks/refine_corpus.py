@@ -48,8 +48,9 @@ def problem_arrays(p: DiscreteProblem) -> dict[str, Any]:
     if p.w_min is None:
         out["w_min"] = np.zeros(p.n)
     out["ends"] = np.array([p.w_start, p.w_end])
-    if p.lateral is not None:
-        out["lat_coef"], out["lat_bound"] = p.lateral.coef, p.lateral.bound
+    if p.lateral_families:  # the corpus stores one family
+        (lat,) = p.lateral_families
+        out["lat_coef"], out["lat_bound"] = lat.coef, lat.bound
     return out
 
 

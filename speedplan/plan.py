@@ -142,7 +142,8 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
             break
         for i, (leg, leg_check) in enumerate(zip(model.legs, leg_checks, strict=True)):
             if not leg_check.verification.ok and isinstance(leg, Leg):
-                grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess)
+                grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess,
+                                    leg.anchors)
                 finer = leg_on_grid(request, leg.bound, grid, leg.start, leg.v0, leg.a0,
                                     leg.vf, leg.af)
                 legs[i] = _solve(finer)

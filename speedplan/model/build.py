@@ -28,7 +28,7 @@ from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
 
 __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
-           "build_model", "node_bounds", "rest_points"]
+           "build_model", "grid_anchors", "node_bounds", "rest_points"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
@@ -78,6 +78,9 @@ class Leg:
         How to build the continuous law from its solution.
     refine : str
         Refinement mode; ``backend``: relaxation backend (from the request).
+    anchors : ndarray
+        Positions on the leg [m] its grids keep as nodes (joins of path pieces where the
+        curvature rate jumps, with a lateral-jerk limit); empty when none.
     """
 
     start: float
@@ -92,6 +95,7 @@ class Leg:
     limits: Limits
     refine: str = "auto"
     backend: str = "auto"
+    anchors: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     def solve(self) -> DiscreteSolution:
         """Solve the leg's discrete problem; an infeasibility is restated physically."""
@@ -281,7 +285,8 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
         s = adaptive_grid(length, lambda q: env.cap(q, leg_bound(q)), a_max=lim.a_max,
                           a_decel=lim.a_decel, v_max=lim.v_max, j_max=lim.j_max,
                           w_start=v0**2, w_end=vf**2,
-                          v_low=min((v for v in low if v > 0), default=None))
+                          v_low=min((v for v in low if v > 0), default=None),
+                          anchors=grid_anchors(request, lo, hi))
     else:
         s = uniform_grid(length, n=NO_JERK_NODES)
     return leg_on_grid(request, leg_bound, s, lo, v0, a0, vf, af)
@@ -323,29 +328,59 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     )
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
-               backend=request.backend)
+               backend=request.backend, anchors=grid_anchors(request, lo, lo + length))
+
+
+def grid_anchors(request: PlanRequest, lo: float, hi: float) -> FloatArray:
+    """Where a leg's default grids put nodes: joins of path pieces inside ``(lo, hi)``.
+
+    In the leg's arc length, and only with a lateral-jerk limit: the curvature rate jumps
+    there, and with a node on the join its two one-sided lateral-jerk rows hold the jump.
+    """
+    if not np.isfinite(request.limits.j_lat_max):
+        return np.zeros(0)
+    joins = request.path.offsets[1:-1]
+    out: FloatArray = joins[(joins > lo) & (joins < hi)] - lo
+    return out
 
 
 def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float
-                      ) -> StencilRows | None:
+                      ) -> tuple[StencilRows, ...] | None:
     """Rows ``|κ' w_i + κ w'_i| sqrt(w_i) <= j_lat_max`` at the interior nodes (or ``None``).
 
     Lateral jerk is ``d(κ v²)/dt = sqrt(w) (κ' w + κ w')``; ``w'`` at node ``i`` is the
     three-point first difference of the (non-uniform) grid, exact for quadratic ``w``. ``κ``
-    and ``κ' = dκ/ds`` are the path's at ``lo + s`` (at a join of pieces, those after it).
+    and ``κ' = dκ/ds`` are the path's at ``lo + s``. At a node on a join of pieces ``κ'``
+    jumps (a clothoid onto an arc): the lateral jerk takes both one-sided values there, so
+    a second family holds the rows with the rate before the join (elsewhere it has none).
     """
     if not np.isfinite(j_lat_max):
         return None
     q = lo + s[1:-1]
     kappa = path.curvature(q)
-    rate = path.curvature_rate(q)
+    after = path.curvature_rate(q)
+    before = after.copy()
+    joins = path.offsets[1:-1]
+    if joins.size:
+        k = np.searchsorted(joins, q)  # nearest join to each node
+        for cand in (np.clip(k - 1, 0, joins.size - 1), np.clip(k, 0, joins.size - 1)):
+            on = np.abs(joins[cand] - q) <= 1e-12 * max(float(path.length), 1.0)
+            for i in np.flatnonzero(on):
+                piece = path.pieces[int(cand[i])]  # the piece ending at that join
+                before[i] = float(piece.curvature_rate(np.array(piece.length)))
     h = np.diff(s)
     h0, h1 = h[:-1], h[1:]
     first = np.column_stack((-h1 / (h0 * (h0 + h1)), (h1 - h0) / (h0 * h1),
                              h0 / (h1 * (h0 + h1))))
-    coef = kappa[:, None] * first
-    coef[:, 1] += rate
-    return StencilRows(coef=coef, bound=np.full(s.size - 2, float(j_lat_max)))
+    bound = np.full(s.size - 2, float(j_lat_max))
+    families = []
+    for rate, rows in ((after, bound), (before, np.where(before != after, bound, np.inf))):
+        if not np.isfinite(rows).any():
+            continue
+        coef = kappa[:, None] * first
+        coef[:, 1] += rate
+        families.append(StencilRows(coef=coef, bound=rows))
+    return tuple(families)
 
 
 def _check_moving_ends_resolved(s: FloatArray, lo: float, v0: float, a0: float, vf: float,

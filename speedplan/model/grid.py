@@ -24,6 +24,7 @@ jumped by up to 19 % there).
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 
 import numpy as np
@@ -38,6 +39,7 @@ __all__ = [
     "DEFAULT_PER_PHASE",
     "GRADING",
     "MAX_DEFAULT_NODES",
+    "MIN_ANCHOR_NODES",
     "MIN_NODES",
     "MIN_RELATIVE_STEP",
     "adaptive_grid",
@@ -60,6 +62,10 @@ MIN_NODES = 200
 MIN_RELATIVE_STEP = 1e-11
 #: Largest relative change between neighbouring steps where the speed may change.
 GRADING = 0.01
+#: Fewest nodes between two grid anchors (points that must be nodes, e.g. joins of path
+#: pieces where the curvature rate jumps): the steps on either side are scaled by at most
+#: ``1 ± 0.5 / MIN_ANCHOR_NODES`` (1 %), within the grading.
+MIN_ANCHOR_NODES = 50
 #: Largest relative change between neighbouring steps inside long constant-bound stretches.
 CRUISE_GRADING = 0.1
 #: Largest step inside long constant-bound stretches, as a fraction of the length: nothing
@@ -99,12 +105,16 @@ def graded_steps(s: FloatArray, h: FloatArray, rate: FloatArray) -> FloatArray:
     return out
 
 
-def nodes_from_steps(s: FloatArray, h: FloatArray) -> FloatArray:
+def nodes_from_steps(s: FloatArray, h: FloatArray,
+                     anchors: FloatArray | None = None) -> FloatArray:
     """Grid with local step ``h(s)`` (piecewise linear over the pre-grid ``s``).
 
     ``N(s) = ∫ ds / h`` is inverted exactly in each pre-grid cell (``h`` linear there gives a
     logarithmic count), after scaling ``h`` so that ``N(length)`` is an integer: consecutive
-    steps then follow ``h`` smoothly.
+    steps then follow ``h`` smoothly. With ``anchors`` (points of the pre-grid ``s``) the
+    scaling is done between consecutive anchors, so that each anchor is a node; an anchor
+    closer than :data:`MIN_ANCHOR_NODES` steps to the previous one is skipped (the change of
+    scale there would break the grading).
 
     Examples
     --------
@@ -112,25 +122,49 @@ def nodes_from_steps(s: FloatArray, h: FloatArray) -> FloatArray:
     >>> g = nodes_from_steps(np.array([0.0, 1.0]), np.array([0.25, 0.25]))
     >>> g.tolist()
     [0.0, 0.25, 0.5, 0.75, 1.0]
+    >>> s = np.linspace(0.0, 1.0, 201)
+    >>> h = np.linspace(0.004, 0.006, 201)
+    >>> g = nodes_from_steps(s, h, anchors=np.array([s[77]]))
+    >>> bool(s[77] in g), bool(np.all(np.diff(g) > 0))
+    (True, True)
     """
     ds = np.diff(s)
     dh = np.diff(h)
     slope = dh / ds
     with np.errstate(divide="ignore", invalid="ignore"):
         cell = np.where(np.abs(dh) > 1e-12 * h[:-1], np.log(h[1:] / h[:-1]) / slope, ds / h[:-1])
-    total = float(cell.sum())
-    count = max(int(np.ceil(total - 1e-9)), 2)
-    cell *= count / total  # scale h by total / count: N(length) = count exactly
-    scale = total / count
+    cum_raw = np.concatenate(([0.0], np.cumsum(cell)))
+    cuts = [0]
+    if anchors is not None:
+        for a in np.unique(np.asarray(anchors, dtype=np.float64)):
+            k = int(np.searchsorted(s, a))
+            if 0 < k < s.size - 1 and s[k] == a \
+                    and cum_raw[k] - cum_raw[cuts[-1]] >= MIN_ANCHOR_NODES \
+                    and cum_raw[-1] - cum_raw[k] >= MIN_ANCHOR_NODES:
+                cuts.append(k)
+    cuts.append(s.size - 1)
+    factor = np.empty(ds.size)  # N is scaled by this on each cell: integer between cuts
+    for k0, k1 in itertools.pairwise(cuts):
+        total = float(cum_raw[k1] - cum_raw[k0])
+        count = max(int(np.ceil(total - 1e-9)) if len(cuts) == 2 else round(total), 1)
+        factor[k0:k1] = count / total
+    if len(cuts) == 2 and factor[0] * cum_raw[-1] < 2.0 - 1e-9:  # at least three nodes
+        factor[:] = 2.0 / cum_raw[-1]
+    cell = cell * factor
     cum = np.concatenate(([0.0], np.cumsum(cell)))
+    count = round(float(cum[-1]))
     targets = np.arange(1, count, dtype=np.float64)
     i = np.clip(np.searchsorted(cum, targets, side="right") - 1, 0, ds.size - 1)
     frac = targets - cum[i]  # nodes counted into cell i
-    h0 = h[i] * scale
-    g = slope[i]
+    # In cell i the scaled count is F log(1 + g x / h_i) / g: x = h_i expm1(g frac / F) / g.
+    f = factor[i]
+    h0, g = h[i] / f, slope[i] / f
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         inner = np.where(np.abs(g) * frac > 1e-12, h0 * np.expm1(g * frac) / g, h0 * frac)
     grid = np.concatenate(([s[0]], np.minimum(s[i] + inner, s[i + 1]), [s[-1]]))
+    if len(cuts) > 2:  # the anchors exactly (their count is an integer to rounding)
+        nearest = np.round(cum[cuts[1:-1]]).astype(np.intp)
+        grid[nearest] = s[cuts[1:-1]]
     out: FloatArray = np.maximum.accumulate(grid)
     return out
 
@@ -148,6 +182,7 @@ def adaptive_grid(
     v_low: float | None = None,
     per_phase: float = DEFAULT_PER_PHASE,
     max_nodes: int = MAX_DEFAULT_NODES,
+    anchors: FloatArray | None = None,
 ) -> FloatArray:
     """Smoothly graded grid with about ``per_phase`` nodes per jerk transition.
 
@@ -169,6 +204,8 @@ def adaptive_grid(
         Nodes per transition length.
     max_nodes : int
         Node cap; beyond it every step grows in proportion.
+    anchors : ndarray, optional
+        Positions [m] that should be nodes (see :func:`nodes_from_steps`).
     """
     a = min(a_max, a_decel)
     t_j = min(a / j_max, np.sqrt(v_max / j_max))
@@ -215,7 +252,10 @@ def adaptive_grid(
     # boundary states put the shortest transitions), refined where it cannot follow h.
     n_pre = int(np.clip(4 * length / max(floor, 1e-12), 2001, 200_001))
     ends = np.geomspace(max(floor / 8.0, 1e-12 * length), 0.5 * length, 200)
-    sf = np.unique(np.concatenate((np.linspace(0.0, length, n_pre), ends, length - ends)))
+    inner_anchors = np.zeros(0) if anchors is None else np.asarray(anchors, dtype=np.float64)
+    inner_anchors = inner_anchors[(inner_anchors > 0.0) & (inner_anchors < length)]
+    sf = np.unique(np.concatenate((np.linspace(0.0, length, n_pre), ends, length - ends,
+                                   inner_anchors)))
     sf = sf[(sf >= 0.0) & (sf <= length)]
     h = steps(sf)
     for _ in range(3):
@@ -238,7 +278,7 @@ def adaptive_grid(
                          np.full(sf.size, CRUISE_GRADING))
     if count < MIN_NODES - 1:
         h = h * (count / (MIN_NODES - 1))
-    grid = nodes_from_steps(sf, h)
+    grid = nodes_from_steps(sf, h, inner_anchors if inner_anchors.size else None)
     grid_size("n", grid.size)
     return grid
 

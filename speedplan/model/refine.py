@@ -13,13 +13,15 @@ __all__ = ["PAD_CELLS", "refined_grid"]
 PAD_CELLS = 4
 
 
-def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray) -> FloatArray:
+def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
+                 anchors: FloatArray | None = None) -> FloatArray:
     """The grid ``s`` with its steps halved around the law pieces flagged in ``excess``.
 
     ``knots`` are the law's knots (nodes and cell midpoints) and ``excess`` flags each piece
     between them. The steps are halved over the flagged cells padded by :data:`PAD_CELLS`
     on each side, and graded back to the old steps at the rate :data:`~speedplan.model.grid
-    .GRADING`, so the new grid is as smooth as the old one.
+    .GRADING`, so the new grid is as smooth as the old one; ``anchors`` (nodes of ``s``) stay
+    nodes.
 
     Examples
     --------
@@ -40,6 +42,7 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray) -> FloatA
         flagged[lo:hi + 1] = True
     target = np.where(flagged, 0.5 * node_h, node_h)
     target = graded_steps(s, target, np.full(s.size, GRADING))
-    grid = nodes_from_steps(s, target)
+    kept = None if anchors is None or not len(anchors) else np.intersect1d(anchors, s)
+    grid = nodes_from_steps(s, target, kept)
     grid_size("n", grid.size)
     return grid

@@ -77,8 +77,10 @@ class DiscreteProblem:
         Lower bounds on ``w`` (e.g. a jerk-limited vehicle leaving a moving state cannot
         slow down faster than its envelope). Lower bounds can make the relaxation inexact
         (the paper's Section 5.1); the refinement then applies.
-    lateral : StencilRows, optional
-        Lateral-jerk rows, relaxed like the jerk rows and part of the exactness test.
+    lateral : StencilRows or tuple of StencilRows, optional
+        Lateral-jerk rows, relaxed like the jerk rows and part of the exactness test; several
+        families when a node needs more than one row (the one-sided curvature rates at a join
+        of path pieces).
     """
 
     s: FloatArray
@@ -89,7 +91,7 @@ class DiscreteProblem:
     w_start: float = 0.0
     w_end: float = 0.0
     w_min: FloatArray | None = None
-    lateral: StencilRows | None = None
+    lateral: StencilRows | tuple[StencilRows, ...] | None = None
 
     @property
     def n(self) -> int:
@@ -125,7 +127,14 @@ class DiscreteProblem:
     @cached_property
     def has_lateral(self) -> bool:
         """Whether any lateral-jerk row is finite."""
-        return self.lateral is not None and bool(np.isfinite(self.lateral.bound).any())
+        return any(bool(np.isfinite(f.bound).any()) for f in self.lateral_families)
+
+    @property
+    def lateral_families(self) -> tuple[StencilRows, ...]:
+        """The lateral-jerk row families (empty without)."""
+        if self.lateral is None:
+            return ()
+        return (self.lateral,) if isinstance(self.lateral, StencilRows) else tuple(self.lateral)
 
     @cached_property
     def second_difference_weights(self) -> FloatArray:
@@ -138,8 +147,7 @@ class DiscreteProblem:
     def stencil_families(self) -> list[StencilRows]:
         """Every row family of the jerk rows' structure: the jerk rows, then lateral jerk."""
         out = [StencilRows(coef=self.second_difference_weights, bound=self.jerk)]
-        if self.lateral is not None:
-            out.append(self.lateral)
+        out.extend(self.lateral_families)
         return out
 
     @cached_property
@@ -172,9 +180,11 @@ class DiscreteProblem:
 
     def lateral_rows(self, w: FloatArray) -> FloatArray:
         """Per interior node, the same measure for the lateral-jerk rows (``-inf`` without)."""
-        if self.lateral is None:
-            return np.full(self.n - 2, -np.inf)
-        return self._rows(self.stencil_matrix(self.lateral.coef) @ w, self.lateral.bound, w)
+        out = np.full(self.n - 2, -np.inf)
+        for family in self.lateral_families:
+            out = np.maximum(out, self._rows(self.stencil_matrix(family.coef) @ w,
+                                             family.bound, w))
+        return out
 
     def _rows(self, load: FloatArray, bound: FloatArray, w: FloatArray) -> FloatArray:
         wi = np.maximum(w[1:-1], 0.0)
@@ -256,5 +266,5 @@ class DiscreteProblem:
             w_start=self.w_start / w_scale,
             w_end=self.w_end / w_scale,
             w_min=None if self.w_min is None else self.w_min / w_scale,
-            lateral=None if self.lateral is None else self.lateral.scaled(s_scale, w_scale),
+            lateral=tuple(f.scaled(s_scale, w_scale) for f in self.lateral_families) or None,
         )
