@@ -34,7 +34,7 @@ from .core.log import logger
 from .solve import BACKENDS, REFINE_MODES
 
 if TYPE_CHECKING:
-    from .timing import SpeedProfile, Trajectory
+    from .timing import SpeedProfile, Trajectory, Verification
 
 __all__ = ["EXIT_CODES", "exit_status", "main"]
 
@@ -270,28 +270,7 @@ def _check_plot(file: str | None) -> None:
 def _metadata(profile: SpeedProfile, args: argparse.Namespace, path_name: str | None
               ) -> dict[str, Any]:
     """What the trajectory file records about how it was made (for a reader, later)."""
-    meta: dict[str, Any] = {
-        "speedplan_version": __version__,
-        "path_file": path_name,
-        "status": profile.status,
-        "duration": profile.duration,
-        "objective": profile.objective,
-        "lower_bound": profile.lower_bound,
-        "gap": profile.gap,
-        "dt": args.dt,
-        "grid_nodes": int(profile.s.size),
-        "backend": profile.solution.backend,
-        "refined": profile.solution.refined,
-        "limits": profile.limits,
-        "boundary": {"v0": args.v0, "a0": args.a0, "vf": args.vf, "af": args.af},
-        "standstill": args.standstill,
-    }
-    return meta
-
-
-def _with_metadata(traj: Trajectory, meta: dict[str, Any]) -> Trajectory:
-    # What the planner filled in (when it does) wins over the command line's own account.
-    return replace(traj, metadata={**meta, **traj.metadata})
+    return {"path_file": path_name, **profile.metadata, "dt": args.dt}
 
 
 def _stdin_text(args: argparse.Namespace) -> str:
@@ -369,6 +348,17 @@ def _write_outputs(args: argparse.Namespace, traj: Trajectory, info: IO[str]) ->
     print(f"wrote     {where} ({len(traj)} samples every {args.dt} s)", file=info)
 
 
+def _conclude(args: argparse.Namespace, status: str, check: Verification,
+              caught: list[warnings.WarningMessage]) -> int:
+    """Print the warnings caught while planning, then the exit code's reason; return the code."""
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
+    code, reason = exit_status(status, check.violations, strict=args.strict)
+    if reason:
+        print(f"speedplan: {reason}", file=sys.stderr)
+    return code
+
+
 def _run_route(args: argparse.Namespace, route: Any, name: str, info: IO[str]) -> int:
     """``speedplan plan order.json``: plan the order's released base, print the node times."""
     from .route_plan import plan_route
@@ -400,19 +390,14 @@ def _run_route(args: argparse.Namespace, route: Any, name: str, info: IO[str]) -
     print("realised maxima / limits:", file=info)
     print("  " + check.summary().replace("\n", "\n  "), file=info)
     traj = profile.sample(args.dt)
-    traj = replace(traj, metadata={**traj.metadata, "path_file": name, "dt": args.dt})
+    traj = replace(traj, metadata={"path_file": name, **traj.metadata})
     _write_outputs(args, traj, info)
     if args.plot:
         from .plot import plot_route
 
         plot_route(profile, args.plot, trajectory=traj, dpi=args.dpi)
         print(f"wrote     {args.plot}", file=info)
-    for w in caught:
-        print(f"warning: {w.message}", file=sys.stderr)
-    code, reason = exit_status(profile.status, check.violations, strict=args.strict)
-    if reason:
-        print(f"speedplan: {reason}", file=sys.stderr)
-    return code
+    return _conclude(args, profile.status, check, caught)
 
 
 def _run_plan(args: argparse.Namespace, pathfile: str | FsPath) -> int:
@@ -444,19 +429,14 @@ def _run_plan(args: argparse.Namespace, pathfile: str | FsPath) -> int:
     print("realised maxima / limits:", file=info)
     print("  " + check.summary().replace("\n", "\n  "), file=info)
     if _output_format(args) is not None:
-        traj = _with_metadata(profile.sample(args.dt), _metadata(profile, args, name))
+        traj = replace(profile.sample(args.dt), metadata=_metadata(profile, args, name))
         _write_outputs(args, traj, info)
     if args.plot:
         from .plot import plot_profile
 
         plot_profile(profile, args.plot, dt=args.dt, dpi=args.dpi)
         print(f"wrote     {args.plot}", file=info)
-    for w in caught:
-        print(f"warning: {w.message}", file=sys.stderr)
-    code, reason = exit_status(profile.status, check.violations, strict=args.strict)
-    if reason:
-        print(f"speedplan: {reason}", file=sys.stderr)
-    return code
+    return _conclude(args, profile.status, check, caught)
 
 
 def exit_status(status: str, violations: dict[str, float], *, strict: bool = False

@@ -7,6 +7,7 @@ import time
 
 import numpy as np
 import pytest
+from shared import LGV
 
 import speedplan as sp
 from speedplan.geometry import Line
@@ -14,8 +15,6 @@ from speedplan.solve.banded import MAX_RAMP_STEPS, ramp_steps
 from speedplan.solve.discrete import solve_problem
 from speedplan.solve.paper import paper_instance
 from speedplan.solve.problem import DiscreteProblem
-
-LGV = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 
 
 def _straight(n: int, h: float, w_max: float, a: float, j: float) -> DiscreteProblem:

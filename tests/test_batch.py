@@ -10,12 +10,11 @@ import warnings
 from concurrent.futures import Future, ThreadPoolExecutor
 
 import pytest
+from shared import LGV
 
 import speedplan as sp
 import speedplan.batch as batch
 from speedplan.geometry import Line
-
-LGV = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 
 
 @pytest.mark.parametrize("jobs", [5, None, 2.5])

@@ -10,12 +10,11 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from shared import LGV_ARGS
 
 import speedplan as sp
 from speedplan import cli
 from speedplan.io import read_path
-
-LGV_ARGS = ["--v-max", "2", "--a-max", "1", "--a-lat-max", "1", "--j-max", "0.5"]
 
 
 def run(*args, cwd=None, stdin=None):

@@ -10,13 +10,12 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
+from shared import LGV_ARGS
 
 import speedplan as sp
 from speedplan.geometry import Line
 from speedplan.io import read_path, read_zones
 from speedplan.plot import PANELS, plot_profile
-
-LGV_ARGS = ["--v-max", "2", "--a-max", "1", "--a-lat-max", "1", "--j-max", "0.5"]
 
 
 def run_cli(*args, cwd=None):

@@ -7,14 +7,13 @@ positions for tangents, hand-derived headings.
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
 import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.special import fresnel
+from shared import examples
 
 from speedplan import InvalidInputError, Path
 from speedplan.geometry.corners import (
@@ -24,7 +23,7 @@ from speedplan.geometry.corners import (
     corner_shape,
 )
 
-SETTINGS = settings(max_examples=int(os.environ.get("GEOMETRY_EXAMPLES", "40")), deadline=None)
+SETTINGS = settings(max_examples=examples(40), deadline=None)
 
 
 def wrapped(a):

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from shared import examples
 from trust_fuzz import FAILURES, draw_case, run_case, summarise
 
 import speedplan as sp
@@ -46,6 +47,7 @@ waypoints = st.lists(
     st.tuples(st.floats(-30, 30, allow_nan=False), st.floats(-30, 30, allow_nan=False)),
     min_size=2, max_size=5,
 )
+
 positive = st.floats(0.05, 20.0, allow_nan=False)
 
 
@@ -85,14 +87,14 @@ cases = dict(
 
 
 @pytest.mark.timeout(900)
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(200), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(**cases, n=st.sampled_from([120, 250]))
 def test_plan_on_small_grids_returns_verified_profile_or_documented_error(**kw):
     _check(**kw)
 
 
 @pytest.mark.timeout(900)
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(40), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(**cases)
 def test_plan_on_default_grids_returns_verified_profile_or_documented_error(**kw):
     _check(**kw, n=None)

@@ -11,6 +11,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 from scipy.interpolate import CubicSpline
+from shared import examples
 
 from speedplan import InvalidInputError, Path
 from speedplan.geometry.fitting import CORNER_FRACTION, fit_clothoid
@@ -30,7 +31,7 @@ def wrapped(a):
 
 
 # ---- G1 Hermite clothoid --------------------------------------------------------------------
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=examples(60), deadline=None)
 @given(
     x=st.floats(-20, 20), y=st.floats(-20, 20), dist=st.floats(0.1, 50),
     chord=st.floats(-np.pi, np.pi),
@@ -206,7 +207,7 @@ def test_polyline_rejects_sharp_corners_and_cusps():
 
 
 # ---- all kinds ------------------------------------------------------------------------------
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=examples(30), deadline=None)
 @given(
     pts=st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=2, max_size=7),
     kind=st.sampled_from(["g2", "clothoid", "spline", "polyline"]),

@@ -3,18 +3,18 @@
 from __future__ import annotations
 
 import itertools
-import os
 
 import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from shared import examples
 
 from speedplan import Path
 from speedplan.geometry import Arc, Clothoid, Line
 
-# Modest by default to keep the suite fast; GEOMETRY_EXAMPLES=500 for a deeper local search.
-SETTINGS = settings(max_examples=int(os.environ.get("GEOMETRY_EXAMPLES", "25")), deadline=None)
+# Modest by default to keep the suite fast; SPEEDPLAN_HYPOTHESIS=deep for a deeper search.
+SETTINGS = settings(max_examples=examples(25), deadline=None)
 
 segment = st.one_of(
     st.builds(Line, st.floats(0.1, 50)),

@@ -9,6 +9,7 @@ import warnings
 import numpy as np
 import pytest
 from ruckig import InputParameter, Result, Ruckig, Trajectory
+from shared import LGV
 
 from speedplan import (
     InfeasibleError,
@@ -24,7 +25,6 @@ from speedplan.model import PlanRequest, build_model
 from speedplan.timing import TOLERANCES, law_for
 from speedplan.timing.verify import check_law
 
-LGV = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 ROAD = Limits(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0)
 DT = 1e-3
 

@@ -13,10 +13,10 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 from oracles import PROMISED, ruckig_duration
+from shared import LGV
 
-from speedplan import InvalidInputError, Limits, Route, plan_route
+from speedplan import InvalidInputError, Route, plan_route
 
-LGV = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 HARD = {"actionType": "pick", "actionId": "pick-1", "blockingType": "HARD"}
 R = 5.0  # the arc edge's radius
 ARC_LIMIT = 0.8

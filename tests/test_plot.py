@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 import pytest
+from shared import LGV
 
 import speedplan as sp
 from speedplan.io import read_path
@@ -15,8 +16,6 @@ from speedplan.plot import PANELS, plot_jerk, plot_path, plot_profile
 
 matplotlib = pytest.importorskip("matplotlib")
 from matplotlib.figure import Figure  # noqa: E402
-
-LGV = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 
 
 @pytest.fixture(scope="module")

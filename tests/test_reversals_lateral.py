@@ -15,6 +15,7 @@ import cvxpy as cp
 import numpy as np
 import pytest
 from oracles import PROMISED, ruckig_duration
+from shared import LGV
 
 import speedplan as sp
 from speedplan import InfeasibleError, InvalidInputError, Limits, Path, SpanLimit, plan
@@ -22,7 +23,6 @@ from speedplan.geometry import Clothoid, Line
 from speedplan.model import PlanRequest, build_model
 from speedplan.solve import solve_problem
 
-LGV = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 COMFORT = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5, j_lat_max=0.3,
                  yaw_rate_max=0.4)
 DT = 1e-3

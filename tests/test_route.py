@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from shared import examples
 
 from speedplan import InvalidInputError
 from speedplan.geometry import Arc, Line, Path
@@ -29,7 +30,7 @@ def polyline_route(points, **edge_fields):
     return nodes, edges
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(st.lists(st.tuples(st.integers(-20, 20), st.integers(-20, 20)), min_size=2, max_size=7,
                 unique=True))
 def test_polyline_route_lengths_node_positions_and_corner_stops(points):

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from shared import examples
 
 from speedplan import InfeasibleError, InvalidInputError, SpeedplanWarning, solve_discrete
 from speedplan.solve import JERK_TOL, DiscreteProblem, solve_problem
@@ -139,7 +140,7 @@ def test_no_jerk_pass_on_a_million_nodes_is_linear_and_exact():
     assert w[-19] == pytest.approx(9.0) and w[-20] == 9.0  # brakes 0.5 per step
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=examples(25), deadline=None)
 @given(rho=st.floats(0.05, 20.0), seed=st.integers(0, 10_000))
 def test_paper_scaling_property(rho, seed):
     # (h, A, J) -> (ρh, A/ρ, J/ρ²) keeps w and multiplies the objective by ρ.
@@ -151,7 +152,7 @@ def test_paper_scaling_property(rho, seed):
     assert scaled.exact == base.exact
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=examples(15), deadline=None)
 @given(omega=st.floats(1e-3, 1e3), seed=st.integers(0, 10_000))
 def test_speed_scaling_property(omega, seed):
     # (w_max, A, J) -> (ω w_max, ω A, ω^1.5 J) scales w by ω and time by 1/sqrt(ω).

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from shared import examples
 
 from speedplan.model.boundary import max_jerk_envelope
 from speedplan.model.grid import GRADING
@@ -34,7 +35,7 @@ def test_constant_acceleration_from_speed_is_exact():
     assert np.abs(law.node_offsets()).max() < 1e-12
 
 
-@settings(max_examples=20, deadline=None)
+@settings(max_examples=examples(20), deadline=None)
 @given(j=st.floats(0.05, 20.0), length=st.floats(0.001, 5000.0))
 def test_max_jerk_start_and_stop_are_reproduced(j, length):
     # A rest-to-rest move that is a max-jerk start followed by its mirror (jerk +j, then -j

@@ -8,12 +8,11 @@ import pickle
 
 import numpy as np
 import pytest
+from shared import LGV
 
 import speedplan as sp
 from speedplan.io import read_path, read_trajectory
 from speedplan.timing.trajectory import COLUMNS, wrap_angle
-
-LGV = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 
 
 @pytest.fixture(scope="module")
@@ -120,7 +119,23 @@ def test_metadata_is_a_read_only_picklable_mapping(loop_traj):
     assert traj.metadata["tags"] == ("a", "b")
     back = pickle.loads(pickle.dumps(traj))
     assert dict(back.metadata) == dict(traj.metadata)
-    assert len(loop_traj.metadata) == 0  # default: empty
+    assert len(sp.Trajectory(**loop_traj.to_dict()).metadata) == 0  # default: empty
+
+
+def test_a_sampled_trajectory_file_says_how_it_was_made(tmp_path):
+    # A file written straight from the library (no CLI) must be interpretable later: version,
+    # certificate, limits and inputs, as plan() was called and as the profile reports them.
+    lim = sp.Limits(v_max=1.5, a_max=0.8, a_lat_max=0.9, j_max=0.4)
+    profile = sp.plan(sp.Path.from_waypoints([[0, 0], [6, 0], [9, 3]]), lim, v0=0.5, a0=0.1)
+    out = tmp_path / "t.json"
+    profile.sample(0.02).to_json(out)
+    meta = json.loads(out.read_text())["metadata"]
+    assert meta["speedplan_version"] == sp.__version__
+    assert meta["duration"] == profile.duration and meta["status"] == profile.status
+    assert meta["gap"] == profile.gap and meta["dt"] == 0.02
+    assert meta["limits"]["v_max"] == 1.5 and meta["limits"]["j_max"] == 0.4
+    assert meta["boundary"] == {"v0": 0.5, "a0": 0.1, "vf": 0.0, "af": 0.0}
+    assert meta["grid_nodes"] == profile.s.size
 
 
 def test_read_trajectory_round_trip(loop_traj, tmp_path):

@@ -157,15 +157,21 @@ def summarise(outcomes: list[Outcome]) -> str:
     planned = [o for o in outcomes if o.kind == "planned"]
     lines = [f"{len(outcomes)} plans: " + ", ".join(f"{k} {v}" for k, v in sorted(kinds.items()))]
     if planned:
+        lines.append("measured / limit over the planned cases (median, 99th percentile, max):")
         for name in ("speed", "accel", "jerk"):
+            ratios = np.array([o.ratios[name] for o in planned])
             worst = max(planned, key=lambda o: o.ratios[name])
-            lines.append(f"worst {name:5s} ratio {worst.ratios[name]:.4f}  "
-                         f"({worst.case.describe()})")
+            lines.append(f"  {name:5s} {np.median(ratios):.4f}  {np.quantile(ratios, 0.99):.4f}  "
+                         f"{ratios.max():.4f}  (max at {worst.case.describe()})")
         with_ref = [o for o in planned if o.duration_ratio is not None]
         if with_ref:
+            ratios = np.array([o.duration_ratio for o in with_ref])
             lo = min(with_ref, key=lambda o: o.duration_ratio)
             hi = max(with_ref, key=lambda o: o.duration_ratio)
-            lines.append(f"duration / ruckig: min {lo.duration_ratio:.8f}, max "
+            lines.append(f"duration / ruckig's optimum ({len(with_ref)} cases): min "
+                         f"{lo.duration_ratio:.8f} (at {lo.case.describe()}), 1st percentile "
+                         f"{np.quantile(ratios, 0.01):.8f}, median {np.median(ratios):.8f}, "
+                         f"99th percentile {np.quantile(ratios, 0.99):.8f}, max "
                          f"{hi.duration_ratio:.8f}  (max at {hi.case.describe()})")
         secs = np.array([o.seconds for o in planned])
         lines.append(f"seconds per planned case: median {np.median(secs):.3f}, "

@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
 import numpy as np
 
-from ..core.checks import FloatArray, as_array, as_scalar
+from .._version import __version__
+from ..core.checks import FloatArray, as_array
 from ..core.errors import InvalidInputError
 from ..timing import SpeedProfile, Trajectory, Verification
+from ..timing.profile import sample_times
 from ..timing.trajectory import COLUMNS
 from .route import Route
 
@@ -175,21 +177,13 @@ class RouteProfile:
         dt : float
             Sampling period [s], > 0.
         """
-        step = as_scalar("dt", dt, positive=True)
-        n = int(np.floor(self.duration / step + 1e-9)) + 1
-        if n > 50_000_000:
-            raise InvalidInputError(
-                f"`dt`={step!r} gives {n} samples for a {self.duration:.6g} s motion; use a "
-                "larger dt"
-            )
-        times = np.arange(n, dtype=np.float64) * step
-        if times[-1] < self.duration - 1e-12 * max(1.0, self.duration):
-            times = np.append(times, self.duration)
-        return self.at(times)
+        traj = self.at(sample_times(self.duration, dt))
+        return replace(traj, metadata={**traj.metadata, "dt": float(dt)})
 
     def _metadata(self) -> dict[str, Any]:
         route = self.route
         return {
+            "speedplan_version": __version__,
             "duration": self.duration,
             "status": self.status,
             "gap": self.gap,

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from .._version import __version__
 from ..core.checks import FloatArray, as_array, as_scalar
 from ..core.errors import InvalidInputError
 from ..core.limits import Limits
@@ -22,7 +23,11 @@ if TYPE_CHECKING:
     from ..geometry import Path
     from ..model import PlanRequest
 
-__all__ = ["PROFILE_STATUSES", "LegResult", "ProfileStatus", "SpeedProfile", "combine"]
+__all__ = ["PROFILE_STATUSES", "LegResult", "ProfileStatus", "SpeedProfile", "combine",
+           "sample_times"]
+
+#: More samples than this is a mistake in ``dt`` (and gigabytes of memory), not a request.
+MAX_SAMPLES = 50_000_000
 
 #: ``SpeedProfile.status``: the solution statuses, and one that says the limits are exceeded.
 ProfileStatus = Literal["optimal", "refined", "scaled", "relaxed", "limits_exceeded"]
@@ -230,26 +235,52 @@ class SpeedProfile:
     def sample(self, dt: float = 0.01) -> Trajectory:
         """Trajectory sampled every ``dt`` seconds from 0; the last sample is at ``duration``.
 
+        Its ``metadata`` records how it was made (:attr:`metadata`, and ``dt``), so an exported
+        file can be interpreted later.
+
         Parameters
         ----------
         dt : float
             Sampling period [s], > 0.
-        """
-        return self.at(self._sample_times(dt))
 
-    def _sample_times(self, dt: float) -> FloatArray:
-        """``0, dt, 2 dt, ...`` up to the duration, which is always the last sample."""
-        step = as_scalar("dt", dt, positive=True)
-        n = int(np.floor(self.duration / step + 1e-9)) + 1
-        if n > 50_000_000:
-            raise InvalidInputError(
-                f"`dt`={step!r} gives {n} samples for a {self.duration:.6g} s trajectory; "
-                "use a larger dt"
-            )
-        times: FloatArray = np.arange(n, dtype=np.float64) * step
-        if times[-1] < self.duration - 1e-12 * max(1.0, self.duration):
-            times = np.append(times, self.duration)
-        return times
+        Examples
+        --------
+        >>> from speedplan import Limits, Path, plan
+        >>> prof = plan(Path.from_waypoints([[0, 0], [10, 0]], kind="polyline"),
+        ...             Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+        >>> traj = prof.sample(0.1)
+        >>> traj.t[-1] == prof.duration, traj.metadata["status"], traj.metadata["dt"]
+        (np.True_, 'optimal', 0.1)
+        """
+        times = sample_times(self.duration, dt)
+        return replace(self.at(times), metadata={**self.metadata, "dt": float(dt)})
+
+    @property
+    def metadata(self) -> dict[str, Any]:
+        """What a trajectory file records about this plan: version, certificate, limits, inputs.
+
+        Keys: ``speedplan_version``, ``status``, ``duration`` [s], ``objective`` and
+        ``lower_bound`` [s], ``gap``, ``grid_nodes``, ``backend``, ``refined``, ``limits``,
+        and, for a profile from :func:`speedplan.plan`, ``boundary`` (``v0``, ``a0``, ``vf``,
+        ``af``) and ``standstill``.
+        """
+        meta: dict[str, Any] = {
+            "speedplan_version": __version__,
+            "status": self.status,
+            "duration": self.duration,
+            "objective": self.objective,
+            "lower_bound": self.lower_bound,
+            "gap": self.gap,
+            "grid_nodes": int(self.s.size),
+            "backend": self.solution.backend,
+            "refined": self.solution.refined,
+            "limits": self.limits,
+        }
+        if self.request is not None:
+            req = self.request
+            meta["boundary"] = {"v0": req.v0, "a0": req.a0, "vf": req.vf, "af": req.af}
+            meta["standstill"] = req.standstill
+        return meta
 
     # ---- checks ---------------------------------------------------------------------------
     def verify(self) -> Verification:
@@ -278,3 +309,23 @@ def law_for(s: FloatArray, w: FloatArray, spec: Any) -> TimeLaw:
     """The :class:`TimeLaw` of a leg's solution under its :class:`~speedplan.model.TimeLawSpec`."""
     return TimeLaw(s, w, accel_start=spec.accel_start, accel_end=spec.accel_end,
                    j_max=spec.j_max)
+
+
+def sample_times(duration: float, dt: float) -> FloatArray:
+    """``0, dt, 2 dt, ...`` up to ``duration``, which is always the last sample [s].
+
+    Examples
+    --------
+    >>> sample_times(1.0, 0.3).tolist()
+    [0.0, 0.3, 0.6, 0.8999999999999999, 1.0]
+    """
+    step = as_scalar("dt", dt, positive=True)
+    n = int(np.floor(duration / step + 1e-9)) + 1
+    if n > MAX_SAMPLES:
+        raise InvalidInputError(
+            f"`dt`={step!r} gives {n} samples for a {duration:.6g} s trajectory; use a larger dt"
+        )
+    times: FloatArray = np.arange(n, dtype=np.float64) * step
+    if times[-1] < duration - 1e-12 * max(1.0, duration):
+        times = np.append(times, duration)
+    return times
