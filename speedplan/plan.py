@@ -18,13 +18,17 @@ from .model.build import leg_on_grid
 from .model.refine import refined_grid
 from .model.request import STANDSTILL_MODES
 from .solve import DiscreteSolution
-from .timing import LegResult, SpeedProfile, law_for
+from .timing import TOLERANCES, LegResult, SpeedProfile, Verification, law_for
 
 # SpeedBound is re-exported so that pickles made when it lived here still load.
-__all__ = ["MAX_REFINEMENTS", "STANDSTILL_MODES", "SpeedBound", "plan", "plan_request"]
+__all__ = ["MAX_REFINEMENTS", "REFINE_FACTORS", "STANDSTILL_MODES", "SpeedBound", "plan",
+           "plan_request", "refine_factor"]
 
 #: Rounds of local grid refinement where the continuous law exceeds a tolerance.
-MAX_REFINEMENTS = 2
+MAX_REFINEMENTS = 3
+#: Bounds on the factor a refinement round multiplies the flagged steps by (finer in one
+#: round grades the grid so steeply that the banded kernel loses accuracy, measured).
+REFINE_FACTORS = (1 / 4, 1 / 2)
 
 
 def plan(
@@ -143,7 +147,7 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
         for i, (leg, leg_check) in enumerate(zip(model.legs, leg_checks, strict=True)):
             if not leg_check.verification.ok and isinstance(leg, Leg):
                 grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess,
-                                    leg.anchors)
+                                    leg.anchors, refine_factor(leg_check.verification))
                 finer = leg_on_grid(request, leg.bound, grid, leg.start, leg.v0, leg.a0,
                                     leg.vf, leg.af)
                 legs[i] = _solve(finer)
@@ -159,6 +163,28 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
             LimitWarning, stacklevel=3,
         )
     return replace(profile, verification=check, limits_exceeded=not check.ok)
+
+
+def refine_factor(check: Verification) -> float:
+    """What to multiply the flagged steps by so that the worst excess falls to half its tolerance.
+
+    Near a violation the excess of a ratio beyond 1 shrinks about like the grid step (a
+    first-order discretisation error), so a ratio ``1 + e`` asks for the steps times
+    ``tol / (2 e)``; the factor is kept within :data:`REFINE_FACTORS`.
+
+    Examples
+    --------
+    >>> from speedplan.timing import Verification
+    >>> refine_factor(Verification(maxima={}, ratios={"lateral_jerk": 1.4}, where={}))
+    0.25
+    >>> round(refine_factor(Verification(maxima={}, ratios={"jerk": 1.06, "speed": 1.0},
+    ...                                  where={})), 6)
+    0.416667
+    """
+    wanted = [0.5 * TOLERANCES[name] / (ratio - 1.0)
+              for name, ratio in check.ratios.items() if ratio > 1.0 + TOLERANCES[name]]
+    lo, hi = REFINE_FACTORS
+    return float(np.clip(min(wanted, default=hi), lo, hi))
 
 
 def _solve(leg: Leg | ForcedLeg) -> LegResult:

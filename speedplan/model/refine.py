@@ -14,14 +14,14 @@ PAD_CELLS = 4
 
 
 def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
-                 anchors: FloatArray | None = None) -> FloatArray:
-    """The grid ``s`` with its steps halved around the law pieces flagged in ``excess``.
+                 anchors: FloatArray | None = None, factor: float = 0.5) -> FloatArray:
+    """The grid ``s`` with its steps times ``factor`` around the pieces flagged in ``excess``.
 
     ``knots`` are the law's knots (nodes and cell midpoints) and ``excess`` flags each piece
-    between them. The steps are halved over the flagged cells padded by :data:`PAD_CELLS`
-    on each side, and graded back to the old steps at the rate :data:`~speedplan.model.grid
-    .GRADING`, so the new grid is as smooth as the old one; ``anchors`` (nodes of ``s``) stay
-    nodes.
+    between them. The steps are multiplied by ``factor`` (in ``(0, 1)``) over the flagged
+    cells padded by :data:`PAD_CELLS` on each side, and graded back to the old steps at the
+    rate :data:`~speedplan.model.grid.GRADING`, so the new grid is as smooth as the old one;
+    ``anchors`` (nodes of ``s``) stay nodes.
 
     Examples
     --------
@@ -40,7 +40,7 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
     for k in np.unique(cell):
         lo, hi = max(k - PAD_CELLS, 0), min(k + 1 + PAD_CELLS, s.size - 1)
         flagged[lo:hi + 1] = True
-    target = np.where(flagged, 0.5 * node_h, node_h)
+    target = np.where(flagged, factor * node_h, node_h)
     target = graded_steps(s, target, np.full(s.size, GRADING))
     kept = None if anchors is None or not len(anchors) else np.intersect1d(anchors, s)
     grid = nodes_from_steps(s, target, kept)
