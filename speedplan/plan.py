@@ -10,10 +10,11 @@ from typing import Any
 
 import numpy as np
 
-from .core.errors import LimitWarning, SolverError, SpeedplanWarning
+from .core.errors import InfeasibleError, LimitWarning, SolverError, SpeedplanWarning
 from .core.limits import Limits
 from .geometry import Path, SpanLimit, SpeedBound, SpeedZone
-from .model import ForcedLeg, Leg, PlanRequest, build_model
+from .model import ForcedLeg, Leg, Model, PlanRequest, build_model
+from .model.boundary import STATE_JERK_SLACK, state_jerk
 from .model.build import leg_on_grid
 from .model.refine import refined_grid
 from .model.request import STANDSTILL_MODES
@@ -24,6 +25,8 @@ from .timing import TOLERANCES, LegResult, SpeedProfile, Verification, law_for
 __all__ = ["MAX_REFINEMENTS", "REFINE_FACTORS", "STANDSTILL_MODES", "SpeedBound", "plan",
            "plan_request", "refine_factor"]
 
+#: What the reachability checks of boundary states name when they refuse one.
+STATE_CONSTRAINTS = ("jerk", "v_max", "length", "speed_bound")
 #: Rounds of local grid refinement where the continuous law exceeds a tolerance.
 MAX_REFINEMENTS = 3
 #: Bounds on the factor a refinement round multiplies the flagged steps by (finer in one
@@ -127,7 +130,7 @@ def plan(
 
 def plan_request(request: PlanRequest) -> SpeedProfile:
     """:func:`plan` for an already validated :class:`~speedplan.model.PlanRequest`."""
-    model = build_model(request)
+    modelled, model = _model_within_state_slack(request)
     jumps = [r.s for r in model.rests if r.reason == "curvature jump"]
     if jumps:
         shown = ", ".join(f"{s:.6g}" for s in jumps[:5]) + (", ..." if len(jumps) > 5 else "")
@@ -148,7 +151,7 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
             if not leg_check.verification.ok and isinstance(leg, Leg):
                 grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess,
                                     leg.anchors, refine_factor(leg_check.verification))
-                finer = leg_on_grid(request, leg.bound, grid, leg.start, leg.v0, leg.a0,
+                finer = leg_on_grid(modelled, leg.bound, grid, leg.start, leg.v0, leg.a0,
                                     leg.vf, leg.af)
                 legs[i] = _solve(finer)
         profile = replace(profile, legs=tuple(legs))
@@ -163,6 +166,37 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
             LimitWarning, stacklevel=3,
         )
     return replace(profile, verification=check, limits_exceeded=not check.ok)
+
+
+def _model_within_state_slack(request: PlanRequest) -> tuple[PlanRequest, Model]:
+    """The request's model, or one with ``j_max (1 + STATE_JERK_SLACK)`` for marginal states.
+
+    Marginal: moving boundary states just outside what ``j_max`` reaches (with a warning).
+
+    A state read off a planned trajectory (whose jerk may exceed ``j_max`` within its 5 %
+    tolerance, e.g. for an order update) or measured on the vehicle can lie a hair outside
+    the set a jerk-limited motion reaches; refusing it would strand the vehicle. The plan is
+    still verified against the requested limits.
+    """
+    try:
+        return request, build_model(request)
+    except InfeasibleError as exc:
+        moving = any(x != 0.0 for x in (request.v0, request.a0, request.vf, request.af))
+        if not (moving and request.jerk_limited and exc.constraint in STATE_CONSTRAINTS):
+            raise
+        refusal = str(exc)
+        lim = request.limits
+        looser = replace(request, limits=replace(lim, j_max=state_jerk(lim.j_max)))
+        try:
+            model = build_model(looser)
+        except InfeasibleError:
+            raise exc from None
+    warnings.warn(
+        f"the boundary states are reachable only with {STATE_JERK_SLACK:.0%} more jerk than "
+        f"j_max={lim.j_max:.6g} m/s³ ({refusal}); planned with j_max={looser.limits.j_max:.6g} "
+        "m/s³, within the jerk tolerance", SpeedplanWarning, stacklevel=4,
+    )
+    return looser, model
 
 
 def refine_factor(check: Verification) -> float:

@@ -157,11 +157,11 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     if executor is None:
         legs = []
         for job, lo in zip(jobs, starts, strict=True):
-            kwargs = dict(job)
+            options = {k: v for k, v in job.items() if k not in ("path", "limits")}
             try:
-                legs.append(plan(kwargs.pop("path"), kwargs.pop("limits"), **kwargs))
+                legs.append(plan(job["path"], job["limits"], **options))
             except SpeedplanError as exc:
-                raise _on_leg(exc, lo, kwargs) from exc
+                raise _on_leg(exc, lo, job) from exc
     else:
         results = plan_many(jobs, executor)
         legs = []

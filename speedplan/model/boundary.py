@@ -28,12 +28,14 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
 
 __all__ = [
+    "STATE_JERK_SLACK",
     "Phase",
     "check_reachable_states",
     "jerk_motion_w",
     "max_jerk_envelope",
     "min_distance",
     "run_phases",
+    "state_jerk",
     "stop_distance",
     "transition",
     "turnaround_speed",
@@ -41,6 +43,20 @@ __all__ = [
 
 #: Relative slack of the reachability tests (rounding of the closed forms).
 _SLACK = 1e-9
+#: Moving boundary states just outside what ``j_max`` reaches are planned with
+#: ``j_max (1 + STATE_JERK_SLACK)`` (:func:`speedplan.plan.plan_request`, with a warning).
+STATE_JERK_SLACK = 0.02
+
+
+def state_jerk(j_max: float) -> float:
+    """The jerk a plan from a marginal boundary state may use: ``j_max (1 + STATE_JERK_SLACK)``.
+
+    Examples
+    --------
+    >>> state_jerk(0.5)
+    0.51
+    """
+    return j_max * (1.0 + STATE_JERK_SLACK)
 
 
 def max_jerk_envelope(d: FloatArray, j_max: float) -> FloatArray:
