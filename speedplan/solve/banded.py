@@ -180,7 +180,7 @@ def _primal_t(p: DiscreteProblem, w: FloatArray) -> FloatArray:
     t: FloatArray = p.tau / np.sqrt(w[1:-1])
     for family in p.stencil_families():
         finite = np.isfinite(family.bound)
-        load = p.stencil_matrix(family.coef) @ w
+        load = p.stencil_apply(family.coef, w)
         t[finite] = np.maximum(t[finite],
                                p.tau[finite] * np.abs(load[finite]) / family.bound[finite])
     return t
@@ -219,7 +219,7 @@ def _lagrangian_bound(
     for family, (a, b) in zip(p.stencil_families(), nu, strict=True):
         finite = np.isfinite(family.bound)
         coef = np.where(finite, (a - b) * p.tau / np.where(finite, family.bound, 1.0), 0.0)
-        g += p.stencil_matrix(family.coef).T @ coef
+        g += p.stencil_adjoint(family.coef, coef)
     const = (g[0] * p.w_start + g[-1] * p.w_end
              - float(mu_acc @ (p.accel * p.h)) - float(mu_dec @ (p.decel * p.h)))
     gi, c, wmax = g[1:-1], lam * p.tau, p.w_max[1:-1]

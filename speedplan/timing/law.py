@@ -290,7 +290,10 @@ class TimeLaw:
         return w
 
     def _speed(self, j: IntArray, dx: FloatArray, dr: FloatArray) -> FloatArray:
-        """``v`` alone at offsets ``(dx, dr)`` of pieces ``j`` (as :meth:`_physical` gives it)."""
+        """``v`` alone at offsets ``(dx, dr)`` of pieces ``j`` (as :meth:`_physical` gives it).
+
+        ``j`` may be of the shape of ``dx`` or broadcast against it (one piece per column).
+        """
         y = self._y_only(j, dx, dr)[0]
         v: FloatArray = np.sqrt(self._w(y, np.cbrt(y), self._pieces.is_u[j]))
         return v
@@ -341,9 +344,9 @@ class TimeLaw:
             inside = np.isfinite(r) & (r > 0) & (r < width)
             cands.append(np.where(inside, r, 0.0))
         dx = np.stack(cands)  # (candidates, pieces)
-        j = np.broadcast_to(np.arange(width.size), dx.shape)
-        y, dy, ddy = self._y(j, dx, width - dx)
-        w, _, a, jerk = self._physical(y, dy, ddy, np.broadcast_to(p.is_u, dx.shape))
+        # One piece per column: the piece data broadcast over the candidates.
+        y, dy, ddy = self._y(np.arange(width.size), dx, width - dx)
+        w, _, a, jerk = self._physical(y, dy, ddy, p.is_u)
         out = {}
         for name, val in (("w", w), ("a", a), ("jerk", jerk)):
             i_max = np.argmax(val, axis=0)
@@ -379,7 +382,7 @@ class TimeLaw:
         jac = np.where(at_rest, span * power * t ** (power - 1.0), span)
         dx = np.where(right, width - off, off)
         dr = np.where(right, off, width - off)
-        v = self._speed(np.broadcast_to(j, off.shape), dx, dr)
+        v = self._speed(j, dx, dr)  # j broadcasts: piece data gathered once per column
         with np.errstate(divide="ignore", invalid="ignore"):
             f = np.where(jac > 0, jac / v, 0.0)
         out: FloatArray = np.sum(tw * f, axis=0)
