@@ -15,11 +15,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..core.checks import FloatArray
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 __all__ = ["DiscreteProblem", "StencilRows"]
 
@@ -157,6 +160,8 @@ class DiscreteProblem:
 
     def stencil_matrix(self, coef: FloatArray) -> sp.csr_matrix:
         """Sparse (n-2, n) operator of the three-point stencils ``coef`` at interior nodes."""
+        import scipy.sparse as sp  # on first use: import speedplan stays light
+
         m = self.n - 2
         rows = np.repeat(np.arange(m), 3)
         cols = (np.arange(m)[:, None] + np.arange(3)[None, :]).ravel()
