@@ -256,8 +256,9 @@ class SpeedProfile:
         """Compare the continuous trajectory with the limits (see :mod:`speedplan.timing.verify`).
 
         Acceleration and jerk: exact extremes of every piece of the law. Speed bound, lateral
-        acceleration, yaw rate and lateral jerk: at 8 points per grid cell and at each
-        piece's speed maximum.
+        acceleration, yaw rate and lateral jerk: at 8 points per grid cell, at each piece's
+        speed maximum and at the speed bound's breakpoints (zone and span ends, ``v_limit``
+        knots, path joins).
         """
         return Verification.merged([self.check_leg(i).verification
                                     for i in range(len(self.legs))])
