@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import speedplan as sp
-from speedplan.geometry import SpeedBound
+from speedplan.geometry import SpanLimit, SpeedBound
 from speedplan.timing import TimeLaw
-from speedplan.timing.verify import SAMPLES_PER_PIECE, TOLERANCES, check_law
+from speedplan.timing.verify import SAMPLES_PER_PIECE, TOLERANCES, bound_breakpoints, check_law
 
 LIMITS = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 
@@ -61,7 +61,7 @@ def test_a_narrow_dip_of_the_speed_bound_between_samples_is_caught(straight):
 def test_a_speed_zone_shorter_than_a_piece_is_caught(straight):
     shapely = pytest.importorskip("shapely")
     path, prof = straight
-    law, x0, width = _cruise_piece(prof)
+    _, x0, width = _cruise_piece(prof)
     lo, hi = x0 + 0.3 * width, x0 + 0.45 * width  # between the second and third sample
     zone = sp.SpeedZone(shapely.box(lo, -1.0, hi, 1.0), 0.5)
     zoned = replace(prof, speed_bound=SpeedBound(path, LIMITS, zones=[zone]), verification=None)
@@ -70,6 +70,29 @@ def test_a_speed_zone_shorter_than_a_piece_is_caught(straight):
     check = zoned.verify()
     assert check.ratios["speed"] == pytest.approx(2.0 / 0.5, rel=1e-6)
     assert lo - 1e-6 <= check.where["speed"] <= hi + 1e-6
+
+
+def test_a_span_shorter_than_a_piece_is_caught(straight):
+    path, prof = straight
+    _, x0, width = _cruise_piece(prof)
+    lo, hi = x0 + 0.3 * width, x0 + 0.45 * width  # between the second and third sample
+    spanned = replace(prof, speed_bound=SpeedBound(path, LIMITS, spans=(SpanLimit(lo, hi, 0.8),)),
+                      verification=None)
+    samples = x0 + width * np.linspace(0.0, 1.0, SAMPLES_PER_PIECE)
+    assert np.array_equal(spanned.speed_bound(samples), np.full(samples.size, 4.0))
+    check = spanned.verify()
+    assert check.ratios["speed"] == pytest.approx(2.0 / 0.8, rel=1e-6)
+    assert check.where["speed"] in (pytest.approx(lo, abs=1e-12), pytest.approx(hi, abs=1e-12))
+
+
+def test_breakpoints_of_a_bound_read_from_an_offset():
+    # A leg's bound reads the path from its start: its breakpoints are in path arc length.
+    path = sp.Path.from_waypoints([[0, 0], [30, 0]], kind="polyline")
+    bound = SpeedBound(path, LIMITS, v_limit=([5.0, 7.0], [2.0, 1.0]),
+                       spans=(SpanLimit(10.0, 12.0, 1.0),))
+    assert bound_breakpoints(path, bound).tolist() == [5.0, 7.0, 10.0, 12.0]
+    assert bound_breakpoints(path, bound.at_offset(4.0)).tolist() == [1.0, 3.0, 6.0, 8.0]
+    assert bound_breakpoints(path, lambda q: np.full(np.shape(q), 4.0)).size == 0
 
 
 def test_a_jerk_extreme_inside_a_piece_is_caught():
