@@ -242,6 +242,22 @@ def toppra_time(s: np.ndarray, w_max: np.ndarray, a_max: float,
     return median_time(run, repeats), float(traj.duration)
 
 
+def plan_and_problem(path: sp.Path, lim: sp.Limits, kw: dict[str, Any],
+                     repeats: int) -> tuple[Any, float, Any]:
+    """``plan()``'s profile, its median time, and the discrete problem of its single leg.
+
+    The problem is ``None`` when the request has several legs (cusps, stops).
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        prof = sp.plan(path, lim, **kw)
+        t_ours = median_time(lambda: sp.plan(path, lim, **kw), repeats)
+        legs = [leg for leg in build_model(PlanRequest.create(path, lim, **kw)).legs
+                if isinstance(leg, Leg)]
+    single = len(legs) == 1 and len(prof.legs) == 1
+    return prof, t_ours, legs[0].problem if single else None
+
+
 def section_toppra(repeats: int) -> None:
     print(f"\n== 3. plan(j_max=inf) against TOPP-RA compute_trajectory, medians of {repeats} ==")
     print(f"{'case':<22} {'n':>5} {'ours [ms]':>10} {'toppra [ms]':>12} {'ratio':>7}"
@@ -249,16 +265,10 @@ def section_toppra(repeats: int) -> None:
     for name, path, lim, kw in cases()[:-1]:
         nojerk = sp.Limits(v_max=lim.v_max, a_max=lim.a_max, a_lat_max=lim.a_lat_max,
                            j_max=math.inf)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            prof = sp.plan(path, nojerk, **kw)
-            t_ours = median_time(lambda p=path, li=nojerk, k=kw: sp.plan(p, li, **k), repeats)
-            legs = [leg for leg in build_model(PlanRequest.create(path, nojerk, **kw)).legs
-                    if isinstance(leg, Leg)]
-        if len(legs) != 1:
-            print(f"{name:<22} skipped: {len(legs)} legs")
+        prof, t_ours, p = plan_and_problem(path, nojerk, kw, repeats)
+        if p is None:
+            print(f"{name:<22} skipped: several legs")
             continue
-        p = legs[0].problem
         t_ta, dur_ta = toppra_time(p.s, p.w_max, lim.a_max, repeats)
         print(f"{name:<22} {p.n:>5} {1e3 * t_ours:>10.2f} {1e3 * t_ta:>12.2f}"
               f" {t_ta / t_ours:>7.1f} {prof.duration:>9.3f} {dur_ta:>9.3f}")
@@ -308,16 +318,10 @@ def section_copp(repeats: int) -> None:
     print(f"{'case':<22} {'n':>5} {'ours [ms]':>10} {'copp [ms]':>10} {'ratio':>6} {'T ours':>9}"
           f" {'(discrete)':>10} {'T copp':>9} {'viol':>8}")
     for name, path, lim, kw in cases()[:-1]:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            prof = sp.plan(path, lim, **kw)
-            t_ours = median_time(lambda p=path, li=lim, k=kw: sp.plan(p, li, **k), repeats)
-            legs = [leg for leg in build_model(PlanRequest.create(path, lim, **kw)).legs
-                    if isinstance(leg, Leg)]
-        if len(legs) != 1 or len(prof.legs) != 1:
-            print(f"{name:<22} skipped: {len(legs)} legs")
+        prof, t_ours, p = plan_and_problem(path, lim, kw, repeats)
+        if p is None:
+            print(f"{name:<22} skipped: several legs")
             continue
-        p = legs[0].problem
         try:
             dur, a = copp_solve(p, lim)
             t_copp = median_time(lambda pp=p, li=lim: copp_solve(pp, li), repeats)
