@@ -2,9 +2,10 @@
 
 The instances: the paper's 18 families x 2 seeds at n = 1000, the log-uniform-J family
 (4 seeds), and the ``plan()`` grids of the sample paths in ``paths/`` (default grid and
-n = 5000). Each is solved by ``solve_problem(problem, backend="banded", refine="never")``;
-we keep the relaxation's ``w``, the kernel's linear-row multipliers ``yl``, the certified
-lower bound, the iteration count and the status (or the exception's name).
+n = 5000, every leg). Each is solved by ``solve_problem(problem, backend="banded",
+refine="never")``; we keep the relaxation's ``w``, the kernel's linear-row multipliers ``yl``,
+the certified lower bound, the iteration count and the status (or the exception's name).
+Then ``plan()`` end to end on each sample path: its duration and the 100 Hz trajectory's speed.
 
     python benchmarks/kernel_fingerprint.py record /tmp/before.npz
     python benchmarks/kernel_fingerprint.py compare /tmp/before.npz /tmp/after.npz
@@ -22,8 +23,9 @@ import numpy as np
 
 import speedplan as sp
 from speedplan.io import read_path, read_zones
-from speedplan.model import PlanRequest, build_model
+from speedplan.model import Leg, PlanRequest, build_model
 from speedplan.solve import _banded_ipm as ipm
+from speedplan.solve.banded import compile_kernel
 from speedplan.solve.discrete import solve_problem
 from speedplan.solve.paper import FAMILIES, paper_instance
 from speedplan.solve.problem import DiscreteProblem
@@ -42,12 +44,33 @@ def instances() -> list[tuple[str, DiscreteProblem]]:
     for seed in range(4):
         inst = paper_instance("rnd", "cnst", "logrnd", n=1000, seed=seed)
         out.append((f"logrnd:{seed}", _paper(inst)))
-    for f in sorted(glob.glob(os.path.join(ROOT, "paths", "*.csv"))
-                    + glob.glob(os.path.join(ROOT, "paths", "*.json"))):
+    for f in _sample_paths():
         lim = ROAD if "road" in f else LGV
         for n in (None, 5000):
             req = PlanRequest.create(read_path(f), lim, zones=read_zones(f) or None, n=n)
-            out.append((f"{os.path.basename(f)}:{n}", build_model(req).problem))
+            legs = [leg for leg in build_model(req).legs if isinstance(leg, Leg)]
+            for k, leg in enumerate(legs):
+                suffix = f"/{k}" if len(legs) > 1 else ""
+                out.append((f"{os.path.basename(f)}:{n}{suffix}", leg.problem))
+    return out
+
+
+def _sample_paths() -> list[str]:
+    return sorted(glob.glob(os.path.join(ROOT, "paths", "*.csv"))
+                  + glob.glob(os.path.join(ROOT, "paths", "*.json")))
+
+
+def plans() -> dict[str, Any]:
+    """``plan()`` end to end on the sample paths: duration, and the 100 Hz trajectory's v."""
+    out: dict[str, Any] = {}
+    for f in _sample_paths():
+        lim = ROAD if "road" in f else LGV
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            prof = sp.plan(read_path(f), lim, zones=read_zones(f) or None)
+        name = f"plan:{os.path.basename(f)}"
+        out[f"{name}|duration"] = np.array(prof.duration)
+        out[f"{name}|v"] = prof.sample(0.01).v
     return out
 
 
@@ -92,6 +115,8 @@ def record(path: str) -> None:
                 arrays[f"{name}|wint{k}"] = out[0]
     finally:
         ipm.iterate = real
+    compile_kernel()  # plan() must use the banded backend, not its fallback
+    arrays.update(plans())
     np.savez(path, **arrays)
     print(f"recorded {len({k.split('|')[0] for k in arrays})} instances into {path}")
 

@@ -143,10 +143,13 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
     legs = [_solve(leg) for leg in model.legs]
     profile = SpeedProfile(path=request.path, limits=request.limits, legs=tuple(legs),
                            speed_bound=model.bound, request=request)
+    # Each leg is checked once per law it gets: the final verification merges these checks
+    # (what profile.verify() computes) instead of checking every leg again.
+    leg_checks = [profile.check_leg(i) for i in range(len(legs))]
     for _ in range(MAX_REFINEMENTS):
-        leg_checks = [profile.check_leg(i) for i in range(len(legs))]
         if all(c.verification.ok for c in leg_checks):
             break
+        changed = []
         for i, (leg, leg_check) in enumerate(zip(model.legs, leg_checks, strict=True)):
             if not leg_check.verification.ok and isinstance(leg, Leg):
                 grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess,
@@ -154,8 +157,11 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
                 finer = leg_on_grid(modelled, leg.bound, grid, leg.start, leg.v0, leg.a0,
                                     leg.vf, leg.af)
                 legs[i] = _solve(finer)
+                changed.append(i)
         profile = replace(profile, legs=tuple(legs))
-    check = profile.verify()
+        for i in changed:
+            leg_checks[i] = profile.check_leg(i)
+    check = Verification.merged([c.verification for c in leg_checks])
     if not check.ok:
         worst = ", ".join(f"{k} {r:.3f}× at s={check.where.get(k, float('nan')):.4g} m"
                           for k, r in check.violations.items())

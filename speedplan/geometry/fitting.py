@@ -8,10 +8,9 @@ validates the options of each kind and refuses reversals (turns back by more tha
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from ..core.checks import FloatArray, as_array, as_scalar, choice
 from ..core.errors import InvalidInputError
@@ -19,6 +18,9 @@ from ._checks import check_waypoints, wrap_angle
 from .corners import CUSP_ANGLE, as_deviation, find_reversal, g2_corners, leg_turns
 from .pieces import CurvePiece, Piece
 from .primitives import ClothoidPiece
+
+if TYPE_CHECKING:  # scipy.interpolate costs ~0.2 s to import: only kind="spline" needs it
+    from scipy.interpolate import CubicSpline
 
 __all__ = ["CORNER_FRACTION", "DEFAULT_KIND", "KINDS", "SplineCurve", "clothoid_chain",
            "estimate_headings", "fit_clothoid", "fit_waypoints", "rounded_polyline",
@@ -134,6 +136,8 @@ def _is_closed(pts: FloatArray) -> bool:
 
 def _chord_spline(pts: FloatArray) -> CubicSpline:
     """Chord-length cubic spline: periodic for closed point sets, not-a-knot otherwise."""
+    from scipy.interpolate import CubicSpline
+
     tau = _chord_parameter(pts)
     if pts.shape[0] == 2:
         return CubicSpline(tau, pts, bc_type="natural")

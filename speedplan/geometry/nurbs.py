@@ -3,15 +3,17 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 from ..core.checks import FloatArray, as_array
 from ..core.errors import InvalidInputError
 from ._checks import as_int
 from .pieces import CurvePiece
+
+if TYPE_CHECKING:  # scipy.interpolate costs ~0.2 s to import: only NURBS edges need it
+    from scipy.interpolate import BSpline
 
 __all__ = ["NurbsCurve", "nurbs_piece"]
 
@@ -44,6 +46,8 @@ class NurbsCurve:
     _spline: BSpline = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        from scipy.interpolate import BSpline
+
         homog = np.column_stack((self.control_points * self.weights[:, None], self.weights))
         object.__setattr__(self, "_spline", BSpline(self.knots, homog, self.degree))
 

@@ -155,8 +155,11 @@ class Path:
         flat, fidx = q.ravel(), idx.ravel()
         trailing = (2,) if attr == "point" else ()
         out = np.empty(flat.shape + trailing)
-        for k in np.unique(fidx):
-            sel = fidx == k
+        # Group by piece with one stable sort (a mask per piece is O(pieces x points)).
+        order = np.argsort(fidx, kind="stable")
+        cuts = np.flatnonzero(np.diff(fidx[order])) + 1
+        for sel in np.split(order, cuts) if flat.size else ():
+            k = int(fidx[sel[0]])
             out[sel] = getattr(self.pieces[k], attr)(flat[sel] - self.offsets[k])
         return out.reshape(q.shape + trailing)
 

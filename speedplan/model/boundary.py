@@ -95,18 +95,23 @@ def _cubic_time(d: FloatArray, v: float, a: float, jerk: float, t_end: float) ->
     q = 2.0 * b**3 / 27.0 - b * c / 3.0 + e
     shift = -b / 3.0
     disc = (q / 2.0) ** 2 + (p / 3.0) ** 3
-    roots = []
-    sq = np.sqrt(np.maximum(disc, 0.0))
-    roots.append(np.where(disc >= 0, np.cbrt(-q / 2.0 + sq) + np.cbrt(-q / 2.0 - sq) + shift,
-                          np.nan))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        r = np.sqrt(np.maximum(-p / 3.0, 0.0))
-        arg = np.clip(np.where(r > 0, (-q / 2.0) / np.where(r > 0, r**3, 1.0), 0.0), -1.0, 1.0)
-        phi = np.arccos(arg) / 3.0
-        for k in range(3):
-            roots.append(np.where(disc < 0, 2.0 * r * np.cos(phi - 2.0 * np.pi * k / 3.0) + shift,
-                                  np.nan))
-    cand = np.stack(roots)
+    # One real root where disc >= 0 (Cardano), three where disc < 0 (trigonometric form):
+    # each formula evaluated only on its own entries.
+    cand = np.full((4, *disc.shape), np.nan)
+    one = disc >= 0
+    if one.any():
+        qo, sq = q[one], np.sqrt(disc[one])
+        cand[0][one] = np.cbrt(-qo / 2.0 + sq) + np.cbrt(-qo / 2.0 - sq) + shift
+    three = ~one
+    if three.any():
+        qt = q[three]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r = np.sqrt(np.maximum(-p / 3.0, 0.0))
+            arg = np.clip(np.where(r > 0, (-qt / 2.0) / np.where(r > 0, r**3, 1.0), 0.0),
+                          -1.0, 1.0)
+            phi = np.arccos(arg) / 3.0
+            for k in range(3):
+                cand[k + 1][three] = 2.0 * r * np.cos(phi - 2.0 * np.pi * k / 3.0) + shift
     ok = np.isfinite(cand) & (cand >= -1e-12 * max(t_end, 1.0)) & (cand <= t_end * (1 + 1e-12))
     t = np.where(ok, cand, np.inf).min(axis=0)
     # Fall back to the bracket's midpoint if rounding lost every root; Newton fixes it.

@@ -58,20 +58,20 @@ answers with Clarabel while a background process compiles it (:func:`kernel_read
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import os
 import subprocess
 import sys
 import tempfile
 import time
 from dataclasses import replace
-from typing import Any, NamedTuple
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, NamedTuple
 
-import numba
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
 from ..core.errors import InfeasibleError, InvalidInputError, SolverError
-from . import _banded_ipm as ipm
 from .clarabel_ import RelaxationResult
 from .nojerk import check_reachable, max_feasible_w, min_feasible_w
 from .problem import DiscreteProblem
@@ -81,6 +81,30 @@ __all__ = [
     "kernel_for_auto", "kernel_ready", "ramp_steps", "solve_relaxation_banded",
     "solve_unit_relaxation", "unit_scales",
 ]
+
+
+def _lazy_module(name: str) -> ModuleType:
+    """``name`` imported on first attribute access (the standard library's LazyLoader recipe).
+
+    The kernel module imports numba (about 0.2 s); ``import speedplan`` must not pay that for
+    processes that never solve with the banded backend.
+    """
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.find_spec(name)
+    assert spec is not None and spec.loader is not None
+    loader = importlib.util.LazyLoader(spec.loader)
+    spec.loader = loader
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    loader.exec_module(module)
+    return module
+
+
+if TYPE_CHECKING:
+    from . import _banded_ipm as ipm
+else:
+    ipm = _lazy_module(f"{__package__}._banded_ipm")
 
 
 class _Rows(NamedTuple):
@@ -156,7 +180,7 @@ def _primal_t(p: DiscreteProblem, w: FloatArray) -> FloatArray:
     t: FloatArray = p.tau / np.sqrt(w[1:-1])
     for family in p.stencil_families():
         finite = np.isfinite(family.bound)
-        load = p.stencil_matrix(family.coef) @ w
+        load = p.stencil_apply(family.coef, w)
         t[finite] = np.maximum(t[finite],
                                p.tau[finite] * np.abs(load[finite]) / family.bound[finite])
     return t
@@ -195,7 +219,7 @@ def _lagrangian_bound(
     for family, (a, b) in zip(p.stencil_families(), nu, strict=True):
         finite = np.isfinite(family.bound)
         coef = np.where(finite, (a - b) * p.tau / np.where(finite, family.bound, 1.0), 0.0)
-        g += p.stencil_matrix(family.coef).T @ coef
+        g += p.stencil_adjoint(family.coef, coef)
     const = (g[0] * p.w_start + g[-1] * p.w_end
              - float(mu_acc @ (p.accel * p.h)) - float(mu_dec @ (p.decel * p.h)))
     gi, c, wmax = g[1:-1], lam * p.tau, p.w_max[1:-1]
@@ -297,7 +321,8 @@ class _Kernel:
     ready = False
     #: The iteration log of the last solve in this process (rows: iterations; columns:
     #: :data:`~speedplan.solve._banded_ipm.LOG_COLUMNS`), for diagnostics and benchmarks.
-    last_log: FloatArray = np.zeros((0, len(ipm.LOG_COLUMNS)))
+    #: Empty (no columns) until the first solve: sizing it would import the kernel.
+    last_log: FloatArray = np.zeros((0, 0))
     background: subprocess.Popen[bytes] | None = None
     spawn_failed = False
 
@@ -319,6 +344,8 @@ def _load_from_disk_cache() -> bool:
     p = _example_problem()
     d, _ = _prepare(p, _positive_feasible(p)[1:-1])
     args = (*_kernel_args(d, *_start(p, d)), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
+    import numba
+
     try:
         sig = tuple(numba.typeof(a) for a in args)  # type: ignore[no-untyped-call]
         if sig in disp.overloads:
@@ -388,6 +415,8 @@ COMPILE_LOCK_STALE = 600.0
 
 def _lock_path() -> str:
     """One lock per copy of speedplan, numba version, cache directory and interpreter."""
+    import numba
+
     key = "|".join((os.path.abspath(ipm.__file__), numba.__version__,
                     os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
     digest = hashlib.sha256(key.encode()).hexdigest()[:16]

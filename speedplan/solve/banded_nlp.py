@@ -26,7 +26,6 @@ from itertools import pairwise
 from typing import NamedTuple
 
 import numpy as np
-from scipy.linalg.lapack import dpbtrf, dpbtrs
 
 from ..core.checks import FloatArray, IntArray
 from .problem import DiscreteProblem
@@ -330,6 +329,8 @@ def _factor(ab: FloatArray, delta_last: float) -> tuple[FloatArray | None, float
     A matrix that is not positive definite gets IPOPT's inertia correction; returns
     ``(factor, δ, factorizations)``.
     """
+    from scipy.linalg.lapack import dpbtrf  # imported on first use: import speedplan stays light
+
     factor, info = dpbtrf(ab, lower=1)
     if info == 0:
         return factor, 0.0, 1
@@ -458,6 +459,8 @@ class _Phase:
 
     def direction(self, nt: _Newton, ev: _Eval, r_c: FloatArray) -> _Point:
         """Step for the row residual ``r_c`` as a ``_Point`` (``z`` holds the gaps' step)."""
+        from scipy.linalg.lapack import dpbtrs
+
         rows = self.rows
         r_t = r_c + nt.r_extra
         dx, _ = dpbtrs(nt.factor, -nt.r_x - rows.jac_t(ev, nt.sig_e * r_t), lower=1)

@@ -11,15 +11,17 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import clarabel
 import numpy as np
-import scipy.sparse as sp
 
 from ..core.checks import FloatArray, IntArray
 from ..core.errors import InfeasibleError, SolverError
 from .problem import DiscreteProblem
+
+if TYPE_CHECKING:  # scipy.sparse is imported where the SOCP is built: import speedplan stays light
+    import scipy.sparse as sp
 
 __all__ = ["RelaxationResult", "solve_relaxation"]
 
@@ -56,6 +58,8 @@ def _rows(
 
 def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, FloatArray, list[Any]]:
     """Return ``(A, b, q, cones)`` of the relaxation in Clarabel's ``Ax + s = b`` form."""
+    import scipy.sparse as sp
+
     n = problem.n
     m = n - 2
     iw, it, iz = 0, n, n + m
@@ -164,6 +168,8 @@ def solve_relaxation(
     problem: DiscreteProblem, settings: clarabel.DefaultSettings | None = None
 ) -> RelaxationResult:
     """Solve the SOCP relaxation; raise on infeasibility or solver failure."""
+    import scipy.sparse as sp
+
     t0 = time.perf_counter()
     A, b, q, cones = build_socp(problem)
     P = sp.csc_matrix((q.size, q.size))

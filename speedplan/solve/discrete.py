@@ -59,7 +59,7 @@ def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArr
     """
     if problem.w_start != 0.0 or problem.w_end != 0.0 or problem.has_lower_bounds:
         return None
-    wpp = np.abs(problem.second_difference @ w)
+    wpp = np.abs(problem.stencil_apply(problem.second_difference_weights, w))
     load = wpp * np.sqrt(np.maximum(w[1:-1], 0.0))
     finite = np.isfinite(problem.jerk) & (load > 0)
     if not finite.any():

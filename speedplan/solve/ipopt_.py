@@ -13,7 +13,6 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-import casadi as ca
 import numpy as np
 
 from ..core.checks import FloatArray
@@ -71,6 +70,7 @@ class RefineResult:
 
 def _rows(problem: DiscreteProblem, x: Any) -> tuple[Any, FloatArray, FloatArray]:
     """Every row as one CasADi column: acceleration, then each jerk-type family."""
+    import casadi as ca
     w_full = ca.vertcat(problem.w_start, x, problem.w_end)
     parts = [w_full[1:] - w_full[:-1]]
     lbg, ubg = [-problem.decel * problem.h], [problem.accel * problem.h]
@@ -112,6 +112,10 @@ def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
     >>> res.success, bool(p.jerk_violation(res.w) <= p.jerk_tol)
     (True, True)
     """
+    # casadi is imported here, not at module level: it costs ~0.3 s and most plans never
+    # reach this fallback (``import speedplan`` must not load it).
+    import casadi as ca
+
     t0 = time.perf_counter()
     m = problem.n - 2
     wmin = 1e-9 * max(1.0, float(np.max(problem.w_max)))

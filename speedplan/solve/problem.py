@@ -15,11 +15,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..core.checks import FloatArray
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 __all__ = ["DiscreteProblem", "StencilRows"]
 
@@ -157,10 +160,48 @@ class DiscreteProblem:
 
     def stencil_matrix(self, coef: FloatArray) -> sp.csr_matrix:
         """Sparse (n-2, n) operator of the three-point stencils ``coef`` at interior nodes."""
+        import scipy.sparse as sp  # on first use: import speedplan stays light
+
         m = self.n - 2
         rows = np.repeat(np.arange(m), 3)
         cols = (np.arange(m)[:, None] + np.arange(3)[None, :]).ravel()
         return sp.csr_matrix((np.asarray(coef).ravel(), (rows, cols)), shape=(m, self.n))
+
+    @staticmethod
+    def stencil_apply(coef: FloatArray, w: FloatArray) -> FloatArray:
+        """``stencil_matrix(coef) @ w`` without building the matrix: ``c_i · w_{i-1:i+2}``.
+
+        Summed left to right from the first stencil point, as the sparse product does, so the
+        two agree to the last bit.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> DiscreteProblem.stencil_apply(np.array([[1.0, -2.0, 1.0]]), np.array([1.0, 4.0, 9.0]))
+        array([2.])
+        """
+        c = np.asarray(coef)
+        out: FloatArray = c[:, 0] * w[:-2] + c[:, 1] * w[1:-1] + c[:, 2] * w[2:]
+        return out
+
+    @staticmethod
+    def stencil_adjoint(coef: FloatArray, x: FloatArray) -> FloatArray:
+        """``stencil_matrix(coef).T @ x`` without building the matrix (shape ``(n,)``).
+
+        Each node collects the rows it appears in in row order, as the sparse product does.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> DiscreteProblem.stencil_adjoint(np.array([[1.0, -2.0, 1.0]]), np.array([3.0]))
+        array([ 3., -6.,  3.])
+        """
+        c = np.asarray(coef)
+        out = np.zeros(c.shape[0] + 2)
+        out[2:] += c[:, 2] * x
+        out[1:-1] += c[:, 1] * x
+        out[:-2] += c[:, 0] * x
+        return out
 
     def travel_time(self, w: FloatArray) -> float:
         """The objective ``Σ τ_i / sqrt(w_i)`` over interior nodes (inf if some ``w_i <= 0``)."""
@@ -176,13 +217,13 @@ class DiscreteProblem:
         invariant under the paper's scaling ``(h, A, J) -> (ρh, A/ρ, J/ρ²)``. Rows with
         ``J = inf`` give ``-inf``.
         """
-        return self._rows(self.second_difference @ w, self.jerk, w)
+        return self._rows(self.stencil_apply(self.second_difference_weights, w), self.jerk, w)
 
     def lateral_rows(self, w: FloatArray) -> FloatArray:
         """Per interior node, the same measure for the lateral-jerk rows (``-inf`` without)."""
         out = np.full(self.n - 2, -np.inf)
         for family in self.lateral_families:
-            out = np.maximum(out, self._rows(self.stencil_matrix(family.coef) @ w,
+            out = np.maximum(out, self._rows(self.stencil_apply(family.coef, w),
                                              family.bound, w))
         return out
 
@@ -243,7 +284,7 @@ class DiscreteProblem:
             return False
         wm = self.w_max.copy()
         wm[0], wm[-1] = self.w_start, self.w_end
-        wpp = self.second_difference @ wm
+        wpp = self.stencil_apply(self.second_difference_weights, wm)
         wi = wm[1:-1]
         with np.errstate(divide="ignore"):
             positive_rows = self.tau**2 * (wpp - self.jerk / np.sqrt(wi))

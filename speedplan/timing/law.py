@@ -269,19 +269,41 @@ class TimeLaw:
         standstill, where it tends to 0.
         """
         p = self._pieces
+        y, right, cj = self._y_only(j, dx, dr)
+        dy = np.where(right, p.g_right[j] - cj * dr, p.g[j] + cj * dx)
+        return y, dy, cj
+
+    def _y_only(self, j: IntArray, dx: FloatArray, dr: FloatArray
+                ) -> tuple[FloatArray, np.ndarray, FloatArray]:
+        """``y`` of :meth:`_y` alone (with the side it was evaluated from and ``y''``)."""
+        p = self._pieces
         cj = p.c[j]
         right = dx > dr
         y = np.where(right, p.y_right[j] - p.g_right[j] * dr + 0.5 * cj * dr * dr,
                      p.y[j] + p.g[j] * dx + 0.5 * cj * dx * dx)
-        dy = np.where(right, p.g_right[j] - cj * dr, p.g[j] + cj * dx)
-        return np.maximum(y, 0.0), dy, cj
+        return np.maximum(y, 0.0), right, cj
+
+    @staticmethod
+    def _w(y: FloatArray, cube: FloatArray, is_u: np.ndarray) -> FloatArray:
+        """``w`` from ``y`` and its cube root (``y = u = w^{3/4}`` where ``is_u``)."""
+        w: FloatArray = np.where(is_u, y * cube, y)
+        return w
+
+    def _speed(self, j: IntArray, dx: FloatArray, dr: FloatArray) -> FloatArray:
+        """``v`` alone at offsets ``(dx, dr)`` of pieces ``j`` (as :meth:`_physical` gives it).
+
+        ``j`` may be of the shape of ``dx`` or broadcast against it (one piece per column).
+        """
+        y = self._y_only(j, dx, dr)[0]
+        v: FloatArray = np.sqrt(self._w(y, np.cbrt(y), self._pieces.is_u[j]))
+        return v
 
     @staticmethod
     def _physical(y: FloatArray, dy: FloatArray, ddy: FloatArray, is_u: np.ndarray
                   ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """``w, v, a, j`` from ``y, y', y''`` (``y = u = w^{3/4}`` where ``is_u``)."""
         cube = np.cbrt(y)
-        w = np.where(is_u, y * cube, y)
+        w = TimeLaw._w(y, cube, is_u)
         v = np.sqrt(w)
         a = np.where(is_u, (2.0 / 3.0) * cube * dy, 0.5 * dy)
         jerk = np.where(is_u, (2.0 / 9.0) * dy * dy + (2.0 / 3.0) * y * ddy, 0.5 * ddy * v)
@@ -322,9 +344,9 @@ class TimeLaw:
             inside = np.isfinite(r) & (r > 0) & (r < width)
             cands.append(np.where(inside, r, 0.0))
         dx = np.stack(cands)  # (candidates, pieces)
-        j = np.broadcast_to(np.arange(width.size), dx.shape)
-        y, dy, ddy = self._y(j, dx, width - dx)
-        w, _, a, jerk = self._physical(y, dy, ddy, np.broadcast_to(p.is_u, dx.shape))
+        # One piece per column: the piece data broadcast over the candidates.
+        y, dy, ddy = self._y(np.arange(width.size), dx, width - dx)
+        w, _, a, jerk = self._physical(y, dy, ddy, p.is_u)
         out = {}
         for name, val in (("w", w), ("a", a), ("jerk", jerk)):
             i_max = np.argmax(val, axis=0)
@@ -360,9 +382,7 @@ class TimeLaw:
         jac = np.where(at_rest, span * power * t ** (power - 1.0), span)
         dx = np.where(right, width - off, off)
         dr = np.where(right, off, width - off)
-        jb = np.broadcast_to(j, off.shape)
-        y, dy, ddy = self._y(jb, dx, dr)
-        _, v, _, _ = self._physical(y, dy, ddy, p.is_u[jb])
+        v = self._speed(j, dx, dr)  # j broadcasts: piece data gathered once per column
         with np.errstate(divide="ignore", invalid="ignore"):
             f = np.where(jac > 0, jac / v, 0.0)
         out: FloatArray = np.sum(tw * f, axis=0)
@@ -438,8 +458,7 @@ class TimeLaw:
             f = part - tau[act]  # increasing in the offset
             lo[act] = np.where(f <= 0, oa, lo[act])
             hi[act] = np.where(f >= 0, oa, hi[act])
-            y, dy, ddy = self._y(ja, np.where(rr, wa - oa, oa), np.where(rr, oa, wa - oa))
-            v = self._physical(y, dy, ddy, p.is_u[ja])[1]
+            v = self._speed(ja, np.where(rr, wa - oa, oa), np.where(rr, oa, wa - oa))
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 newton = oa - f * v
             inside = (newton >= lo[act]) & (newton <= hi[act])

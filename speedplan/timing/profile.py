@@ -17,7 +17,7 @@ from ..solve.solution import STATUSES as SOLUTION_STATUSES
 from ..solve.solution import DiscreteSolution
 from .law import LawChain, TimeLaw
 from .trajectory import Trajectory
-from .verify import LegCheck, Verification, check_law, curvature_rate
+from .verify import LegCheck, Verification, bound_breakpoints, check_law, curvature_rate
 
 if TYPE_CHECKING:
     from ..geometry import Path
@@ -287,8 +287,9 @@ class SpeedProfile:
         """Compare the continuous trajectory with the limits (see :mod:`speedplan.timing.verify`).
 
         Acceleration and jerk: exact extremes of every piece of the law. Speed bound, lateral
-        acceleration, yaw rate and lateral jerk: at 8 points per grid cell and at each
-        piece's speed maximum.
+        acceleration, yaw rate and lateral jerk: at 8 points per grid cell, at each piece's
+        speed maximum and at the speed bound's breakpoints (zone and span ends, ``v_limit``
+        knots, path joins).
         """
         return Verification.merged([self.check_leg(i).verification
                                     for i in range(len(self.legs))])
@@ -296,7 +297,13 @@ class SpeedProfile:
     def check_leg(self, i: int) -> LegCheck:
         """The check of leg ``i`` (which of its law pieces exceed a tolerance)."""
         leg = self.legs[i]
-        return check_law(leg.law, leg.start, self.path, self.speed_bound, self.limits)
+        return check_law(leg.law, leg.start, self.path, self.speed_bound, self.limits,
+                         self._bound_breaks)
+
+    @cached_property
+    def _bound_breaks(self) -> FloatArray:
+        """Breakpoints of the speed bound (:func:`bound_breakpoints`), once for every leg."""
+        return bound_breakpoints(self.path, self.speed_bound)
 
     def __repr__(self) -> str:
         return (

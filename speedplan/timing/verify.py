@@ -5,8 +5,10 @@ acceleration and jerk over each piece are exact closed forms (:meth:`TimeLaw.ext
 nothing between samples can escape. What depends on the path — the speed bound (curvature,
 zones, ``v_limit``), lateral acceleration ``κ v²``, yaw rate ``κ v`` and lateral jerk
 ``v (κ' w + 2 κ a)`` — is evaluated at :data:`SAMPLES_PER_PIECE` points of every piece
-(both ends included: 8 per grid cell, as dense as the discrete problem's own bound sampling)
-and at the piece's speed maximum.
+(both ends included: 8 per grid cell, as dense as the discrete problem's own bound sampling),
+at the piece's speed maximum, and at every breakpoint of the speed bound inside the leg
+(:func:`bound_breakpoints`: knots of ``v_limit``, ends of spans, zone entries and exits, joins
+of path pieces), where a narrow dip or a step of the bound can fall between two samples.
 """
 
 from __future__ import annotations
@@ -18,11 +20,12 @@ import numpy as np
 
 from ..core.checks import FloatArray
 from ..core.limits import Limits
-from ..geometry import Path, SpeedBound
+from ..geometry import Path, SpeedBound, zone_intervals
+from ..geometry.bounds import _check_v_limit
 from .law import TimeLaw
 
 __all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "Verification",
-           "check_law", "curvature_rate"]
+           "bound_breakpoints", "check_law", "curvature_rate"]
 
 #: Documented tolerances at the default resolution, as fractions of each limit; all shrink
 #: as the grid is refined (docs/convergence.md, docs/failure-modes.md).
@@ -154,9 +157,45 @@ def curvature_rate(path: Path, s: FloatArray) -> FloatArray:
     return out
 
 
+def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> FloatArray:
+    """Arc lengths [m] of ``path`` where the speed bound may have a kink, a step or a dip.
+
+    The joins of the path's pieces (where the curvature may jump or change its law) and, for
+    a :class:`~speedplan.geometry.SpeedBound`, the knots of its ``v_limit`` (piecewise
+    linear: its minimum over any stretch is at a knot or an end), the ends of its spans and
+    the entries and exits of its zones (:func:`~speedplan.geometry.zone_intervals`, located
+    to 1e-9 m on the inside). Sorted, within ``[0, path.length]``.
+
+    Examples
+    --------
+    >>> from speedplan import Limits
+    >>> from speedplan.geometry import Arc, Line, Path, SpeedBound
+    >>> p = Path.from_segments([Line(5.0), Arc(radius=2.0, angle=1.0)])
+    >>> lim = Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
+    >>> bound_breakpoints(p, SpeedBound(p, lim, v_limit=([1.0, 2.0], [2.0, 1.0]))).tolist()
+    [1.0, 2.0, 5.0]
+    """
+    parts = [np.asarray(path.offsets[1:-1], dtype=np.float64)]
+    if isinstance(bound, SpeedBound):
+        shift = bound.offset  # the bound reads the path at s + offset
+        if bound.v_limit is not None:
+            parts.append(_check_v_limit(bound.v_limit)[0] - shift)
+        parts += [np.array([span.start, span.end]) - shift for span in bound.spans]
+        if bound.zones:
+            cuts = zone_intervals(bound.path, bound.zones)
+            parts.append(np.array([x for a, b, _ in cuts for x in (a, b)]) - shift)
+    out = np.unique(np.concatenate(parts))
+    return out[(out >= 0.0) & (out <= path.length)]
+
+
 def check_law(law: TimeLaw, offset: float, path: Path,
-              bound: Callable[[FloatArray], FloatArray], limits: Limits) -> LegCheck:
-    """Check the law of one leg that covers ``[offset, offset + law.length]`` of ``path``."""
+              bound: Callable[[FloatArray], FloatArray], limits: Limits,
+              breaks: FloatArray | None = None) -> LegCheck:
+    """Check the law of one leg that covers ``[offset, offset + law.length]`` of ``path``.
+
+    ``breaks``: arc lengths of ``path`` (:func:`bound_breakpoints`, computed here when not
+    given) where the path-dependent quantities are evaluated too, besides the samples.
+    """
     ex = law.extremes()
     knots = law.knots
     width = np.diff(knots)
@@ -164,7 +203,14 @@ def check_law(law: TimeLaw, offset: float, path: Path,
     q = knots[:-1, None] + width[:, None] * frac[None, :]
     q = np.concatenate((q, ex["w"][0][:, None]), axis=1)  # + the piece's speed maximum
     shape = q.shape
-    q = np.clip(q.ravel(), 0.0, law.length)
+    if breaks is None:
+        breaks = bound_breakpoints(path, bound)
+    local = breaks[(breaks >= offset) & (breaks <= offset + law.length)] - offset
+    # Each breakpoint counts for the piece(s) it lies in (both, on a knot).
+    at = np.searchsorted(knots, local, side="right") - 1
+    left = np.searchsorted(knots, local, side="left") - 1
+    extra_piece = np.clip(np.concatenate((at, left)), 0, width.size - 1)
+    q = np.clip(np.concatenate((q.ravel(), local)), 0.0, law.length)
     glob = offset + q
     w, v, a, _ = law.kinematics(q)
     kappa = np.asarray(path.curvature(glob), dtype=np.float64)
@@ -195,7 +241,10 @@ def check_law(law: TimeLaw, offset: float, path: Path,
         maxima[name] = float(np.max(value))
         ratios[name] = float(ratio_s[k])
         where[name] = float(glob[k])
-        excess |= (ratio_s.reshape(shape) > 1.0 + TOLERANCES[name]).any(axis=1)
+        over = ratio_s > 1.0 + TOLERANCES[name]
+        excess |= over[: over.size - local.size].reshape(shape).any(axis=1)
+        if local.size:
+            excess[extra_piece[np.tile(over[over.size - local.size:], 2)]] = True
     a_top, a_bottom = ex["a"][1], ex["a"][2]
     j_top, j_bottom = ex["jerk"][1], ex["jerk"][2]
     j_abs = np.maximum(j_top, -j_bottom)

@@ -1,0 +1,473 @@
+"""Every performance target of issue #17 in one run: where ``plan()``'s time goes, and more.
+
+Usage::
+
+    python benchmarks/bench_all.py                  # everything (about 4-6 minutes)
+    python benchmarks/bench_all.py --quick          # fewer repeats, no 100 k-node runs
+
+Prints, in order:
+
+1. ``plan()`` split into stages, per sample path (``paths/*.json|csv``, LGV limits
+   v_max=2, a_max=1, a_lat_max=1, j_max=0.5; road limits for ``road_*``), for a
+   deterministic 20-waypoint, 127 m serpentine route (:func:`serpentine`), and for the
+   first request of the refinement corpus (a vehicle that starts braking on an 8 m line;
+   its relaxation is exact now that standstills are smooth, so ``refine`` stays 0 here: the
+   refinement is timed on the stored inexact problems in section 7).
+   Stages (medians over ``--repeats``, one warm-up call excluded): model/grid build
+   (``build_model``, and grid refinement rounds), relaxation (``solution.relaxation.time``),
+   refinement (``solution.refinement.time``), the rest of the solve (scaling, certificate),
+   time law (``law_for``), the per-leg checks that decide grid refinement (``check_leg``),
+   the final ``verify()``, what is left (``other``), the total, and then ``sample(0.01)``.
+   The stages are timed by wrapping those functions inside the real ``plan()`` (exclusive
+   times: a wrapped call inside another one counts for its own stage only).
+2. ``plan(n=1000)`` against the bare relaxation solve of the same grid
+   (``solve_problem(problem, refine="never", backend="auto")``), and
+   ``profile_from_waypoints`` on the route.
+3. ``plan(j_max=inf)`` against TOPP-RA's ``compute_trajectory`` (toppra, 1-DOF path ``q = s``
+   with the same speed bound per node and the same grid: the same discrete problem).
+4. copp-py's jerk-limited TOPP3 (``topp3_socp``) on the same grids, when it is installed.
+5. ``import speedplan`` (subprocess, median of ``--import-runs``) and the first ``plan()`` in
+   a fresh process with an empty numba cache (``NUMBA_CACHE_DIR`` in a temporary directory).
+6. ``solve_discrete`` at 10 k and 100 k nodes: tracemalloc peak per node and the time ratio,
+   sizes interleaved (as ``bench_kernel_scaling.py``).
+7. The refinement (``speedplan.solve.refine.refine``) on the stored corpus of inexact
+   ``plan()`` relaxations (``benchmarks/data/refine_corpus.npz``, see ``bench_refine.py``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import math
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import tracemalloc
+import warnings
+from collections import defaultdict
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path as FsPath
+from typing import Any
+
+import numpy as np
+
+import speedplan as sp
+from speedplan.geometry import Line
+from speedplan.io import read_path, read_zones
+from speedplan.model import Leg, PlanRequest, build_model
+from speedplan.solve.banded import compile_kernel
+from speedplan.solve.discrete import solve_problem
+from speedplan.solve.paper import paper_instance
+from speedplan.timing import SpeedProfile
+
+ROOT = FsPath(__file__).resolve().parents[1]
+LGV = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+ROAD = sp.Limits(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0)
+# The first case of benchmarks/refine_corpus.py: a vehicle that starts braking (inexact when
+# the corpus was built; exact with the current model).
+ISSUE_LIMITS = sp.Limits(v_max=1.5103489923280469, a_max=0.8675731399347792, a_lat_max=1,
+                         j_max=0.1324661827707745)
+ISSUE_KW: dict[str, Any] = {"v0": 0.09343837197243295, "a0": -0.15353125453853034}
+ISSUE_LENGTH = 8.149176458679765
+
+STAGES = ("build", "relax", "refine", "solve rest", "law", "checks", "verify", "other",
+          "total")
+
+
+def serpentine() -> np.ndarray:
+    """20 waypoints: ten 10 m aisles 3 m apart, driven alternately (127 m of legs)."""
+    pts = []
+    for row in range(10):
+        xs = (0.0, 10.0) if row % 2 == 0 else (10.0, 0.0)
+        pts += [(xs[0], 3.0 * row), (xs[1], 3.0 * row)]
+    return np.array(pts)
+
+
+def cases() -> list[tuple[str, sp.Path, sp.Limits, dict[str, Any]]]:
+    out = []
+    for f in sorted(p for p in (ROOT / "paths").iterdir() if p.suffix in (".csv", ".json")):
+        zones = read_zones(str(f))
+        out.append((f.name, read_path(str(f)), ROAD if "road" in f.name else LGV,
+                    {"zones": zones} if zones else {}))
+    out.append(("serpentine 20 wp", sp.Path.from_waypoints(serpentine()), LGV, {}))
+    out.append(("braking start 8 m", sp.Path.from_segments([Line(ISSUE_LENGTH)]), ISSUE_LIMITS,
+                ISSUE_KW))
+    return out
+
+
+# --- 1. stages of plan() -------------------------------------------------------------------
+
+
+@contextmanager
+def staged(acc: dict[str, float]) -> Iterator[None]:
+    """Wrap the stage functions that ``plan()`` calls; accumulate their times into ``acc``."""
+    plan_mod = importlib.import_module("speedplan.plan")
+    saved: list[tuple[Any, str, Any]] = []
+    inner: list[float] = []  # time spent in wrapped calls nested in the open ones
+
+    def wrap(owner: Any, name: str, stage: str,
+             after: Callable[[Any], None] | None = None) -> None:
+        real = getattr(owner, name)
+
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            inner.append(0.0)
+            t0 = time.perf_counter()
+            try:
+                out = real(*args, **kwargs)
+            finally:
+                elapsed = time.perf_counter() - t0
+                nested = inner.pop()
+                acc[stage] += elapsed - nested  # exclusive: nested stages count as theirs
+                if inner:
+                    inner[-1] += elapsed
+            if after is not None:
+                after(out)
+            return out
+
+        saved.append((owner, name, real))
+        setattr(owner, name, timed)
+
+    def split(sol: Any) -> None:
+        relax = sol.relaxation.time if sol.relaxation is not None else 0.0
+        refine = sol.refinement.time if sol.refinement is not None else 0.0
+        acc["relax"] += relax
+        acc["refine"] += refine
+        acc["solve rest"] -= relax + refine
+
+    wrap(plan_mod, "build_model", "build")
+    wrap(plan_mod, "leg_on_grid", "build")
+    wrap(plan_mod, "refined_grid", "build")
+    wrap(Leg, "solve", "solve rest", split)
+    wrap(plan_mod, "law_for", "law")
+    wrap(SpeedProfile, "check_leg", "checks")
+    wrap(SpeedProfile, "verify", "verify")
+    try:
+        yield
+    finally:
+        for owner, name, real in reversed(saved):
+            setattr(owner, name, real)
+
+
+def plan_stages(path: sp.Path, lim: sp.Limits, kw: dict[str, Any],
+                repeats: int) -> tuple[dict[str, float], Any]:
+    runs: list[dict[str, float]] = []
+    prof = None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sp.plan(path, lim, **kw)  # warm-up
+        for _ in range(repeats):
+            acc: dict[str, float] = defaultdict(float)
+            with staged(acc):
+                t0 = time.perf_counter()
+                prof = sp.plan(path, lim, **kw)
+                acc["total"] = time.perf_counter() - t0
+            acc["other"] = acc["total"] - sum(acc[k] for k in STAGES[:-2])
+            runs.append(acc)
+    return {k: statistics.median(r[k] for r in runs) for k in STAGES}, prof
+
+
+def median_time(call: Callable[[], Any], repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def section_stages(repeats: int) -> None:
+    print("\n== 1. plan() by stage [ms], medians of", repeats, "==")
+    head = " ".join(f"{k:>10}" for k in STAGES)
+    print(f"{'case':<22} {'n':>5} {'T [s]':>8} {head} {'sample':>8}")
+    for name, path, lim, kw in cases():
+        st, prof = plan_stages(path, lim, kw, repeats)
+        t_sample = median_time(lambda pr=prof: pr.sample(0.01), repeats)
+        n = sum(leg.s.size for leg in prof.legs)
+        cols = " ".join(f"{1e3 * st[k]:>10.2f}" for k in STAGES)
+        print(f"{name:<22} {n:>5} {prof.duration:>8.3f} {cols} {1e3 * t_sample:>8.2f}")
+
+
+# --- 2. plan() against its bare relaxation, profile_from_waypoints ---------------------------
+
+
+def section_overhead(repeats: int) -> None:
+    print(f"\n== 2. plan(n=1000) against the bare relaxation of its grid, medians of {repeats} ==")
+    print(f"{'case':<22} {'plan [ms]':>10} {'relax [ms]':>11} {'ratio':>7}")
+    for name, path, lim, kw in cases()[:-1]:
+        kw = {**kw, "n": 1000}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sp.plan(path, lim, **kw)
+            t_plan = median_time(lambda p=path, li=lim, k=kw: sp.plan(p, li, **k), repeats)
+            problems = [leg.problem for leg in build_model(PlanRequest.create(path, lim, **kw)).legs
+                        if isinstance(leg, Leg)]
+            t_relax = median_time(
+                lambda ps=problems: [solve_problem(p, refine="never", backend="auto")
+                                     for p in ps], repeats)
+        print(f"{name:<22} {1e3 * t_plan:>10.2f} {1e3 * t_relax:>11.2f} {t_plan / t_relax:>7.2f}")
+    wps = serpentine()
+    kwargs = {"v_max": 2.0, "a_max": 1.0, "a_lat_max": 1.0, "j_max": 0.5}
+    for n in (None, 1000):
+        extra = {} if n is None else {"n": n}
+        sp.profile_from_waypoints(wps, **kwargs, **extra)
+        t = median_time(lambda e=extra: sp.profile_from_waypoints(wps, **kwargs, **e), repeats)
+        print(f"profile_from_waypoints(20 waypoints, dt=0.01, n={n}): {1e3 * t:.2f} ms")
+
+
+# --- 3. no jerk limit: TOPP-RA ------------------------------------------------------------
+
+
+def toppra_time(s: np.ndarray, w_max: np.ndarray, a_max: float,
+                repeats: int) -> tuple[float, float]:
+    import toppra as ta
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    ta.setup_logging("WARNING")
+    v = np.sqrt(w_max)
+
+    def run() -> Any:
+        path = ta.SplineInterpolator(np.array([s[0], s[-1]]), np.array([[s[0]], [s[-1]]]))
+        vel = constraint.JointVelocityConstraintVarying(
+            lambda x: np.array([[-np.interp(x, s, v), np.interp(x, s, v)]]))
+        acc = constraint.JointAccelerationConstraint(np.array([[-a_max, a_max]]))
+        inst = algo.TOPPRA([vel, acc], path, gridpoints=s, parametrizer="ParametrizeConstAccel")
+        return inst.compute_trajectory(0, 0)
+
+    traj = run()
+    return median_time(run, repeats), float(traj.duration)
+
+
+def plan_and_problem(path: sp.Path, lim: sp.Limits, kw: dict[str, Any],
+                     repeats: int) -> tuple[Any, float, Any]:
+    """``plan()``'s profile, its median time, and the discrete problem of its single leg.
+
+    The problem is ``None`` when the request has several legs (cusps, stops).
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        prof = sp.plan(path, lim, **kw)
+        t_ours = median_time(lambda: sp.plan(path, lim, **kw), repeats)
+        legs = [leg for leg in build_model(PlanRequest.create(path, lim, **kw)).legs
+                if isinstance(leg, Leg)]
+    single = len(legs) == 1 and len(prof.legs) == 1
+    return prof, t_ours, legs[0].problem if single else None
+
+
+def section_toppra(repeats: int) -> None:
+    print(f"\n== 3. plan(j_max=inf) against TOPP-RA compute_trajectory, medians of {repeats} ==")
+    print(f"{'case':<22} {'n':>5} {'ours [ms]':>10} {'toppra [ms]':>12} {'ratio':>7}"
+          f" {'T ours':>9} {'T toppra':>9}")
+    for name, path, lim, kw in cases()[:-1]:
+        nojerk = sp.Limits(v_max=lim.v_max, a_max=lim.a_max, a_lat_max=lim.a_lat_max,
+                           j_max=math.inf)
+        prof, t_ours, p = plan_and_problem(path, nojerk, kw, repeats)
+        if p is None:
+            print(f"{name:<22} skipped: several legs")
+            continue
+        t_ta, dur_ta = toppra_time(p.s, p.w_max, lim.a_max, repeats)
+        print(f"{name:<22} {p.n:>5} {1e3 * t_ours:>10.2f} {1e3 * t_ta:>12.2f}"
+              f" {t_ta / t_ours:>7.1f} {prof.duration:>9.3f} {dur_ta:>9.3f}")
+
+
+# --- 4. copp-py ------------------------------------------------------------------------------
+
+
+def copp_solve(p: Any, lim: sp.Limits) -> tuple[float, np.ndarray]:
+    """copp-py's TOPP3-SOCP on the grid ``p.s`` (1-DOF path ``q = s``): duration and ``a``.
+
+    Same speed bound per node (``sqrt(p.w_max)``, lateral limit included), ``a_max``,
+    ``a_decel`` and ``j_max`` on ``d³s/dt³``, rest to rest. copp linearises its jerk rows
+    around a reference profile (here ``p.w_max``) and has its own discretisation of the jerk
+    (``b = s''`` as a node variable) and time integration (``s_to_t_topp3``): not our
+    discrete problem, so the durations differ by the models, not only by the solvers.
+    """
+    import copp_py as copp
+
+    s, n = p.s, p.n
+    robot = copp.Robot(1)
+    robot.append_s(s)
+    robot.set_q(s[:, None], np.ones((n, 1)), np.zeros((n, 1)), 0, dddq=np.zeros((n, 1)))
+    v = np.maximum(np.sqrt(p.w_max), 1e-9)[:, None]  # copp wants strictly signed limits
+    robot.add_velocity_limits(v, -v, start_idx_s=0, length=n)
+    robot.add_acceleration_limits(np.array([lim.a_max]), np.array([-lim.a_decel]),
+                                  start_idx_s=0, length=n)
+    robot.add_jerk_limits(np.array([lim.j_max]), np.array([-lim.j_max]), start_idx_s=0,
+                          length=n)
+    problem = copp.solver.topp3_socp.Problem(robot.constraints, p.w_max.copy(), idx_s_start=0)
+    prof = copp.solver.topp3_socp.solve(problem)
+    duration, _ = copp.interpolation.s_to_t_topp3(s, prof)
+    return float(duration), np.asarray(prof.a, dtype=np.float64)
+
+
+def section_copp(repeats: int) -> None:
+    print(f"\n== 4. copp-py topp3_socp (jerk-limited), same grid and speed bound, medians of "
+          f"{repeats} ==")
+    try:
+        import copp_py
+    except ImportError:
+        print("copp-py is not installed (pip install copp-py, or the bench extra): skipped")
+        return
+    print(f"copp-py {copp_py.__version__}. T ours: plan()'s continuous law (and our discrete "
+          "objective); T copp: copp's s_to_t_topp3; viol: copp's a against our jerk rows "
+          "(in units of jerk_tol)")
+    print(f"{'case':<22} {'n':>5} {'ours [ms]':>10} {'copp [ms]':>10} {'ratio':>6} {'T ours':>9}"
+          f" {'(discrete)':>10} {'T copp':>9} {'viol':>8}")
+    for name, path, lim, kw in cases()[:-1]:
+        prof, t_ours, p = plan_and_problem(path, lim, kw, repeats)
+        if p is None:
+            print(f"{name:<22} skipped: several legs")
+            continue
+        try:
+            dur, a = copp_solve(p, lim)
+            t_copp = median_time(lambda pp=p, li=lim: copp_solve(pp, li), repeats)
+        except Exception as exc:  # report and go on: copp may refuse a grid
+            print(f"{name:<22} copp failed: {type(exc).__name__}: {exc}")
+            continue
+        viol = p.jerk_violation(np.clip(a, 0.0, p.w_max)) / p.jerk_tol
+        print(f"{name:<22} {p.n:>5} {1e3 * t_ours:>10.2f} {1e3 * t_copp:>10.2f}"
+              f" {t_copp / t_ours:>6.1f} {prof.duration:>9.3f}"
+              f" {prof.legs[0].solution.objective:>10.3f} {dur:>9.3f} {viol:>8.2g}")
+
+
+# --- 5. import and cold start --------------------------------------------------------------
+
+
+def _run(code: str, env: dict[str, str]) -> str:
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, cwd=str(ROOT), timeout=600)
+    if res.returncode != 0:
+        raise RuntimeError(res.stderr)
+    return res.stdout.strip()
+
+
+COLD = """
+import time
+t0 = time.perf_counter()
+import speedplan as sp
+from speedplan.io import read_path
+t1 = time.perf_counter()
+prof = sp.plan(read_path("paths/u_turn.json"), sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+t2 = time.perf_counter()
+prof = sp.plan(read_path("paths/u_turn.json"), sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+t3 = time.perf_counter()
+print(f"{t1 - t0:.3f} {t2 - t1:.3f} {t3 - t2:.3f} {prof.legs[0].solution.backend}", end="")
+from speedplan.solve.banded import _Kernel
+if _Kernel.background is not None:  # wait for the background compilation, and say how long
+    _Kernel.background.wait()
+    print(f"  (background compilation done {time.perf_counter() - t3:.1f} s later)", end="")
+print()
+"""
+
+
+def section_startup(import_runs: int) -> None:
+    print("\n== 5. import speedplan and the first plan() ==")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)}
+    code = ("import time; t = time.perf_counter(); import speedplan, sys; "
+            "print(time.perf_counter() - t, "
+            "' '.join(m for m in ('casadi', 'matplotlib', 'numba') if m in sys.modules))")
+    outs = [_run(code, env).split(maxsplit=1) for _ in range(import_runs)]
+    times = sorted(float(o[0]) for o in outs)
+    loaded = {o[1] if len(o) > 1 else "" for o in outs}
+    print(f"import speedplan: median {statistics.median(times):.3f} s over {import_runs} "
+          f"subprocesses (min {times[0]:.3f}, max {times[-1]:.3f}); heavy modules loaded: "
+          f"{sorted(loaded - {''}) or 'none'}")
+    print("first plan() of paths/u_turn.json in a new process [s]: import, first plan, second plan")
+    with tempfile.TemporaryDirectory() as cache:
+        cold = {**env, "NUMBA_CACHE_DIR": cache, "SPEEDPLAN_BACKGROUND_COMPILE": "0"}
+        t0 = time.perf_counter()
+        out = _run(COLD, cold)
+        print(f"  empty cache, waiting for the compilation:  {out}"
+              f"  (process {time.perf_counter() - t0:.2f} s)")
+        out = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache})
+        print(f"  same cache, now filled:                    {out}")
+    with tempfile.TemporaryDirectory() as cache:
+        out = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache})  # waits for its compilation
+        print(f"  empty cache, default (compiles in the background): {out}")
+
+
+# --- 6. memory and scaling of solve_discrete -----------------------------------------------
+
+
+def section_memory(sizes: list[int], rounds: int) -> None:
+    print(f"\n== 6. solve_discrete (paper rnd/cnst/cnst): memory per node, time ratio over "
+          f"{rounds} interleaved rounds ==")
+    insts = {n: paper_instance("rnd", "cnst", "cnst", n=n, seed=0) for n in sizes}
+    for n, inst in insts.items():
+        tracemalloc.start()
+        sp.solve_discrete(inst.w_max, inst.A, inst.J, backend="banded")
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        print(f"n={n:>7}: tracemalloc peak {peak / n:6.0f} bytes/node")
+    times: dict[int, list[float]] = {n: [] for n in sizes}
+    for _ in range(rounds):
+        for n, inst in insts.items():
+            t0 = time.perf_counter()
+            sp.solve_discrete(inst.w_max, inst.A, inst.J, backend="banded")
+            times[n].append(time.perf_counter() - t0)
+    med = {n: statistics.median(t) for n, t in times.items()}
+    print("  ".join(f"n={n}: {med[n]:.4f} s" for n in sizes)
+          + f"  ratio {med[sizes[-1]] / med[sizes[0]]:.2f}")
+
+
+# --- 7. the refinement -------------------------------------------------------------------
+
+
+def section_refine(limit: int | None) -> None:
+    """``refine()`` (banded NLP, IPOPT fallback) on the stored inexact ``plan()`` problems."""
+    sys.path.insert(0, str(FsPath(__file__).parent))
+    from bench_refine import CORPUS, load_corpus, run_new  # imports casadi: only here
+
+    cases = load_corpus(CORPUS)[:limit]
+    print(f"\n== 7. refinement of {len(cases)} inexact plan() relaxations "
+          f"(benchmarks/data/refine_corpus.npz, as bench_refine.py 'new') ==")
+    runs = [(case, run_new(case)) for case in cases]
+    times = sorted(run.time for _, run in runs)
+    n_nodes = [case.problem.n for case in cases]
+    q90 = times[min(len(times) - 1, int(0.9 * len(times)))]
+    print(f"accepted {sum(run.success for _, run in runs)} of {len(runs)}; nodes "
+          f"{min(n_nodes)}-{max(n_nodes)}; time median {statistics.median(times):.3f} s, "
+          f"90 % {q90:.3f} s, max {times[-1]:.3f} s")
+    slow = max(runs, key=lambda cr: cr[1].time)
+    print(f"slowest: {slow[0].key} (n={slow[0].problem.n}): {slow[1].time:.3f} s, "
+          f"{slow[1].status}")
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--import-runs", type=int, default=9)
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--quick", action="store_true", help="3 repeats, sizes 1 k and 10 k")
+    ap.add_argument("--only", nargs="+", type=int, choices=range(1, 8),
+                    help="run only these sections")
+    args = ap.parse_args(argv)
+    repeats = 3 if args.quick else args.repeats
+    sizes = [1000, 10000] if args.quick else [10000, 100000]
+    only = set(args.only or range(1, 8))
+    print(f"speedplan {sp.__version__} from {os.path.dirname(sp.__file__)}; "
+          f"cores: {os.cpu_count()}; load average {os.getloadavg()[0]:.1f}")
+    compile_kernel()
+    if 1 in only:
+        section_stages(repeats)
+    if 2 in only:
+        section_overhead(repeats)
+    if 3 in only:
+        section_toppra(repeats)
+    if 4 in only:
+        section_copp(repeats)
+    if 5 in only:
+        section_startup(args.import_runs)
+    if 6 in only:
+        section_memory(sizes, 3 if args.quick else args.rounds)
+    if 7 in only:
+        section_refine(20 if args.quick else None)
+
+
+if __name__ == "__main__":
+    main()
