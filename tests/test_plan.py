@@ -15,6 +15,7 @@ from speedplan import (
     InfeasibleError,
     InvalidInputError,
     Limits,
+    LimitWarning,
     Path,
     SpeedZone,
     plan,
@@ -293,6 +294,23 @@ def test_long_moves_resolve_their_final_jerk_phase(length, lim):
         profile = plan(Path.from_segments([Line(length)]), lim)
     assert profile.status == "optimal"
     assert profile.duration >= ruckig_duration(length, lim) * (1 - 1e-9)
+
+
+def test_a_refinement_that_cannot_resolve_a_jerk_phase_keeps_the_flagged_law():
+    # 27 km at a_max 0.054, j_max 11 (trust fuzz): the jerk phases (0.2 µm) lie below the
+    # finest default step (1e-11 L). Refining towards them drove the steps to 1e-8 m, the law
+    # came to rest on the way and plan() raised SolverError. Now the refinement stops at that
+    # step and the profile comes back flagged, never faster than ruckig's optimum.
+    length = 27373.408073555755
+    lim = Limits(v_max=12.217721761422338, a_max=0.05420259524615834, a_lat_max=1,
+                 j_max=11.189576218503156, a_decel=0.05420259524615834)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        profile = plan(Path.from_segments([Line(length)]), lim)
+    assert np.isfinite(profile.duration)
+    assert profile.duration >= ruckig_duration(length, lim) * (1 - 1e-4)
+    if profile.status == "limits_exceeded":
+        assert any(issubclass(w.category, LimitWarning) for w in caught)
 
 
 def test_coarse_user_grid_for_a_braking_start_is_refused_by_name():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.checks import FloatArray, grid_size
-from .grid import GRADING, graded_steps, nodes_from_steps
+from .grid import GRADING, MIN_RELATIVE_STEP, graded_steps, nodes_from_steps
 
 __all__ = ["PAD_CELLS", "refined_grid"]
 
@@ -19,9 +19,10 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
 
     ``knots`` are the law's knots (nodes and cell midpoints) and ``excess`` flags each piece
     between them. The steps are multiplied by ``factor`` (in ``(0, 1)``) over the flagged
-    cells padded by :data:`PAD_CELLS` on each side, and graded back to the old steps at the
-    rate :data:`~speedplan.model.grid.GRADING`, so the new grid is as smooth as the old one;
-    ``anchors`` (nodes of ``s``) stay nodes.
+    cells padded by :data:`PAD_CELLS` on each side (never below the default grids' finest
+    step, :data:`~speedplan.model.grid.MIN_RELATIVE_STEP` of the length), and graded back to
+    the old steps at the rate :data:`~speedplan.model.grid.GRADING`, so the new grid is as
+    smooth as the old one; ``anchors`` (nodes of ``s``) stay nodes.
 
     Examples
     --------
@@ -40,7 +41,9 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
     for k in np.unique(cell):
         lo, hi = max(k - PAD_CELLS, 0), min(k + 1 + PAD_CELLS, s.size - 1)
         flagged[lo:hi + 1] = True
-    target = np.where(flagged, factor * node_h, node_h)
+    # Never below the default grids' finest step: finer steps lose the digits of w.
+    finest = MIN_RELATIVE_STEP * float(s[-1] - s[0])
+    target = np.where(flagged, np.maximum(factor * node_h, np.minimum(node_h, finest)), node_h)
     target = graded_steps(s, target, np.full(s.size, GRADING))
     kept = None if anchors is None or not len(anchors) else np.intersect1d(anchors, s)
     grid = nodes_from_steps(s, target, kept)
