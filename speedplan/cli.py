@@ -141,7 +141,8 @@ def _add_common(p: argparse.ArgumentParser, out: str | None = None,
     g.add_argument("--backend", choices=BACKENDS, default="auto",
                    help="relaxation solver: banded interior point or Clarabel")
     g.add_argument("--refine", choices=REFINE_MODES, default="auto",
-                   help="IPOPT refinement: auto = only when the relaxation is not exact")
+                   help="local refinement of an inexact relaxation (a banded interior-point "
+                        "NLP, CasADi + IPOPT as fallback): auto = only when it is not exact")
     g.add_argument("--strict", action="store_true",
                    help="exit 5 if verify() finds any limit exceeded beyond its tolerance")
     g = p.add_argument_group("output")
@@ -474,7 +475,7 @@ def _run_bench(args: argparse.Namespace) -> int:
 
     print(f"paper's families, {args.instances} random instance(s) each, n = {args.n}; wall-clock "
           "medians:\n  relaxation [s]: setup + solve of the convex relaxation\n"
-          "  solve_discrete [s]: the whole call (relaxation, plus IPOPT when not exact)")
+          "  solve_discrete [s]: the whole call (relaxation, plus the refinement when not exact)")
     print(f"{'W':8s} {'A':5s} {'J':6s} {'non-exact':>9s} {'relaxation [s]':>15s} "
           f"{'solve_discrete [s]':>19s}")
     for i, fam in enumerate(FAMILIES):

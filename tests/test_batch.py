@@ -8,6 +8,7 @@ import textwrap
 import threading
 import warnings
 from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import replace
 
 import pytest
 from shared import LGV
@@ -33,10 +34,11 @@ def test_executor_must_be_an_executor():
         sp.plan_many([(sp.Path.from_segments([Line(3.0)]), LGV)], executor="local")
 
 
-def _coarse_job():
-    # A 5-node grid on a straight line: verify() finds the jerk beyond tolerance and plan()
-    # warns (LimitWarning).
-    return {"path": sp.Path.from_segments([Line(10.0)]), "limits": LGV, "n": 5}
+def _warning_job():
+    # A G1 corner (arc onto a line) with a lateral-jerk limit: plan() warns that the vehicle
+    # stops at the curvature jump (SpeedplanWarning), on any grid.
+    path = sp.Path.from_waypoints([[0, 0], [10, 0], [10, 10]], kind="polyline")
+    return {"path": path, "limits": replace(LGV, j_lat_max=1.0), "n": 200}
 
 
 def _warnings_in_process(job):
@@ -47,10 +49,10 @@ def _warnings_in_process(job):
 
 
 def test_warnings_of_each_job_come_back_with_its_result():
-    expected = _warnings_in_process(_coarse_job())  # oracle: the same job in this thread
-    assert expected, "the coarse job must warn for this test to mean anything"
+    expected = _warnings_in_process(_warning_job())  # oracle: the same job in this thread
+    assert expected, "the job must warn for this test to mean anything"
     clean = {"path": sp.Path.from_segments([Line(10.0)]), "limits": LGV}
-    jobs = [_coarse_job(), clean, _coarse_job()]
+    jobs = [_warning_job(), clean, _warning_job()]
     with ThreadPoolExecutor(3) as pool:
         results = sp.plan_many(jobs, pool)
     assert [list(r.warnings) for r in results] == [expected, [], expected]
@@ -62,7 +64,7 @@ def test_warnings_of_each_job_come_back_with_its_result():
 def test_thread_pool_capture_leaves_the_warnings_machinery_as_it_was():
     show, filters = warnings.showwarning, list(warnings.filters)
     with ThreadPoolExecutor(4) as pool:
-        sp.plan_many([_coarse_job() for _ in range(8)], pool)
+        sp.plan_many([_warning_job() for _ in range(8)], pool)
     assert warnings.showwarning is show
     assert warnings.filters == filters
 
