@@ -3,6 +3,9 @@
 Speed, tangential-acceleration, lateral-acceleration and true jerk limits; see :func:`plan`.
 """
 
+import importlib
+from types import ModuleType
+
 from ._version import __version__
 from .batch import BatchResult, plan_many
 from .core.errors import (
@@ -49,3 +52,13 @@ __all__ = [
     "solve_discrete",
     "speed_bounds",
 ]
+
+#: Submodules imported on first attribute access (``speedplan.io.read_path`` after a plain
+#: ``import speedplan``), so that the import itself stays light.
+_LAZY_SUBMODULES = ("cli", "io", "plot")
+
+
+def __getattr__(name: str) -> ModuleType:
+    if name in _LAZY_SUBMODULES:
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module 'speedplan' has no attribute {name!r}")

@@ -45,3 +45,13 @@ def test_import_speedplan_loads_no_casadi_matplotlib_or_numba(request):
 )
 def test_each_lazy_module_is_loaded_by_its_user(request, code, loaded):
     assert _loaded_after(code, str(request.config.rootpath)) == loaded
+
+
+def test_submodules_are_reachable_as_attributes_without_importing_them_first():
+    code = ("import sys, speedplan; assert 'matplotlib' not in sys.modules; "
+            "speedplan.io.read_path; assert 'matplotlib' not in sys.modules; "
+            "speedplan.plot.plot_profile; "
+            "speedplan.cli.main; print('ok')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=False)
+    assert out.stdout.strip() == "ok", out.stderr
