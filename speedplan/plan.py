@@ -106,7 +106,9 @@ def plan(
         waypoints), or boundary speeds beyond the speed bound.
     InfeasibleError
         No jerk-limited motion meets the boundary states (the message says which state, which
-        limit and where, ``s`` in metres).
+        limit and where, ``s`` in metres). Moving states that ``j_max`` misses by a hair but
+        ``j_max (1 + STATE_JERK_SLACK)`` (2 %) reaches are planned with that jerk instead, with
+        a :class:`~speedplan.SpeedplanWarning`.
 
     Examples
     --------

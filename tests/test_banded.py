@@ -46,8 +46,8 @@ def _check_against_clarabel(p: DiscreteProblem, statuses=("Solved",)) -> None:
     # Clarabel's objective is not a rigorous upper bound (its w may exceed bounds by ~1e-8).
     assert res.dual_objective <= ref.primal_objective * (1 + 1e-7)
     # Certified gap: as tight as Clarabel's default (1e-8) when "Solved"; when the method
-    # stalls short of tol it says "AlmostSolved", whose contract is a certified gap <= 1e-6.
-    gap_tol = 1e-8 if res.status == "Solved" else 1e-6
+    # stalls short of tol it says "AlmostSolved", whose contract is a certified gap <= 1e-5.
+    gap_tol = 1e-8 if res.status == "Solved" else 1e-5
     assert res.primal_objective - res.dual_objective <= gap_tol * res.primal_objective
     assert res.primal_objective == pytest.approx(p.travel_time(w), rel=1e-6) or (
         p.jerk_violation(w) > 0  # when not exact, t exceeds τ/sqrt(w) at some nodes
@@ -167,7 +167,7 @@ def test_zero_speed_bound_inside_is_infeasible():
 
 @pytest.mark.parametrize("code", ["NUMERICAL_ERROR", "MAX_ITERATIONS", "NO_PROGRESS"])
 def test_banded_stop_is_accepted_on_its_certificate_whatever_stopped_it(monkeypatch, code):
-    # The kernel's stop reason does not decide: a feasible w with a certified gap <= 1e-6 is
+    # The kernel's stop reason does not decide: a feasible w with a certified gap <= 1e-5 is
     # "AlmostSolved" (here a converged iterate reported as a failure); a poor one raises.
     from speedplan.solve import _banded_ipm as ipm
 
@@ -185,7 +185,7 @@ def test_banded_stop_is_accepted_on_its_certificate_whatever_stopped_it(monkeypa
     res = solve_relaxation_banded(problem)
     assert res.status == "AlmostSolved"
     assert res.primal_objective == ref.primal_objective
-    assert res.primal_objective - res.dual_objective <= 1e-6 * res.primal_objective
+    assert res.primal_objective - res.dual_objective <= 1e-5 * res.primal_objective
     with pytest.raises(SolverError, match=ipm.STATUS_NAMES[getattr(ipm, code)]):
         solve_relaxation_banded(problem, max_iter=2)
 
