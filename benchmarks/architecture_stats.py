@@ -26,12 +26,16 @@ from __future__ import annotations
 import argparse
 import ast
 import subprocess
+import sys
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 CONTRACT = ROOT / "tests" / "test_architecture.py"
+sys.path.insert(0, str(ROOT / "tests"))
+
+from shared import imported_modules  # noqa: E402  (the contract test's own resolution)
 
 
 def contract_layers(file: Path = CONTRACT) -> tuple[str, ...]:
@@ -75,25 +79,6 @@ def module_name(path: str) -> str:
     if parts[-1] == "__init__":
         parts.pop()
     return ".".join(parts)
-
-
-def imported_modules(tree: ast.AST, module: str, is_package: bool) -> list[str]:
-    """``speedplan`` modules (or ``module.name``) imported anywhere in ``tree``, as the test."""
-    package = module if is_package else module.rsplit(".", 1)[0]
-    out: list[str] = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")
-                base = base[: len(base) - node.level + 1]
-                target = ".".join(base + ([node.module] if node.module else []))
-            else:
-                target = node.module or ""
-            names = [target] if node.module else [f"{target}.{a.name}" for a in node.names]
-            out.extend(n for n in names if n.startswith("speedplan"))
-        elif isinstance(node, ast.Import):
-            out.extend(a.name for a in node.names if a.name.startswith("speedplan"))
-    return out
 
 
 @dataclass(frozen=True)

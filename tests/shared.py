@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import os
 
 from speedplan import Limits
@@ -21,3 +22,27 @@ if HYPOTHESIS_PROFILE not in ("ci", "dev", "deep"):
 def examples(n: int) -> int:
     """``n`` hypothesis examples, ten times as many under the ``deep`` profile."""
     return 10 * n if HYPOTHESIS_PROFILE == "deep" else n
+
+
+def imported_modules(tree: ast.AST, module: str, is_package: bool = False) -> list[str]:
+    """``speedplan`` modules (or ``module.name``) imported anywhere in ``tree`` by ``module``.
+
+    Relative imports are resolved against ``module`` (its own package when ``is_package``);
+    imports inside functions count too. Used by the import-contract test and by
+    ``benchmarks/architecture_stats.py``.
+    """
+    package = module if is_package else module.rsplit(".", 1)[0]
+    out: list[str] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[: len(base) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            names = [target] if node.module else [f"{target}.{a.name}" for a in node.names]
+            out.extend(n for n in names if n.startswith("speedplan"))
+        elif isinstance(node, ast.Import):
+            out.extend(a.name for a in node.names if a.name.startswith("speedplan"))
+    return out

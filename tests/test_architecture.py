@@ -11,6 +11,7 @@ import ast
 from pathlib import Path
 
 import pytest
+from shared import imported_modules
 
 PACKAGE = Path(__file__).resolve().parent.parent / "speedplan"
 LAYERS = ("core", "geometry", "solve", "model", "timing", "route")
@@ -35,21 +36,7 @@ def _layer(module: str) -> int:
 
 
 def _imports(source: str, module: str, is_package: bool = False) -> list[str]:
-    package = module if is_package else module.rsplit(".", 1)[0]
-    out = []
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")
-                base = base[: len(base) - node.level + 1]
-                target = ".".join(base + ([node.module] if node.module else []))
-            else:
-                target = node.module or ""
-            names = [target] if node.module else [f"{target}.{a.name}" for a in node.names]
-            out.extend(n for n in names if n.startswith("speedplan"))
-        elif isinstance(node, ast.Import):
-            out.extend(a.name for a in node.names if a.name.startswith("speedplan"))
-    return out
+    return imported_modules(ast.parse(source), module, is_package)
 
 
 FILES = sorted(PACKAGE.rglob("*.py"))
