@@ -46,9 +46,13 @@ def ruckig_move(length, lim, v0=0.0, a0=0.0, vf=0.0, af=0.0):
     if result != Result.Working:
         return RuckigAnswer(None)
     T = traj.duration
-    # Dense near both ends, where a braking pre-trajectory would leave the limits.
-    t = np.unique(np.concatenate((np.linspace(0, min(T, 5.0), 4001), np.linspace(0, T, 4001),
-                                  np.linspace(max(T - 5.0, 0.0), T, 4001))))
+    # Dense near both ends, where a braking pre-trajectory would leave the limits: over the
+    # time a full change of acceleration and speed takes (a 48 km move's dip below 0 at
+    # 6.8 s, from a0 = -0.27 at j_max = 0.04, fell between samples 8 s apart).
+    a_hi, a_lo = max(lim.a_max, lim.a_decel), min(lim.a_max, lim.a_decel)
+    edge = min(T, max(5.0, 3.0 * (a_hi / lim.j_max + lim.v_max / a_lo)))
+    t = np.unique(np.concatenate((np.linspace(0, edge, 8001), np.linspace(0, T, 4001),
+                                  np.linspace(T - edge, T, 8001))))
     vel = np.array([traj.at_time(x)[1][0] for x in t])
     if vel.min() < -1e-9 * lim.v_max or vel.max() > lim.v_max * (1 + 1e-9):
         return RuckigAnswer(None)
