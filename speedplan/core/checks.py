@@ -7,7 +7,7 @@ argument, shows the offending value and says what to do.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,6 +16,7 @@ from .errors import InvalidInputError
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
+T = TypeVar("T")
 
 #: Largest grid a single solve accepts; beyond it memory, not the solver, becomes the limit.
 MAX_GRID_POINTS = 5_000_000
@@ -115,6 +116,35 @@ def broadcast_positive(
             f"`{name}` must be > 0 everywhere; got {shown(arr[bad])} at index {bad}"
         )
     return arr
+
+
+def instances(name: str, value: Any, kind: type[T]) -> list[T]:
+    """``value`` as a list of ``kind``: ``None`` is empty, one instance a list of one.
+
+    Examples
+    --------
+    >>> instances("x", None, int), instances("x", 3, int), instances("x", (1, 2), int)
+    ([], [3], [1, 2])
+    >>> instances("zones", [1, "a"], int)
+    Traceback (most recent call last):
+    ...
+    speedplan.core.errors.InvalidInputError: `zones[1]` must be a int; got str
+    """
+    if value is None:
+        return []
+    if isinstance(value, kind):
+        return [value]
+    if isinstance(value, str | bytes) or not hasattr(value, "__iter__"):
+        raise InvalidInputError(
+            f"`{name}` must be a sequence of {kind.__name__}; got {type(value).__name__}"
+        )
+    items = list(value)
+    for i, item in enumerate(items):
+        if not isinstance(item, kind):
+            raise InvalidInputError(
+                f"`{name}[{i}]` must be a {kind.__name__}; got {type(item).__name__}"
+            )
+    return items
 
 
 def choice(name: str, value: Any, options: Iterable[str]) -> str:

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import shapely
 
-from ..core.checks import FloatArray, as_array, as_scalar
+from ..core.checks import FloatArray, as_array, as_scalar, instances
 from ..core.errors import InvalidInputError
 from ..core.limits import Limits
 from .path import Path
@@ -115,17 +115,8 @@ class SpanLimit:
 
 def check_spans(spans: Any, length: float | None = None) -> list[SpanLimit]:
     """``spans`` as a list of :class:`SpanLimit` (one, a sequence, or ``None``)."""
-    if spans is None:
-        return []
-    items = [spans] if isinstance(spans, SpanLimit) else spans
-    if isinstance(items, str | bytes) or not hasattr(items, "__iter__"):
-        raise InvalidInputError(f"`spans` must be a sequence of SpanLimit; got {spans!r}")
-    out = list(items)
+    out = instances("spans", spans, SpanLimit)
     for i, span in enumerate(out):
-        if not isinstance(span, SpanLimit):
-            raise InvalidInputError(
-                f"`spans[{i}]` must be a SpanLimit; got {type(span).__name__}"
-            )
         if length is not None and span.end > length * (1 + 1e-9):
             raise InvalidInputError(
                 f"`spans[{i}]` ends at {span.end:.9g} m, beyond the path's length "
@@ -365,17 +356,4 @@ def check_zones(zones: Any) -> list[SpeedZone]:
     >>> check_zones(z) == check_zones([z]) == [z]
     True
     """
-    if zones is None:
-        return []
-    if isinstance(zones, SpeedZone):
-        return [zones]
-    try:
-        zone_list = list(zones)
-    except TypeError as exc:
-        raise InvalidInputError(
-            f"`zones` must be a sequence of SpeedZone; got {type(zones).__name__}"
-        ) from exc
-    for i, z in enumerate(zone_list):
-        if not isinstance(z, SpeedZone):
-            raise InvalidInputError(f"`zones[{i}]` must be a SpeedZone; got {type(z).__name__}")
-    return zone_list
+    return instances("zones", zones, SpeedZone)

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.checks import FloatArray
+from ..core.checks import FloatArray, instances
 from ..core.errors import InvalidInputError
 from ..geometry import Path
 from ..geometry._checks import wrap_angle
@@ -264,17 +264,8 @@ class Route:
     _stops: tuple[tuple[int, str], ...] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        for name, kind in (("nodes", RouteNode), ("edges", RouteEdge)):
-            items: Any = getattr(self, name)
-            if isinstance(items, str | bytes) or not hasattr(items, "__iter__"):
-                raise InvalidInputError(f"`{name}` must be a sequence of {kind.__name__}")
-            items = tuple(items)
-            for i, item in enumerate(items):
-                if not isinstance(item, kind):
-                    raise InvalidInputError(
-                        f"`{name}[{i}]` must be a {kind.__name__}; got {type(item).__name__}"
-                    )
-            object.__setattr__(self, name, items)
+        object.__setattr__(self, "nodes", tuple(instances("nodes", self.nodes, RouteNode)))
+        object.__setattr__(self, "edges", tuple(instances("edges", self.edges, RouteEdge)))
         if len(self.nodes) < 2:
             raise InvalidInputError(
                 f"`nodes`: a route needs at least two nodes (and an edge); got {len(self.nodes)}"
