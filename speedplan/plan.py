@@ -148,12 +148,13 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
     # Each leg is checked once per law it gets: the final verification merges these checks
     # (what profile.verify() computes) instead of checking every leg again.
     leg_checks = [profile.check_leg(i) for i in range(len(legs))]
+    stuck: set[int] = set()  # legs whose refined law did not arrive: retrying repeats it
     for _ in range(MAX_REFINEMENTS):
         if all(c.verification.ok for c in leg_checks):
             break
         changed = []
         for i, (leg, leg_check) in enumerate(zip(model.legs, leg_checks, strict=True)):
-            if not leg_check.verification.ok and isinstance(leg, Leg):
+            if not leg_check.verification.ok and isinstance(leg, Leg) and i not in stuck:
                 grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess,
                                     leg.anchors, refine_factor(leg_check.verification))
                 finer = leg_on_grid(modelled, leg.bound, grid, leg.start, leg.v0, leg.a0,
@@ -161,6 +162,7 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
                 try:
                     legs[i] = _solve(finer)
                 except SolverError:  # keep the verified law; its excess is reported below
+                    stuck.add(i)
                     continue
                 changed.append(i)
         profile = replace(profile, legs=tuple(legs))
