@@ -9,13 +9,15 @@ file) and comfort limits ``j_lat_max`` in {1.0, 0.3} m/s³, ``yaw_rate_max`` 0.4
 whether the relaxation was exact, the certified gap, the duration cost against the plain limits
 and whether ``verify()`` holds. Part 2: a fuzz of random G2 waypoint paths (4–8 waypoints in
 a 40 m square, deviations 0.1–1 m) with random limits (``j_lat_max`` 0.05–3 m/s³, ``yaw_rate_max``
-0.2–2 rad/s or none): the share of exact relaxations, the gap quantiles, verification failures.
+0.2–2 rad/s or none): the share of exact relaxations, the gap quantiles, verification failures
+and the seconds each `plan()` took.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 import warnings
 from pathlib import Path
 
@@ -50,7 +52,7 @@ def sample_paths() -> None:
 def fuzz(cases: int, seed: int) -> None:
     rng = np.random.default_rng(seed)
     exact = refined = flagged = failed = 0
-    gaps = []
+    gaps, seconds = [], []
     for _ in range(cases):
         k = int(rng.integers(4, 9))
         pts = np.cumsum(rng.uniform(-10, 10, size=(k, 2)), axis=0)
@@ -63,7 +65,9 @@ def fuzz(cases: int, seed: int) -> None:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
+                start = time.perf_counter()
                 prof = sp.plan(path, lim)
+                seconds.append(time.perf_counter() - start)
         except sp.SpeedplanError as exc:
             failed += 1
             print(f"  error: {type(exc).__name__}: {exc}"[:160])
@@ -77,6 +81,10 @@ def fuzz(cases: int, seed: int) -> None:
     print(f"fuzz: {done} planned, {failed} errors; exact {exact}/{done} "
           f"({exact / max(done, 1):.0%}), refined {refined}, limits_exceeded {flagged}; "
           f"gap median {q[0]:.2e}, 90% {q[1]:.2e}, max {q[2]:.2e}")
+    if seconds:
+        sec = np.quantile(seconds, [0.5, 0.9, 1.0])
+        print(f"seconds per plan(): median {sec[0]:.2f}, 90% {sec[1]:.2f}, max {sec[2]:.2f}; "
+              f"over 2 s: {sum(x > 2.0 for x in seconds)} of {len(seconds)}")
 
 
 def main() -> int:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import time
 import warnings
 from collections.abc import Sequence
@@ -182,28 +183,37 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
 
 
 def _model_within_state_slack(request: PlanRequest) -> tuple[PlanRequest, Model]:
-    """The request's model, or one with ``j_max (1 + STATE_JERK_SLACK)`` for marginal states.
+    """The request's model, else with exact reach envelopes, else with a hair more jerk.
 
-    Marginal: moving boundary states just outside what ``j_max`` reaches (with a warning).
+    Moving boundary states are capped by the max-jerk motion (``reach="max_jerk"``), which
+    keeps the relaxation exact but misses feasible motions whose speed first dips: if it
+    refuses the states, the exact envelope in distance (``reach="distance"``) decides.
 
-    A state read off a planned trajectory (whose jerk may exceed ``j_max`` within its 5 %
-    tolerance, e.g. for an order update) or measured on the vehicle can lie a hair outside
-    the set a jerk-limited motion reaches; refusing it would strand the vehicle. The plan is
-    still verified against the requested limits.
+    Marginal states: moving boundary states just outside what ``j_max`` reaches are planned
+    with ``j_max (1 + STATE_JERK_SLACK)`` (with a warning). A state read off a planned
+    trajectory (whose jerk may exceed ``j_max`` within its 5 % tolerance, e.g. for an order
+    update) or measured on the vehicle can lie a hair outside the set a jerk-limited motion
+    reaches; refusing it would strand the vehicle. The plan is still verified against the
+    requested limits.
     """
+    moving = any(x != 0.0 for x in (request.v0, request.a0, request.vf, request.af))
     try:
         return request, build_model(request)
     except InfeasibleError as exc:
-        moving = any(x != 0.0 for x in (request.v0, request.a0, request.vf, request.af))
         if not (moving and request.jerk_limited and exc.constraint in STATE_CONSTRAINTS):
             raise
-        refusal = str(exc)
-        lim = request.limits
-        looser = replace(request, limits=replace(lim, j_max=state_jerk(lim.j_max)))
-        try:
+        refusal = exc
+    exact = replace(request, reach="distance")
+    with contextlib.suppress(InfeasibleError):
+        return exact, build_model(exact)
+    lim = request.limits
+    looser_jerk = replace(lim, j_max=state_jerk(lim.j_max))
+    for looser in (replace(request, limits=looser_jerk), replace(exact, limits=looser_jerk)):
+        with contextlib.suppress(InfeasibleError):
             model = build_model(looser)
-        except InfeasibleError:
-            raise exc from None
+            break
+    else:
+        raise refusal from None
     warnings.warn(
         f"the boundary states are reachable only with {STATE_JERK_SLACK:.0%} more jerk than "
         f"j_max={lim.j_max:.6g} m/s³ ({refusal}); planned with j_max={looser.limits.j_max:.6g} "

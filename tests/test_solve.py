@@ -319,3 +319,29 @@ def test_very_fine_grid_gets_a_certified_answer(name):
     assert prof.status == "optimal"
     assert sol.objective - sol.lower_bound <= 1e-6 * sol.objective
     assert prof.verify().ok
+
+
+def test_a_relaxed_law_that_stops_inside_the_leg_falls_back_to_the_other_backend(monkeypatch):
+    # Trust fuzz, first use: while the banded kernel compiled, Clarabel answered a 7 km move
+    # (steps 1e-8..72 m) "AlmostSolved" with w = 0 next to the end; plan() then raised
+    # SolverError ("comes to rest before its end"). Such an answer is a stall, not a solution.
+    from dataclasses import replace
+
+    from speedplan.solve import discrete
+
+    inst = paper_instance(*FAMILIES[0], n=200, seed=0)
+    reference = solve_discrete(inst.w_max, inst.A, inst.J, backend="banded", refine="never")
+    clarabel = discrete.RELAXATION_BACKENDS["clarabel"]
+
+    def stalled(unit):
+        out = clarabel(unit)
+        w = out.w.copy()
+        w[-2] = 0.0
+        return replace(out, w=w, status="AlmostSolved")
+
+    monkeypatch.setitem(discrete.RELAXATION_BACKENDS, "clarabel", stalled)
+    sol = solve_discrete(inst.w_max, inst.A, inst.J, backend="clarabel", refine="never")
+    assert sol.relaxation.backend == "banded"
+    assert "comes to rest inside the leg" in sol.relaxation.fallback
+    assert np.isfinite(sol.objective)
+    np.testing.assert_allclose(sol.w, reference.w, rtol=1e-12, atol=0)

@@ -4,11 +4,17 @@ Along a straight line the motion is 1-D: position ``s``, speed ``v >= 0``, accel
 in ``[-a_decel, a_max]``, jerk in ``[-j, j]``. Everything here is a closed form of that
 system.
 
-* **Envelopes.** The fastest motion leaving ``(v0, a0)`` applies ``+j`` until the acceleration
-  reaches ``a_max``, then holds it; the slowest applies ``-j`` down to ``-a_decel``. No
-  jerk-limited motion is faster (slower) at any ``s``, so they bound ``w = v²`` from above
-  (below) — :func:`jerk_motion_w`; from rest the upper one is ``(j²/4)(6 s/j)^{4/3}``
-  (:func:`max_jerk_envelope`). The same at the end, time reversed (``a -> -a``).
+* **Envelopes.** The slowest motion leaving ``(v0, a0)`` applies ``-j`` down to ``-a_decel``;
+  no jerk-limited motion is slower at any ``s`` (one that gets to ``s`` earlier has had less
+  time to lower its acceleration), so it bounds ``w = v²`` from below — :func:`jerk_motion_w`.
+  The largest ``w`` at a distance is *not* the fastest motion in time (``+j`` up to ``a_max``):
+  a motion that is slower gets to ``s`` later and may have built up more acceleration by
+  then. By Pontryagin's principle the motion that maximises ``v`` at a given distance applies
+  ``-j`` then ``+j`` (one switch), and the speed bound ``v >= 0`` makes the extreme either no
+  ``-j`` at all or the stop-and-go motion: brake to rest in the shortest distance, then
+  ``+j`` from rest. :func:`fastest_w` is the larger of the two; from rest it is
+  ``(j²/4)(6 s/j)^{4/3}`` up to ``a_max`` (:func:`max_jerk_envelope`). The same at the end,
+  time reversed (``a -> -a``).
 * **Reachability.** From ``(v0, a0)`` the speed passes through ``v0 + a0 |a0| / (2 j)`` at
   least (it keeps rising while the acceleration is brought to 0): above ``v_max`` the state
   cannot be met, below 0 it cannot either, and at exactly 0 the vehicle comes to rest on the
@@ -31,6 +37,7 @@ __all__ = [
     "STATE_JERK_SLACK",
     "Phase",
     "check_reachable_states",
+    "fastest_w",
     "jerk_motion_w",
     "max_jerk_envelope",
     "min_distance",
@@ -164,6 +171,38 @@ def jerk_motion_w(d: FloatArray, v: float, a: float, jerk: float, a_limit: float
         w_after = np.maximum(v1 * v1 + 2.0 * a_limit * (d - s_jerk), 0.0)
     out: FloatArray = np.where(in_jerk, vj * vj, w_after)
     return np.where(d == 0, v * v, out)
+
+
+def fastest_w(d: FloatArray, v: float, a: float, j_max: float, a_limit: float,
+              a_brake: float) -> FloatArray:
+    """Largest ``w = v²`` a jerk-limited motion leaving ``(v, a)`` can have at distance ``d``.
+
+    The upper envelope in distance: the larger of the maximum-jerk motion
+    (:func:`jerk_motion_w` with ``+j_max`` up to ``a_limit``) and the stop-and-go motion,
+    which brakes to rest in the shortest distance (:func:`stop_distance`, deceleration up to
+    ``a_brake``) and then starts again with ``+j_max``. The second is larger far enough
+    away: having come to rest it covers the distance later, with more acceleration built up.
+    See the module docstring for why no other motion is faster at ``d``.
+
+    Examples
+    --------
+    From 0.3 m/s braking at 0.2 m/s² (``j = 0.1``), 2 m on, the motion that first comes to
+    rest is faster than the one that raises its acceleration at once:
+
+    >>> import numpy as np
+    >>> d = np.array([2.0])
+    >>> fast_in_time = jerk_motion_w(d, 0.3, -0.2, 0.1, 1.0)
+    >>> bool(fastest_w(d, 0.3, -0.2, 0.1, 1.0, 1.0)[0] > fast_in_time[0])
+    True
+    """
+    d = np.maximum(np.asarray(d, dtype=np.float64), 0.0)
+    w = jerk_motion_w(d, v, a, j_max, a_limit)
+    if v <= 0.0 or not np.isfinite(j_max):
+        return w
+    braking = stop_distance(v, a, j_max, a_brake)
+    restart = jerk_motion_w(d - braking, 0.0, 0.0, j_max, a_limit)
+    out: FloatArray = np.where(d > braking, np.maximum(w, restart), w)
+    return out
 
 
 def _first_stop(v: float, a: float, jerk: float, t_max: float) -> float:

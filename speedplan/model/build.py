@@ -22,7 +22,7 @@ from ..core.limits import Limits
 from ..geometry import Path, SpeedBound
 from ..solve import DiscreteProblem, DiscreteSolution, solve_problem
 from ..solve.problem import StencilRows
-from .boundary import check_reachable_states, jerk_motion_w, turnaround_speed
+from .boundary import check_reachable_states, fastest_w, jerk_motion_w, turnaround_speed
 from .grid import adaptive_grid, uniform_grid
 from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
@@ -272,8 +272,7 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
     length = hi - lo
     leg_bound = bound if (lo == 0.0 and hi == float(request.path.length)) else _sub_bound(
         request, bound, lo, hi)
-    env = _Envelopes(lim, request.smooth_standstill, request.jerk_limited, v0, a0, vf, af,
-                     length)
+    env = _Envelopes.of(request, v0, a0, vf, af, length)
     if request.n is not None or request.ds is not None:
         n = None if request.n is None else request.n
         s = uniform_grid(length, n=n, ds=request.ds)
@@ -297,8 +296,7 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     """The leg's discrete problem on the grid ``s`` (from 0 to the leg's length)."""
     lim = request.limits
     length = float(s[-1])
-    env = _Envelopes(lim, request.smooth_standstill, request.jerk_limited, v0, a0, vf, af,
-                     length)
+    env = _Envelopes.of(request, v0, a0, vf, af, length)
     w_max = env.cap(s, node_bounds(bound, s))
     w_max[0] = max(w_max[0], v0 * v0)
     w_max[-1] = max(w_max[-1], vf * vf)
@@ -455,22 +453,39 @@ class _Envelopes:
     vf: float
     af: float
     length: float
+    in_distance: bool = False
+
+    @classmethod
+    def of(cls, request: PlanRequest, v0: float, a0: float, vf: float, af: float,
+           length: float) -> _Envelopes:
+        """The envelopes of one leg of ``request`` between the given states."""
+        return cls(request.limits, request.smooth_standstill, request.jerk_limited, v0, a0,
+                   vf, af, length, in_distance=request.reach == "distance")
 
     def cap(self, s: FloatArray, w: FloatArray) -> FloatArray:
-        """``w`` capped by the fastest motion leaving (v0, a0) and arriving at (vf, af).
+        """``w`` capped by the largest ``w`` reachable from (v0, a0) and reaching (vf, af).
 
         At rest the cap is the max-jerk start only for a smooth standstill (the paper's free
-        standstill lets the acceleration jump there); a moving state is always capped.
+        standstill lets the acceleration jump there); a moving state is always capped: by
+        the max-jerk motion, or with ``in_distance`` by the envelope in distance
+        (:func:`~speedplan.model.boundary.fastest_w`), which is above it where the vehicle
+        could brake to rest and start again (``PlanRequest.reach``).
         """
         lim = self.limits
         if not self.jerk_limited:
             return w
         if self.smooth or self.v0 > 0:
-            w = np.minimum(w, jerk_motion_w(s, self.v0, self.a0, lim.j_max, lim.a_max))
+            w = np.minimum(w, self._fastest(s, self.v0, self.a0, lim.a_max, lim.a_decel))
         if self.smooth or self.vf > 0:
-            w = np.minimum(w, jerk_motion_w(self.length - s, self.vf, -self.af, lim.j_max,
-                                            lim.a_decel))
+            w = np.minimum(w, self._fastest(self.length - s, self.vf, -self.af, lim.a_decel,
+                                            lim.a_max))
         return w
+
+    def _fastest(self, d: FloatArray, v: float, a: float, a_limit: float,
+                 a_brake: float) -> FloatArray:
+        if self.in_distance:
+            return fastest_w(d, v, a, self.limits.j_max, a_limit, a_brake)
+        return jerk_motion_w(d, v, a, self.limits.j_max, a_limit)
 
     def floor(self, s: FloatArray) -> FloatArray | None:
         """The slowest motion leaving a moving start (and arriving at a moving end)."""

@@ -15,11 +15,19 @@ from ..geometry import Path, SpeedZone
 from ..geometry.bounds import SpanLimit, check_spans, check_zones
 from ..solve.discrete import BACKENDS, REFINE_MODES
 
-__all__ = ["MIN_RELATIVE_LENGTH", "STANDSTILL_MODES", "PlanRequest"]
+__all__ = ["MIN_RELATIVE_LENGTH", "REACH_MODES", "STANDSTILL_MODES", "PlanRequest"]
 
 #: ``"smooth"``: acceleration is 0 at a standstill and jerk-limited from the first instant.
 #: ``"free"``: the paper's model, where acceleration may jump at a standstill.
 STANDSTILL_MODES = ("smooth", "free")
+#: The upper envelope that caps ``w`` next to a moving boundary state (``PlanRequest.reach``):
+#: ``"max_jerk"``, the fastest motion in time (``+j_max`` at once), tight and keeping the
+#: relaxation exact, but below the speed of some feasible motions where the speed first dips;
+#: ``"distance"``, the exact largest ``w`` at each distance
+#: (:func:`~speedplan.model.boundary.fastest_w`), whose kinks can leave the relaxation
+#: inexact. :func:`speedplan.plan` uses the first and falls back to the second when the first
+#: refuses the boundary states.
+REACH_MODES = ("max_jerk", "distance")
 #: Shortest path planned, relative to ``v_max² / a_max`` (4e-9 m for v_max = 2 m/s, a_max = 1
 #: m/s²; relative, so that millimetres and metres agree). Far below any vehicle's resolution;
 #: much shorter paths (nearly coincident waypoints) made the solvers fail with misleading
@@ -60,6 +68,7 @@ class PlanRequest:
     backend: str = "auto"
     stops: tuple[float, ...] = ()
     spans: tuple[SpanLimit, ...] = ()
+    reach: str = "max_jerk"  # one of REACH_MODES; set by plan(), not by callers
 
     @classmethod
     def create(
