@@ -28,6 +28,8 @@ from .law import TimeLaw
 __all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "Verification",
            "bound_breakpoints", "check_law", "curvature_rate"]
 
+#: Points per law piece where path-dependent quantities are evaluated (ends included).
+SAMPLES_PER_PIECE = 5
 #: Documented tolerances at the default resolution, as fractions of each limit; all shrink
 #: as the grid is refined (docs/convergence.md, docs/failure-modes.md).
 TOLERANCES: dict[str, float] = {
@@ -41,8 +43,6 @@ TOLERANCES: dict[str, float] = {
 }
 #: Every checked limit, in report order.
 LIMIT_NAMES = tuple(TOLERANCES)
-#: Points per law piece where path-dependent quantities are evaluated (ends included).
-SAMPLES_PER_PIECE = 5
 
 
 @dataclass(frozen=True)
