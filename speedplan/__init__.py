@@ -8,15 +8,15 @@ from types import ModuleType
 
 from ._version import __version__
 from .batch import BatchResult, plan_many
-from .core.errors import (
+from .core import (
     InfeasibleError,
     InvalidInputError,
+    Limits,
     LimitWarning,
     SolverError,
     SpeedplanError,
     SpeedplanWarning,
 )
-from .core.limits import Limits
 from .geometry import Path, SpanLimit, SpeedZone, speed_bounds
 from .plan import plan
 from .route import Route, RouteProfile

@@ -22,13 +22,6 @@ from .timing import SpeedProfile
 __all__ = ["BatchResult", "JobWarning", "plan_many"]
 
 
-class JobWarning(NamedTuple):
-    """A warning issued while a job ran: the name of its category and its message."""
-
-    category: str
-    message: str
-
-
 @dataclass(frozen=True)
 class BatchResult:
     """Outcome of one job: ``profile`` on success, else ``error`` (the exception raised).
@@ -58,6 +51,13 @@ class BatchResult:
     def ok(self) -> bool:
         """Whether the job produced a profile."""
         return self.error is None
+
+
+class JobWarning(NamedTuple):
+    """A warning issued while a job ran: the name of its category and its message."""
+
+    category: str
+    message: str
 
 
 class _Outcome(NamedTuple):

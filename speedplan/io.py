@@ -600,13 +600,8 @@ def write_nurbs(
     _write_text(file, json.dumps(doc, indent=1) + "\n", "VDA 5050 NURBS JSON")
 
 
-def write_trajectory(
-    file: FileName,
-    degree: int,
-    knots: Any,
-    control_points: Any,
-    weights: Any = None,
-) -> None:
+def write_trajectory(file: FileName, degree: int, knots: Any, control_points: Any,
+                     weights: Any = None) -> None:
     """Deprecated name of :func:`write_nurbs` (it writes a path, not a trajectory in time).
 
     Warns

@@ -185,9 +185,14 @@ def plot_acceleration(trajectory: Trajectory, limits: Limits, ax: Any = None) ->
     return ax
 
 
-def _symmetric(ax: Any, t: Any, y: Any, limit: float, limit_label: str,
-               style: dict[str, Any]) -> Any:
-    """A trace ``y(t)`` against ``±limit`` (none when infinite), legend above the traces."""
+def _symmetric(ax: Any, t: Any, y: Any, limit: float, limit_label: str, style: dict[str, Any],
+               **labels: str) -> Any:
+    """A trace ``y(t)`` against ``±limit`` (none when infinite), legend above the traces.
+
+    ``ax`` as the public functions take it; ``labels`` are the ``ylabel`` and ``title``.
+    """
+    ax = _axes(ax)
+    ax.set(xlabel="t [s]", **labels)
     ax.plot(t, y, **style)
     peak = float(np.abs(y).max())
     if np.isfinite(limit):
@@ -205,23 +210,42 @@ def plot_lateral(trajectory: Trajectory, limits: Limits, ax: Any = None) -> Any:
     -------
     matplotlib.axes.Axes
     """
-    ax = _axes(ax)
-    ax.set(xlabel="t [s]", ylabel="a_lat [m/s²]", title="lateral acceleration (+ = left turn)")
     return _symmetric(ax, trajectory.t, trajectory.a_lat, limits.a_lat_max, "limits ±a_lat_max",
-                      {"color": "C2", "label": "lateral a_lat(t)"})
+                      {"color": "C2", "label": "lateral a_lat(t)"}, ylabel="a_lat [m/s²]",
+                      title="lateral acceleration (+ = left turn)")
 
 
 def plot_jerk(trajectory: Trajectory, limits: Limits, ax: Any = None) -> Any:
     """Jerk ``j(t)`` against ``±j_max``.
 
+    Drawn like :func:`plot_lateral` (no limit lines when the limit is infinite).
+
     Returns
     -------
     matplotlib.axes.Axes
     """
-    ax = _axes(ax)
-    ax.set(xlabel="t [s]", ylabel="jerk [m/s³]", title="jerk")
     return _symmetric(ax, trajectory.t, trajectory.j, limits.j_max, "limits ±j_max",
-                      {"color": "C3", "lw": 1.2, "label": "jerk j(t)"})
+                      {"color": "C3", "lw": 1.2, "label": "jerk j(t)"}, ylabel="jerk [m/s³]",
+                      title="jerk")
+
+
+def _panels(fig: Any, figsize: tuple[float, float], mosaic: list[list[str]],
+            height_ratios: list[float]) -> tuple[Any, dict[str, Any]]:
+    """``fig`` (or a new figure of ``figsize``) and its panels' axes by name."""
+    if fig is None:
+        fig = _figure(figsize=figsize, layout="constrained")
+    elif not hasattr(fig, "subplot_mosaic"):
+        raise InvalidInputError(
+            f"`fig` must be a matplotlib Figure or SubFigure; got {type(fig).__name__}"
+        )
+    return fig, fig.subplot_mosaic(mosaic, height_ratios=height_ratios)
+
+
+def _saved(fig: Any, file: str | PathLike[str] | None, dpi: float) -> Any:
+    """The figure holding ``fig`` (itself, or a SubFigure's parent), saved first if ``file``."""
+    if file is not None:
+        fig.savefig(file, dpi=dpi)
+    return getattr(fig, "figure", None) or fig
 
 
 #: Panel names of :func:`plot_profile`, in ``fig.axes`` order (colour bar last).
@@ -278,16 +302,8 @@ def plot_profile(
     >>> fig.savefig(io.BytesIO(), format="svg")
     """
     traj = trajectory if trajectory is not None else profile.sample(dt)
-    if fig is None:
-        fig = _figure(figsize=(11, 9.5), layout="constrained")
-    elif not hasattr(fig, "subplot_mosaic"):
-        raise InvalidInputError(
-            f"`fig` must be a matplotlib Figure or SubFigure; got {type(fig).__name__}"
-        )
-    axes = fig.subplot_mosaic(
-        [["path", "path"], ["speed", "lateral"], ["acceleration", "jerk"]],
-        height_ratios=[1.25, 1, 1],
-    )
+    fig, axes = _panels(fig, (11, 9.5), [["path", "path"], ["speed", "lateral"],
+                                         ["acceleration", "jerk"]], [1.25, 1, 1])
     lim = profile.limits
     zones = profile.request.zones if profile.request is not None else None
     plot_path(traj, axes["path"], v_max=lim.v_max, zones=zones)
@@ -295,24 +311,16 @@ def plot_profile(
     plot_lateral(traj, lim, axes["lateral"])
     plot_acceleration(traj, lim, axes["acceleration"])
     plot_jerk(traj, lim, axes["jerk"])
-    if file is not None:
-        fig.savefig(file, dpi=dpi)
-    return getattr(fig, "figure", None) or fig
+    return _saved(fig, file, dpi)
 
 
 #: Panel names of :func:`plot_route`, in ``fig.axes`` order (colour bar last).
 ROUTE_PANELS = ("path", "speed", "acceleration", "jerk")
 
 
-def plot_route(
-    profile: RouteProfile,
-    file: str | PathLike[str] | None = None,
-    *,
-    trajectory: Trajectory | None = None,
-    dt: float = 0.01,
-    fig: Any = None,
-    dpi: float = DPI,
-) -> Any:
+def plot_route(profile: RouteProfile, file: str | PathLike[str] | None = None, *,
+               trajectory: Trajectory | None = None, dt: float = 0.01, fig: Any = None,
+               dpi: float = DPI) -> Any:
     """Draw a planned route in four panels, optionally saved to ``file``.
 
     The path with its nodes (labelled with their times) and stops; ``v(s)`` against the
@@ -332,27 +340,21 @@ def plot_route(
 
     Examples
     --------
+    A route of one edge, from node A to node B:
+
     >>> from speedplan import Limits, plan_route
     >>> from speedplan.geometry import Line, Path
-    >>> from speedplan.route import Route, RouteEdge, RouteNode
-    >>> nodes = [RouteNode("A", 0, (0.0, 0.0)), RouteNode("B", 2, (6.0, 0.0), stop=True),
-    ...          RouteNode("C", 4, (12.0, 0.0))]
-    >>> edges = [RouteEdge("AB", 1, "A", "B", Path.from_segments([Line(6.0)]), v_max=1.0),
-    ...          RouteEdge("BC", 3, "B", "C", Path.from_segments([Line(6.0)], start=(6, 0)))]
     >>> from speedplan.plot import plot_route
-    >>> fig = plot_route(plan_route(Route(nodes, edges), Limits(2, 1, 1, 0.5)))
+    >>> from speedplan.route import Route, RouteEdge, RouteNode
+    >>> route = Route([RouteNode("A", 0, (0.0, 0.0)), RouteNode("B", 2, (6.0, 0.0))],
+    ...               [RouteEdge("AB", 1, "A", "B", Path.from_segments([Line(6.0)]))])
+    >>> fig = plot_route(plan_route(route, Limits(2, 1, 1, 0.5)))
     >>> [ax.get_xlabel() for ax in fig.axes[:4]]
     ['x [m]', 's [m]', 't [s]', 't [s]']
     """
     traj = trajectory if trajectory is not None else profile.sample(dt)
-    if fig is None:
-        fig = _figure(figsize=(11, 8.5), layout="constrained")
-    elif not hasattr(fig, "subplot_mosaic"):
-        raise InvalidInputError(
-            f"`fig` must be a matplotlib Figure or SubFigure; got {type(fig).__name__}"
-        )
-    axes = fig.subplot_mosaic([["path", "path"], ["speed", "speed"], ["acceleration", "jerk"]],
-                              height_ratios=[1.3, 1, 1])
+    fig, axes = _panels(fig, (11, 8.5), [["path", "path"], ["speed", "speed"],
+                                         ["acceleration", "jerk"]], [1.3, 1, 1])
     lim = profile.legs[0].limits
     route = profile.route
     ax = plot_path(traj, axes["path"], v_max=lim.v_max)
@@ -384,6 +386,4 @@ def plot_route(
     _legend_on_top(sp_ax, HEADROOM * lim.v_max, -0.04 * lim.v_max)
     plot_acceleration(traj, lim, axes["acceleration"])
     plot_jerk(traj, lim, axes["jerk"])
-    if file is not None:
-        fig.savefig(file, dpi=dpi)
-    return getattr(fig, "figure", None) or fig
+    return _saved(fig, file, dpi)

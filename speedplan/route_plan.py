@@ -136,16 +136,15 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
 
     Examples
     --------
+    One 12 m edge limited to 1 m/s (a VDA 5050 order reads into the same
+    :class:`~speedplan.Route`, see :meth:`~speedplan.Route.from_vda5050`):
+
     >>> from speedplan import Limits, plan_route
-    >>> from speedplan.route import Route
-    >>> order = {"version": "2.0.0", "nodes": [
-    ...     {"nodeId": "A", "sequenceId": 0, "released": True, "actions": [],
-    ...      "nodePosition": {"x": 0.0, "y": 0.0, "mapId": "m"}},
-    ...     {"nodeId": "B", "sequenceId": 2, "released": True, "actions": [],
-    ...      "nodePosition": {"x": 12.0, "y": 0.0, "mapId": "m"}}],
-    ...     "edges": [{"edgeId": "AB", "sequenceId": 1, "released": True, "actions": [],
-    ...                "startNodeId": "A", "endNodeId": "B", "maxSpeed": 1.0}]}
-    >>> profile = plan_route(Route.from_vda5050(order), Limits(2, 1, 1, 0.5))
+    >>> from speedplan.geometry import Line, Path
+    >>> from speedplan.route import Route, RouteEdge, RouteNode
+    >>> edge = RouteEdge("AB", 1, "A", "B", Path.from_segments([Line(12.0)]), v_max=1.0)
+    >>> route = Route([RouteNode("A", 0, (0.0, 0.0)), RouteNode("B", 2, (12.0, 0.0))], [edge])
+    >>> profile = plan_route(route, Limits(2, 1, 1, 0.5))
 
     At the edge's 1 m/s the jerk-limited start (and stop) takes ``2 sqrt(v/j) = 2.828`` s over
     1.414 m; 9.172 m of cruise remain: 14.828 s in all.

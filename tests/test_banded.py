@@ -207,14 +207,14 @@ def _newton_state(seed: int):
         u[0] = np.hypot(u[1], u[2]) * (1.0 + 10.0 ** rng.uniform(-2, 0, lay.nc))
         return u
 
-    pt = ipm.Point.empty(lay)
+    pt = ipm.empty(ipm.Point, lay)
     pt.sl[:], pt.yl[:] = 10.0 ** rng.uniform(-2, 2, (2, lay.n_lin))
     pt.ss[:], pt.ys[:] = cone_interior(), cone_interior()
     sc = ipm.Scaling.identity(lay)
     ipm.scaling_into(pt.ss, pt.ys, sc)
-    fac = ipm.Factor.empty(lay)
+    fac = ipm.empty(ipm.Factor, lay)
     assert ipm.factor_into(d, sc, pt.yl, pt.sl, fac)
-    res, rhs = ipm.Residual.empty(lay), ipm.Rhs.empty(lay)
+    res, rhs = ipm.empty(ipm.Residual, lay), ipm.empty(ipm.Rhs, lay)
     for arr in (*res, *rhs):
         arr[:] = rng.normal(size=arr.shape)
     return ipm, d, sc, fac, pt, res, rhs
@@ -228,8 +228,8 @@ def test_newton_refines_only_above_its_residual_threshold(seed):
     lay = d.lay
 
     def direction(refine_above):
-        dn = ipm.Direction.empty(lay)
-        ipm.newton_into(d, sc, fac, ipm.Work.empty(lay), pt, res, rhs, refine_above, dn)
+        dn = ipm.empty(ipm.Direction, lay)
+        ipm.newton_into(d, sc, fac, ipm.empty(ipm.Work, lay), pt, res, rhs, refine_above, dn)
         gx = (np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m))
         ipm.g_adjoint_into(d, dn.dyl, dn.dys, *gx)
         residual = np.sqrt(sum(float(np.sum((b - g) ** 2))

@@ -186,12 +186,12 @@ def _random_state(seed: int):
     unit, d = _setup(seed)
     lay = d.lay
     rng = np.random.default_rng(100 + seed)
-    pt = ipm.Point.empty(lay)
+    pt = ipm.empty(ipm.Point, lay)
     pt.sl[:], pt.yl[:] = 10.0 ** rng.uniform(-1, 1, (2, lay.n_lin))
     pt.ss[:], pt.ys[:] = _interior_cones(rng, lay.nc), _interior_cones(rng, lay.nc)
     sc = ipm.Scaling.identity(lay)
     ipm.scaling_into(pt.ss, pt.ys, sc)
-    fac = ipm.Factor.empty(lay)
+    fac = ipm.empty(ipm.Factor, lay)
     assert ipm.factor_into(d, sc, pt.yl, pt.sl, fac)
     g_lin, g_soc = _dense_g(unit, d)
     # Dense H = W⁻²: diag(y / s) on the linear rows, inv(W_c)² per cone (cone-major order).
@@ -241,11 +241,11 @@ def test_newton_direction_solves_the_full_kkt_system(seed, refine_above):
     d, pt, sc, fac, g_lin, g_soc, _, rng = _random_state(seed)
     lay = d.lay
     m, nl, nc = lay.m, lay.n_lin, lay.nc
-    res, rhs = ipm.Residual.empty(lay), ipm.Rhs.empty(lay)
+    res, rhs = ipm.empty(ipm.Residual, lay), ipm.empty(ipm.Rhs, lay)
     for arr in (*res, *rhs):
         arr[:] = rng.normal(size=arr.shape)
-    dn = ipm.Direction.empty(lay)
-    ipm.newton_into(d, sc, fac, ipm.Work.empty(lay), pt, res, rhs, refine_above, dn)
+    dn = ipm.empty(ipm.Direction, lay)
+    ipm.newton_into(d, sc, fac, ipm.empty(ipm.Work, lay), pt, res, rhs, refine_above, dn)
     # Unknowns: Δx (3m), Δs_lin (nl), Δs_soc (3 nc, cone-major), Δy_lin, Δy_soc.
     g_cones = np.concatenate([g_soc[:, c, :] for c in range(nc)])
     nx, ns = 3 * m, nl + 3 * nc

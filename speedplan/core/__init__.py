@@ -1,4 +1,4 @@
-"""Base layer: errors and warnings, vehicle limits, input checks and shared numerics.
+"""Base layer: errors and warnings, vehicle limits, input checks, shared numerics and helpers.
 
 Every other layer imports from here; this layer imports nothing else from speedplan.
 """

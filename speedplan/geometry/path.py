@@ -601,16 +601,9 @@ class Path:
         return cls((nurbs_piece(degree, knots, control_points, weights),))
 
     @classmethod
-    def from_linestring(
-        cls,
-        ls: Any,
-        kind: str = "g2",
-        *,
-        headings: Any = None,
-        corner_radius: float | None = None,
-        max_deviation: float | None = None,
-        transition: float | None = None,
-    ) -> Path:
+    def from_linestring(cls, ls: Any, kind: str = "g2", *, headings: Any = None,
+                        corner_radius: float | None = None, max_deviation: float | None = None,
+                        transition: float | None = None) -> Path:
         """Path through the vertices of a shapely ``LineString`` (z ignored).
 
         ``kind`` and the keyword options are those of :meth:`from_waypoints`, with the same

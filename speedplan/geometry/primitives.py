@@ -15,7 +15,7 @@ formula). Arcs and lines are the constant-curvature cases of the same piece.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -30,6 +30,24 @@ __all__ = ["Arc", "Clothoid", "ClothoidPiece", "Line", "Segment", "as_segment", 
 
 #: Largest heading change over one quadrature cell of a clothoid [rad].
 _CELL_TURN = 0.25
+
+
+def _set_checked(segment: Any, **checks: Callable[[str, Any], Any]) -> None:
+    """Replace each named field of the frozen ``segment`` by ``check(name, value)``, in order."""
+    for name, check in checks.items():
+        object.__setattr__(segment, name, check(name, getattr(segment, name)))
+
+
+def _positive(name: str, value: Any) -> float:
+    return as_scalar(name, value, positive=True)
+
+
+def _turn(name: str, value: Any) -> float:
+    """An arc's angle: a non-zero number [rad]."""
+    angle = as_scalar(name, value)
+    if angle == 0.0:
+        raise InvalidInputError("`angle` of an Arc must be non-zero; use a Line instead")
+    return angle
 
 
 @dataclass(frozen=True)
@@ -56,8 +74,7 @@ class Line:
     reverse: bool = False
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "length", as_scalar("length", self.length, positive=True))
-        object.__setattr__(self, "reverse", as_reverse("reverse", self.reverse))
+        _set_checked(self, length=_positive, reverse=as_reverse)
 
 
 @dataclass(frozen=True)
@@ -67,10 +84,10 @@ class Arc:
     Parameters
     ----------
     radius : float
-        Radius [m], > 0.
+        Radius [m], > 0; the arc is ``radius * |angle|`` long.
     angle : float
-        Angle turned [rad], non-zero; its sign gives the direction (left positive). The arc
-        length is ``radius * |angle|`` and the curvature ``sign(angle) / radius``.
+        Angle turned [rad], non-zero; its sign gives the direction (left positive) and the
+        curvature is ``sign(angle) / radius``.
     reverse : bool
         Driven in reverse (default ``False``); the curvature is that of the arc traversed in
         the direction of travel and the vehicle's heading still changes by ``angle``.
@@ -89,12 +106,7 @@ class Arc:
     reverse: bool = False
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "radius", as_scalar("radius", self.radius, positive=True))
-        angle = as_scalar("angle", self.angle)
-        if angle == 0.0:
-            raise InvalidInputError("`angle` of an Arc must be non-zero; use a Line instead")
-        object.__setattr__(self, "angle", angle)
-        object.__setattr__(self, "reverse", as_reverse("reverse", self.reverse))
+        _set_checked(self, radius=_positive, angle=_turn, reverse=as_reverse)
 
 
 @dataclass(frozen=True)
@@ -104,7 +116,7 @@ class Clothoid:
     Parameters
     ----------
     length : float
-        Length [m], > 0.
+        Arc length [m], > 0.
     k0, k1 : float
         Signed curvature at the start and at the end [1/m] (positive: turning left), of the
         curve traversed in the direction of travel.
@@ -125,10 +137,7 @@ class Clothoid:
     reverse: bool = False
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "length", as_scalar("length", self.length, positive=True))
-        object.__setattr__(self, "k0", as_scalar("k0", self.k0))
-        object.__setattr__(self, "k1", as_scalar("k1", self.k1))
-        object.__setattr__(self, "reverse", as_reverse("reverse", self.reverse))
+        _set_checked(self, length=_positive, k0=as_scalar, k1=as_scalar, reverse=as_reverse)
 
 
 Segment = Line | Arc | Clothoid

@@ -59,7 +59,37 @@ class TimeLawSpec:
 
 
 @dataclass(frozen=True)
-class Leg:
+class Rest:
+    """A point inside the path where the vehicle must be at rest (v = 0, a = 0).
+
+    Attributes
+    ----------
+    s : float
+        Position along the path [m].
+    reason : str
+        Why: ``"cusp"`` (the direction of travel flips), ``"stop"`` (asked for, e.g. a route
+        node with a blocking action) or ``"curvature jump"`` (a G1 join with ``j_lat_max``
+        set: the lateral acceleration would step).
+    """
+
+    s: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class _Ends:
+    """Where a piece of the request lies and its boundary states (documented by its subclasses)."""
+
+    start: float
+    length: float
+    v0: float
+    a0: float
+    vf: float
+    af: float
+
+
+@dataclass(frozen=True)
+class Leg(_Ends):
     """One piece of the request, from one boundary state (or stop) to the next.
 
     Attributes
@@ -83,12 +113,6 @@ class Leg:
         curvature rate jumps, with a lateral-jerk limit); empty when none.
     """
 
-    start: float
-    length: float
-    v0: float
-    a0: float
-    vf: float
-    af: float
     bound: SpeedBound
     problem: DiscreteProblem
     time_law: TimeLawSpec
@@ -106,41 +130,18 @@ class Leg:
 
 
 @dataclass(frozen=True)
-class ForcedLeg:
+class ForcedLeg(_Ends):
     """A piece of motion with no freedom left: the max-jerk motion from a state to rest.
 
     From ``(v0, a0)`` with ``v0 = a0² / (2 j)`` (``a0 < 0``) every jerk-limited motion must
     apply ``+j`` until it is at rest; ``w`` is that motion sampled on ``s`` (or its time
-    reversal at the end of a request, arriving at ``(vf, af)`` from rest).
+    reversal at the end of a request, arriving at ``(vf, af)`` from rest). ``start``,
+    ``length`` and the boundary states are those of :class:`Leg`.
     """
 
-    start: float
-    length: float
-    v0: float
-    a0: float
-    vf: float
-    af: float
     s: FloatArray
     w: FloatArray
     time_law: TimeLawSpec
-
-
-@dataclass(frozen=True)
-class Rest:
-    """A point inside the path where the vehicle must be at rest (v = 0, a = 0).
-
-    Attributes
-    ----------
-    s : float
-        Position along the path [m].
-    reason : str
-        Why: ``"cusp"`` (the direction of travel flips), ``"stop"`` (asked for, e.g. a route
-        node with a blocking action) or ``"curvature jump"`` (a G1 join with ``j_lat_max``
-        set: the lateral acceleration would step).
-    """
-
-    s: float
-    reason: str
 
 
 @dataclass(frozen=True)

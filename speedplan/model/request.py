@@ -71,25 +71,11 @@ class PlanRequest:
     reach: str = "max_jerk"  # one of REACH_MODES; set by plan(), not by callers
 
     @classmethod
-    def create(
-        cls,
-        path: Any,
-        limits: Any,
-        *,
-        n: Any = None,
-        ds: Any = None,
-        v0: Any = 0.0,
-        a0: Any = 0.0,
-        vf: Any = 0.0,
-        af: Any = 0.0,
-        zones: Sequence[SpeedZone] | None = None,
-        v_limit: Any = None,
-        refine: str = "auto",
-        standstill: str = "smooth",
-        backend: str = "auto",
-        stops: Any = None,
-        spans: Any = None,
-    ) -> PlanRequest:
+    def create(cls, path: Any, limits: Any, *, n: Any = None, ds: Any = None, v0: Any = 0.0,
+               a0: Any = 0.0, vf: Any = 0.0, af: Any = 0.0,
+               zones: Sequence[SpeedZone] | None = None, v_limit: Any = None,
+               refine: str = "auto", standstill: str = "smooth", backend: str = "auto",
+               stops: Any = None, spans: Any = None) -> PlanRequest:
         """Check every argument; raise :class:`~speedplan.InvalidInputError` naming a bad one."""
         if not isinstance(path, Path):
             raise InvalidInputError(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -16,17 +17,8 @@ from ..geometry import Path
 from ..geometry._checks import wrap_angle
 from ..geometry.corners import CUSP_ANGLE, g2_chain
 from ..geometry.primitives import ClothoidPiece
-from ._checks import (
-    boolean,
-    check_meets_node,
-    check_released,
-    check_sequence,
-    integer,
-    node_tolerance,
-    number,
-    positive,
-    string,
-)
+from . import _checks
+from ._checks import boolean, integer, number, positive, string
 
 __all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode"]
 
@@ -37,6 +29,17 @@ HEADING_TOLERANCE = 1e-6
 def _limit(value: Any, where: str) -> float | None:
     """An optional limit: ``None`` (no limit) or a number > 0."""
     return None if value is None else positive(value, where)
+
+
+def _distance(value: Any, where: str) -> float:
+    """A number >= 0."""
+    return number(value, where, minimum=0.0)
+
+
+def _set_checked(obj: Any, **checks: Callable[[Any, str], Any]) -> None:
+    """Replace each named field of the frozen dataclass ``obj`` by ``check(value, name)``."""
+    for name, check in checks.items():
+        object.__setattr__(obj, name, check(getattr(obj, name), name))
 
 
 @dataclass(frozen=True)
@@ -80,20 +83,16 @@ class RouteNode:
     released: bool = True
 
     def __post_init__(self) -> None:
-        set_ = object.__setattr__
-        set_(self, "node_id", string(self.node_id, "node_id"))
-        set_(self, "sequence_id", integer(self.sequence_id, "sequence_id"))
+        _set_checked(self, node_id=string, sequence_id=integer)
         if self.position is not None:
             pos = self.position
             if isinstance(pos, str) or not hasattr(pos, "__len__") or len(pos) != 2:
                 raise InvalidInputError(f"`position` must be (x, y) or None; got {pos!r}")
-            set_(self, "position", (number(pos[0], "position[0]"), number(pos[1], "position[1]")))
+            object.__setattr__(self, "position", (number(pos[0], "position[0]"),
+                                                  number(pos[1], "position[1]")))
         if self.theta is not None:
-            set_(self, "theta", number(self.theta, "theta"))
-        set_(self, "allowed_deviation_xy",
-             number(self.allowed_deviation_xy, "allowed_deviation_xy", minimum=0.0))
-        set_(self, "stop", boolean(self.stop, "stop"))
-        set_(self, "released", boolean(self.released, "released"))
+            _set_checked(self, theta=number)
+        _set_checked(self, allowed_deviation_xy=_distance, stop=boolean, released=boolean)
 
 
 @dataclass(frozen=True, eq=False)
@@ -148,20 +147,14 @@ class RouteEdge:
     stop: bool = False
 
     def __post_init__(self) -> None:
-        set_ = object.__setattr__
-        set_(self, "edge_id", string(self.edge_id, "edge_id"))
-        set_(self, "sequence_id", integer(self.sequence_id, "sequence_id"))
-        set_(self, "start_node", string(self.start_node, "start_node"))
-        set_(self, "end_node", string(self.end_node, "end_node"))
+        _set_checked(self, edge_id=string, sequence_id=integer, start_node=string,
+                     end_node=string)
         if not isinstance(self.path, Path):
             raise InvalidInputError(
                 f"`path` must be a speedplan.Path; got {type(self.path).__name__}"
             )
-        set_(self, "v_max", _limit(self.v_max, "v_max"))
-        set_(self, "yaw_rate_max", _limit(self.yaw_rate_max, "yaw_rate_max"))
-        set_(self, "reverse", boolean(self.reverse, "reverse"))
-        set_(self, "released", boolean(self.released, "released"))
-        set_(self, "stop", boolean(self.stop, "stop"))
+        _set_checked(self, v_max=_limit, yaw_rate_max=_limit, reverse=boolean, released=boolean,
+                     stop=boolean)
 
 
 def _heading_change(incoming: Path, outgoing: Path) -> float:
@@ -270,9 +263,9 @@ class Route:
             raise InvalidInputError(
                 f"`nodes`: a route needs at least two nodes (and an edge); got {len(self.nodes)}"
             )
-        check_sequence([n.sequence_id for n in self.nodes], [e.sequence_id for e in self.edges],
-                       "sequence_id")
-        check_released([n.released for n in self.nodes], [e.released for e in self.edges])
+        _checks.check_sequence([n.sequence_id for n in self.nodes],
+                               [e.sequence_id for e in self.edges], "sequence_id")
+        _checks.check_released([n.released for n in self.nodes], [e.released for e in self.edges])
         for i, e in enumerate(self.edges):
             for attr, j in (("start_node", i), ("end_node", i + 1)):
                 if getattr(e, attr) != self.nodes[j].node_id:
@@ -293,16 +286,17 @@ class Route:
         ends = edge.path.point(np.array([0.0, edge.path.length]))
         for j, end, verb in ((i, ends[0], "starts"), (i + 1, ends[1], "ends")):
             node = self.nodes[j]
-            tol = node_tolerance(node.allowed_deviation_xy)
+            tol = _checks.node_tolerance(node.allowed_deviation_xy)
             label = f"`nodes[{j}]` ({node.node_id!r})"
             if node.position is not None:
-                check_meets_node(end, node.position, tol, f"`edges[{i}].path` {verb}", label)
+                _checks.check_meets_node(end, node.position, tol, f"`edges[{i}].path` {verb}",
+                                         label)
             elif verb == "starts" and i > 0:  # no position: the two paths must meet
                 prev = self.edges[i - 1].path
                 meet = prev.point(prev.length)
-                check_meets_node(end, (float(meet[0]), float(meet[1])), tol,
-                                 f"`edges[{i}].path` {verb}",
-                                 f"the end of `edges[{i - 1}].path` at {label} (no position)")
+                _checks.check_meets_node(
+                    end, (float(meet[0]), float(meet[1])), tol, f"`edges[{i}].path` {verb}",
+                    f"the end of `edges[{i - 1}].path` at {label} (no position)")
 
     def _find_stops(self) -> tuple[tuple[int, str], ...]:
         """``(base node index, reason)`` of every stop, in order along the base."""

@@ -3,11 +3,11 @@
 Everything here runs under :func:`numba.njit`. One interior-point iteration at ``n = 1000``
 is a few hundred small vector operations, which as separate numpy calls cost more than the
 arithmetic itself; written as loops over nodes they compile to a few passes over memory.
-Every array is allocated once per solve, by the Python driver, with the named constructors
-below (``Point.empty(lay)``, ``Factor.empty(lay)``, ...), whose shapes :func:`check_sizes`
-verifies before the kernel runs: with bounds checks off, a wrongly sized array would be
-silent memory corruption. Compiled code is cached on disk (``cache=True``), so only the
-first use after installation pays the compilation. Arithmetic follows numpy's error model
+Every array is allocated once per solve, by the Python driver, with :func:`empty`
+(``empty(Point, lay)``, ``empty(Factor, lay)``, ...; ``Scaling.identity(lay)``), whose shapes
+:func:`check_sizes` verifies before the kernel runs: with bounds checks off, a wrongly sized
+array would be silent memory corruption. Compiled code is cached on disk (``cache=True``), so
+only the first use after installation pays the compilation. Arithmetic follows numpy's error model
 (division by zero gives ``inf``/``nan``, which the iteration detects and reports as a
 numerical breakdown) rather than raising inside compiled code.
 
@@ -98,7 +98,7 @@ def _shape(kind: str, lay: Layout) -> tuple[int, ...]:
             "low": (lay.kl,)}[kind]
 
 
-def _empty(cls: type[_T], lay: Layout) -> _T:
+def empty(cls: type[_T], lay: Layout) -> _T:
     """Zero-filled arrays of the shapes ``lay`` asks for, one per field of ``cls``."""
     kinds = _KINDS[cls]
     return cls(*(np.zeros(_shape(kinds[f], lay)) for f in cls._fields))  # type: ignore[attr-defined]
@@ -157,10 +157,6 @@ class Point(NamedTuple):
     ss: FloatArray  # cones (3, nc)
     ys: FloatArray
 
-    @classmethod
-    def empty(cls, lay: Layout) -> Point:
-        """Zero arrays for ``lay``."""
-        return _empty(cls, lay)
 
 
 class Residual(NamedTuple):
@@ -172,10 +168,6 @@ class Residual(NamedTuple):
     ryl: FloatArray
     rys: FloatArray
 
-    @classmethod
-    def empty(cls, lay: Layout) -> Residual:
-        """Zero arrays for ``lay``."""
-        return _empty(cls, lay)
 
 
 class Direction(NamedTuple):
@@ -189,10 +181,6 @@ class Direction(NamedTuple):
     dss: FloatArray
     dys: FloatArray
 
-    @classmethod
-    def empty(cls, lay: Layout) -> Direction:
-        """Zero arrays for ``lay``."""
-        return _empty(cls, lay)
 
 
 class Rhs(NamedTuple):
@@ -201,10 +189,6 @@ class Rhs(NamedTuple):
     bsl: FloatArray
     bss: FloatArray
 
-    @classmethod
-    def empty(cls, lay: Layout) -> Rhs:
-        """Zero arrays for ``lay``."""
-        return _empty(cls, lay)
 
 
 class Scaling(NamedTuple):
@@ -221,7 +205,7 @@ class Scaling(NamedTuple):
     @classmethod
     def identity(cls, lay: Layout) -> Scaling:
         """``W = I`` (``β = 1``, ``v = e``): the scaling of the starting point."""
-        sc = _empty(cls, lay)
+        sc = empty(cls, lay)
         sc.beta[:] = 1.0
         sc.v[0] = 1.0
         return sc
@@ -240,10 +224,6 @@ class Factor(NamedTuple):
     q: FloatArray
     r: FloatArray
 
-    @classmethod
-    def empty(cls, lay: Layout) -> Factor:
-        """Zero arrays for ``lay``."""
-        return _empty(cls, lay)
 
 
 class Work(NamedTuple):
@@ -253,10 +233,6 @@ class Work(NamedTuple):
     rt: FloatArray
     rz: FloatArray
 
-    @classmethod
-    def empty(cls, lay: Layout) -> Work:
-        """Zero arrays for ``lay``."""
-        return _empty(cls, lay)
 
 
 _KINDS: dict[type, dict[str, str]] = {

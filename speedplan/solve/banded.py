@@ -295,10 +295,11 @@ def _kernel_args(
            ipm.Work]:
     """The kernel's arrays for ``d`` with the start ``(w0, t0, z0)``, sizes checked."""
     lay = d.lay
-    pt = ipm.Point.empty(lay)
+    pt = ipm.empty(ipm.Point, lay)
     pt.w[:], pt.t[:], pt.z[:] = w0, t0, z0
-    args = (d, pt, ipm.Residual.empty(lay), ipm.Direction.empty(lay), ipm.Rhs.empty(lay),
-            ipm.Scaling.identity(lay), ipm.Factor.empty(lay), ipm.Work.empty(lay))
+    args = (d, pt, ipm.empty(ipm.Residual, lay), ipm.empty(ipm.Direction, lay),
+            ipm.empty(ipm.Rhs, lay), ipm.Scaling.identity(lay), ipm.empty(ipm.Factor, lay),
+            ipm.empty(ipm.Work, lay))
     ipm.check_sizes(*args)
     return args
 

@@ -106,9 +106,11 @@ def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
     >>> import numpy as np
     >>> from speedplan.solve import DiscreteProblem
     >>> from speedplan.solve.ipopt_ import refine_ipopt
-    >>> p = DiscreteProblem(s=np.linspace(0.0, 1.0, 21), w_max=np.ones(21), accel=np.full(20, 4.0),
-    ...                     decel=np.full(20, 4.0), jerk=np.full(19, 8.0))
-    >>> res = refine_ipopt(p, np.full(21, 0.5))
+    >>> n = 21
+    >>> p = DiscreteProblem(s=np.linspace(0.0, 1.0, n), w_max=np.ones(n),
+    ...                     accel=np.full(n - 1, 4.0), decel=np.full(n - 1, 4.0),
+    ...                     jerk=np.full(n - 2, 8.0))
+    >>> res = refine_ipopt(p, np.full(n, 0.5))
     >>> res.success, bool(p.jerk_violation(res.w) <= p.jerk_tol)
     (True, True)
     """

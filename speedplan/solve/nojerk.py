@@ -98,18 +98,10 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
                 s=float(where),
             )
     # Braking from w_start: the backward pass alone says how fast each node may be.
-    c = _cumulative(problem.decel * problem.h)
-    reach_back = problem.w_max.copy()
-    reach_back[-1] = min(reach_back[-1], problem.w_end)
-    limit_from = reach_back + c  # w_0 <= w_max_j + c_j - c_0
-    j = int(np.argmin(limit_from))
-    if problem.w_start > limit_from[j] + tol:
-        raise InfeasibleError(
-            f"cannot brake from w_start={problem.w_start:.6g} down to w_max={reach_back[j]:.6g} "
-            f"at s={s[j]:.6g}{units} under the braking bound",
-            constraint="decel",
-            s=float(s[j]),
-        )
+    c = _cumulative(problem.decel * problem.h)  # w_0 <= w_max_j + c_j - c_0
+    _check_pass(problem, tol, units, "decel", problem.w_start, c, -1, problem.w_end,
+                "cannot brake from w_start={w_start:.6g} down to w_max={w:.6g} at s={s:.6g}"
+                "{units} under the braking bound")
     if problem.has_lower_bounds:
         assert problem.w_min is not None
         short = problem.w_min - max_feasible_w(problem)
@@ -125,15 +117,30 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
                 constraint="jerk",
                 s=float(s[k]),
             )
-    c = _cumulative(problem.accel * problem.h)
-    reach_fwd = problem.w_max.copy()
-    reach_fwd[0] = min(reach_fwd[0], problem.w_start)
-    limit_to = reach_fwd + (c[-1] - c)  # w_end <= w_max_j + (c_end - c_j)
-    j = int(np.argmin(limit_to))
-    if problem.w_end > limit_to[j] + tol:
+    # Accelerating into w_end: the forward pass, likewise.
+    c = _cumulative(problem.accel * problem.h)  # w_end <= w_max_j + (c_end - c_j)
+    _check_pass(problem, tol, units, "accel", problem.w_end, c[-1] - c, 0, problem.w_start,
+                "cannot accelerate from w_max={w:.6g} at s={s:.6g}{units} up to "
+                "w_end={w_end:.6g} under the acceleration bound")
+
+
+def _check_pass(problem: DiscreteProblem, tol: float, units: str, constraint: str,
+                value: float, reach: FloatArray, other_end: int, other_value: float,
+                message: str) -> None:
+    """Raise unless ``value`` at one end is at most ``w_max_j + reach_j`` at every node ``j``.
+
+    ``reach_j`` is what the rate rows allow between node ``j`` and that end; the bound of the
+    node ``other_end`` is also the other end's value ``other_value``. ``message`` is formatted
+    with the binding node's bound ``w`` and position ``s``, ``units``, ``w_start``, ``w_end``.
+    """
+    bound = problem.w_max.copy()
+    bound[other_end] = min(bound[other_end], other_value)
+    limit = bound + reach
+    j = int(np.argmin(limit))
+    if value > limit[j] + tol:
         raise InfeasibleError(
-            f"cannot accelerate from w_max={reach_fwd[j]:.6g} at s={s[j]:.6g}{units} up to "
-            f"w_end={problem.w_end:.6g} under the acceleration bound",
-            constraint="accel",
-            s=float(s[j]),
+            message.format(w=bound[j], s=problem.s[j], units=units, w_start=problem.w_start,
+                           w_end=problem.w_end),
+            constraint=constraint,
+            s=float(problem.s[j]),
         )

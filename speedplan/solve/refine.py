@@ -38,8 +38,8 @@ def refine(
     Parameters
     ----------
     problem : DiscreteProblem
-        The problem, best in units where ``max(w_max) = 1`` and the mean step is 1 (as
-        :func:`speedplan.solve.solve_problem` passes it).
+        The problem, best in the units :func:`~speedplan.solve.banded_nlp.solve_banded_nlp`
+        asks for.
     w0 : ndarray, shape (n,)
         The relaxed ``w``.
     accept : callable, optional

@@ -12,6 +12,7 @@ import numpy as np
 from .._version import __version__
 from ..core.checks import FloatArray, as_array, as_scalar
 from ..core.errors import InvalidInputError
+from ..core.forward import Forwarded
 from ..core.limits import Limits
 from ..solve.solution import STATUSES as SOLUTION_STATUSES
 from ..solve.solution import DiscreteSolution
@@ -125,6 +126,14 @@ class SpeedProfile:
     limits_exceeded : bool
         Whether that check still failed after local refinement (then :attr:`status` is
         ``"limits_exceeded"``).
+    objective : float
+        Discrete objective ``Σ τ_i / sqrt(w_i)`` that the solver minimised [s].
+    lower_bound : float
+        Certified lower bound on the discrete objective's optimum [s].
+    gap : float
+        Relative optimality gap of the discrete problem (0 when exact).
+    exact : bool
+        Whether the convex relaxation was exact (global optimum certified).
     """
 
     path: Path
@@ -174,26 +183,11 @@ class SpeedProfile:
         """Travel time of the continuous time law [s]."""
         return self.law.duration
 
-    # ---- certificate (of the discrete problem) ----------------------------------------------
-    @property
-    def objective(self) -> float:
-        """Discrete objective ``Σ τ_i / sqrt(w_i)`` that the solver minimised [s]."""
-        return self.solution.objective
-
-    @property
-    def lower_bound(self) -> float:
-        """Certified lower bound on the discrete objective's optimum [s]."""
-        return self.solution.lower_bound
-
-    @property
-    def gap(self) -> float:
-        """Relative optimality gap of the discrete problem (0 when exact)."""
-        return self.solution.gap
-
-    @property
-    def exact(self) -> bool:
-        """Whether the convex relaxation was exact (global optimum certified)."""
-        return self.solution.exact
+    # ---- certificate (of the discrete problem), documented in the class docstring -----------
+    objective = Forwarded[float]("solution", "objective")
+    lower_bound = Forwarded[float]("solution", "lower_bound")
+    gap = Forwarded[float]("solution", "gap")
+    exact = Forwarded[bool]("solution", "exact")
 
     @property
     def status(self) -> ProfileStatus:

@@ -293,12 +293,12 @@ class Trajectory:
         Parameters
         ----------
         file : str, os.PathLike or text file object, optional
-            Where to write; a path's directory must exist.
+            Where to write, as for :meth:`to_csv`; by default only the string is returned.
 
         Raises
         ------
         InvalidInputError
-            The directory does not exist or the file cannot be written.
+            As :meth:`to_csv` raises it, when ``file`` cannot be written.
 
         Examples
         --------

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.checks import FloatArray
+from ..core.forward import Forwarded
 from ..core.limits import Limits
 from ..geometry import Path, SpeedBound, zone_intervals
 from ..geometry.bounds import _check_v_limit
@@ -27,6 +28,8 @@ from .law import TimeLaw
 __all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "Verification",
            "bound_breakpoints", "check_law", "curvature_rate"]
 
+#: Points per law piece where path-dependent quantities are evaluated (ends included).
+SAMPLES_PER_PIECE = 5
 #: Documented tolerances at the default resolution, as fractions of each limit; all shrink
 #: as the grid is refined (docs/convergence.md, docs/failure-modes.md).
 TOLERANCES: dict[str, float] = {
@@ -40,8 +43,6 @@ TOLERANCES: dict[str, float] = {
 }
 #: Every checked limit, in report order.
 LIMIT_NAMES = tuple(TOLERANCES)
-#: Points per law piece where path-dependent quantities are evaluated (ends included).
-SAMPLES_PER_PIECE = 5
 
 
 @dataclass(frozen=True)
@@ -60,6 +61,9 @@ class Verification:
         ``inf`` give 0. A ratio above ``1 + TOLERANCES[name]`` is a violation.
     where : dict
         Arc length [m] at which each ratio is largest.
+    max_speed, max_accel, max_decel, max_jerk, max_lateral : float
+        Largest speed [m/s], acceleration, braking deceleration [m/s²], absolute jerk [m/s³]
+        and absolute lateral acceleration [m/s²]: the entries of ``maxima``.
 
     Examples
     --------
@@ -75,30 +79,12 @@ class Verification:
     ratios: dict[str, float]
     where: dict[str, float] = field(default_factory=dict)
 
-    @property
-    def max_speed(self) -> float:
-        """Largest speed [m/s]."""
-        return self.maxima["speed"]
-
-    @property
-    def max_accel(self) -> float:
-        """Largest acceleration [m/s²]."""
-        return self.maxima["accel"]
-
-    @property
-    def max_decel(self) -> float:
-        """Largest braking deceleration [m/s²]."""
-        return self.maxima["decel"]
-
-    @property
-    def max_jerk(self) -> float:
-        """Largest absolute jerk [m/s³]."""
-        return self.maxima["jerk"]
-
-    @property
-    def max_lateral(self) -> float:
-        """Largest absolute lateral acceleration [m/s²]."""
-        return self.maxima["lateral"]
+    # Shorthands for entries of ``maxima``, documented in the class docstring.
+    max_speed = Forwarded[float]("maxima", key="speed")
+    max_accel = Forwarded[float]("maxima", key="accel")
+    max_decel = Forwarded[float]("maxima", key="decel")
+    max_jerk = Forwarded[float]("maxima", key="jerk")
+    max_lateral = Forwarded[float]("maxima", key="lateral")
 
     @property
     def violations(self) -> dict[str, float]:
