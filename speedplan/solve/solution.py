@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import KW_ONLY, dataclass
 from typing import Literal
 
 from ..core.checks import FloatArray
@@ -126,6 +126,7 @@ class DiscreteSolution:
     status: Status
     solve_time: float
     backend: str
+    _: KW_ONLY  # the details below are passed by name
     relaxation: RelaxationInfo | None = None
     refinement: RefinementInfo | None = None
 
