@@ -50,7 +50,6 @@ from functools import cached_property
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
-from ..core.numerics import GAUSS_NODES, GAUSS_WEIGHTS
 
 __all__ = ["STANDSTILL_EXPONENT", "LawChain", "TimeLaw"]
 
@@ -368,24 +367,13 @@ class TimeLaw:
         (``lo`` nearer to it): next to a standstill at the right end the offsets then keep full
         relative precision. A stretch that starts at a standstill end is integrated with
         ``σ = y²`` (``w`` linear there, ``1/v ~ σ^{-1/2}``) or ``σ = y³`` (``u`` linear,
-        ``1/v ~ σ^{-2/3}``): the integrand becomes smooth.
+        ``1/v ~ σ^{-2/3}``): the integrand becomes smooth. Compiled
+        (:mod:`speedplan.timing._law_kernel`).
         """
-        p = self._pieces
-        width = p.x[j + 1] - p.x[j]
+        from . import _law_kernel
+
         right = np.zeros(j.shape, dtype=bool) if from_right is None else from_right
-        at_rest = np.where(right, p.y_right[j] <= 0.0, p.y[j] <= 0.0) & (lo <= 0.0)
-        power = np.where(p.is_u[j], 3.0, 2.0)
-        span = hi - lo
-        t = GAUSS_NODES[:, None]
-        tw = GAUSS_WEIGHTS[:, None]
-        off = np.where(at_rest, span * t**power, lo + span * t)  # from the anchoring knot
-        jac = np.where(at_rest, span * power * t ** (power - 1.0), span)
-        dx = np.where(right, width - off, off)
-        dr = np.where(right, off, width - off)
-        v = self._speed(j, dx, dr)  # j broadcasts: piece data gathered once per column
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f = np.where(jac > 0, jac / v, 0.0)
-        out: FloatArray = np.sum(tw * f, axis=0)
+        out: FloatArray = _law_kernel.integrals(self._pieces, j, lo, hi, right)
         return out
 
     @cached_property
@@ -431,45 +419,16 @@ class TimeLaw:
         keeps full relative precision, where an arc length near a long path's end would be
         quantised to 1e-16 of the path (and the speed with it). Starts from the piece's own
         power law (``σ = τ³`` in ``u``, ``τ²`` in ``w`` at a standstill, linear otherwise);
-        Newton steps are kept only inside the bracket, bisection otherwise.
+        Newton steps are kept only inside the bracket, bisection otherwise. Compiled, one
+        iteration per time (:mod:`speedplan.timing._law_kernel`).
         """
+        from . import _law_kernel
+
         p = self._pieces
         T = self.knot_times
         t = np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration)
         j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, p.c.size - 1)
-        width = p.x[j + 1] - p.x[j]
-        span_t = T[j + 1] - T[j]
-        rest_left = p.y[j] <= 0.0
-        rest_right = (p.y_right[j] <= 0.0) & ~rest_left
-        power = np.where(p.is_u[j], 3.0, 2.0)
-        # Time measured from the offset's origin: the right knot for a right standstill.
-        tau = np.where(rest_right, T[j + 1] - t, t - T[j])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            frac = np.clip(np.where(span_t > 0, tau / span_t, 0.0), 0.0, 1.0)
-        off = width * np.where(rest_left | rest_right, frac**power, frac)
-        lo, hi = np.zeros_like(off), width.copy()
-        ttol = 1e-15 * np.maximum(span_t, 1e-300)
-        act = np.flatnonzero((tau > 0) & (tau < span_t))  # at a knot the offset is exact
-        for _ in range(100):
-            if act.size == 0:
-                break
-            ja, wa, oa, rr = j[act], width[act], off[act], rest_right[act]
-            part = self._integral(ja, 0.0 * oa, oa, rr)
-            f = part - tau[act]  # increasing in the offset
-            lo[act] = np.where(f <= 0, oa, lo[act])
-            hi[act] = np.where(f >= 0, oa, hi[act])
-            v = self._speed(ja, np.where(rr, wa - oa, oa), np.where(rr, oa, wa - oa))
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                newton = oa - f * v
-            inside = (newton >= lo[act]) & (newton <= hi[act])
-            converged = np.abs(f) <= ttol[act]
-            new = np.where(converged, oa, np.where(inside, newton, 0.5 * (lo[act] + hi[act])))
-            off[act] = new
-            moving = ~converged & (np.abs(new - oa) > 4e-16 * np.maximum(np.abs(new), 1e-300))
-            act = act[moving]
-        off = np.where(tau >= span_t, width, np.where(tau <= 0, 0.0, off))
-        dx = np.where(rest_right, width - off, off)
-        dr = np.where(rest_right, off, width - off)
+        dx, dr = _law_kernel.invert(p, T, j, t)
         return j, dx, dr
 
     def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
