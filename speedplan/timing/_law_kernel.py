@@ -24,7 +24,7 @@ from numba import njit
 from ..core.checks import FloatArray, IntArray
 from ..core.numerics import GAUSS_NODES, GAUSS_WEIGHTS
 
-__all__ = ["integrals", "invert"]
+__all__ = ["integrals", "invert", "kinematics"]
 
 BoolArray = np.ndarray
 
@@ -181,6 +181,54 @@ def invert(pieces: Any, T: np.ndarray, j: np.ndarray, t: np.ndarray
                  _flat(j, np.int64), _flat(t, np.float64), _RULE, dx.reshape(-1),
                  dr.reshape(-1))
     return dx, dr
+
+
+@njit(f"void({_PIECES}, i8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])",
+      cache=True, error_model="numpy")
+def _kinematics_into(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray,
+                     is_u: BoolArray, y_right: FloatArray, g_right: FloatArray, j: IntArray,
+                     dx: FloatArray, dr: FloatArray, w_out: FloatArray, v_out: FloatArray,
+                     a_out: FloatArray, jerk_out: FloatArray) -> None:
+    """``w, v, a, jerk`` at offsets ``(dx, dr)`` of pieces ``j``.
+
+    ``y, y', y''`` from the nearer knot (accurate relative to its own size next to a
+    standstill), then ``w = y`` or ``u^{4/3}``, ``v = sqrt(w)``, ``a = y'/2`` or
+    ``(2/3) u^{1/3} u'``, jerk ``y'' v / 2`` or ``(2/9) u'² + (2/3) u u''``.
+    """
+    for k in range(j.size):
+        jk, dxk, drk = j[k], dx[k], dr[k]
+        cj = c[jk]
+        if dxk > drk:
+            val = y_right[jk] - g_right[jk] * drk + 0.5 * cj * drk * drk
+            dy = g_right[jk] - cj * drk
+        else:
+            val = y[jk] + g[jk] * dxk + 0.5 * cj * dxk * dxk
+            dy = g[jk] + cj * dxk
+        val = max(val, 0.0)
+        if is_u[jk]:
+            cube = np.cbrt(val)
+            w = val * cube
+            v = math.sqrt(w)
+            a = (2.0 / 3.0) * cube * dy
+            jerk = (2.0 / 9.0) * dy * dy + (2.0 / 3.0) * val * cj
+        else:
+            w = val
+            v = math.sqrt(w)
+            a = 0.5 * dy
+            jerk = 0.5 * cj * v
+        w_out[k], v_out[k], a_out[k], jerk_out[k] = w, v, a, jerk
+
+
+def kinematics(pieces: Any, j: np.ndarray, dx: np.ndarray, dr: np.ndarray
+               ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """``w, v, a, jerk`` at offsets ``(dx, dr)`` of pieces ``j`` (broadcast together)."""
+    j, dx, dr = np.broadcast_arrays(j, dx, dr)
+    out = tuple(np.empty(j.shape) for _ in range(4))
+    x, y, g, c, is_u, y_right, g_right = _arrays(pieces)
+    _kinematics_into(x, y, g, c, is_u, y_right, g_right, _flat(j, np.int64),
+                     _flat(dx, np.float64), _flat(dr, np.float64), out[0].reshape(-1),
+                     out[1].reshape(-1), out[2].reshape(-1), out[3].reshape(-1))
+    return out[0], out[1], out[2], out[3]
 
 
 def _flat(a: np.ndarray, dtype: type) -> np.ndarray:

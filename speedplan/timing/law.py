@@ -260,61 +260,24 @@ class TimeLaw:
         out: IntArray = np.clip(np.searchsorted(x, q, side="right") - 1, 0, x.size - 2)
         return out
 
-    def _y(self, j: IntArray, dx: FloatArray, dr: FloatArray
-           ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``y, y', y''`` on pieces ``j`` at ``dx`` after the left knot (``dr`` before the right).
+    def _kinematics(self, j: IntArray, dx: FloatArray, dr: FloatArray
+                    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``w, v, a, jerk`` on pieces ``j`` at ``dx`` after the left knot, ``dr`` before the right.
 
-        ``y`` is evaluated from the nearer knot: accurate relative to its own size next to a
-        standstill, where it tends to 0.
+        The three broadcast together. Each piece is evaluated from the nearer knot: accurate
+        relative to its own size next to a standstill, where ``y`` tends to 0. Compiled
+        (:mod:`speedplan.timing._law_kernel`).
         """
-        p = self._pieces
-        y, right, cj = self._y_only(j, dx, dr)
-        dy = np.where(right, p.g_right[j] - cj * dr, p.g[j] + cj * dx)
-        return y, dy, cj
+        from . import _law_kernel
 
-    def _y_only(self, j: IntArray, dx: FloatArray, dr: FloatArray
-                ) -> tuple[FloatArray, np.ndarray, FloatArray]:
-        """``y`` of :meth:`_y` alone (with the side it was evaluated from and ``y''``)."""
-        p = self._pieces
-        cj = p.c[j]
-        right = dx > dr
-        y = np.where(right, p.y_right[j] - p.g_right[j] * dr + 0.5 * cj * dr * dr,
-                     p.y[j] + p.g[j] * dx + 0.5 * cj * dx * dx)
-        return np.maximum(y, 0.0), right, cj
-
-    @staticmethod
-    def _w(y: FloatArray, cube: FloatArray, is_u: np.ndarray) -> FloatArray:
-        """``w`` from ``y`` and its cube root (``y = u = w^{3/4}`` where ``is_u``)."""
-        w: FloatArray = np.where(is_u, y * cube, y)
-        return w
-
-    def _speed(self, j: IntArray, dx: FloatArray, dr: FloatArray) -> FloatArray:
-        """``v`` alone at offsets ``(dx, dr)`` of pieces ``j`` (as :meth:`_physical` gives it).
-
-        ``j`` may be of the shape of ``dx`` or broadcast against it (one piece per column).
-        """
-        y = self._y_only(j, dx, dr)[0]
-        v: FloatArray = np.sqrt(self._w(y, np.cbrt(y), self._pieces.is_u[j]))
-        return v
-
-    @staticmethod
-    def _physical(y: FloatArray, dy: FloatArray, ddy: FloatArray, is_u: np.ndarray
-                  ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """``w, v, a, j`` from ``y, y', y''`` (``y = u = w^{3/4}`` where ``is_u``)."""
-        cube = np.cbrt(y)
-        w = TimeLaw._w(y, cube, is_u)
-        v = np.sqrt(w)
-        a = np.where(is_u, (2.0 / 3.0) * cube * dy, 0.5 * dy)
-        jerk = np.where(is_u, (2.0 / 9.0) * dy * dy + (2.0 / 3.0) * y * ddy, 0.5 * ddy * v)
-        return w, v, a, jerk
+        return _law_kernel.kinematics(self._pieces, j, dx, dr)
 
     def kinematics(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """Return ``w, v, a, jerk`` at arc lengths ``q`` [m] (SI units)."""
         q = np.asarray(q, dtype=np.float64)
         j = self._locate(q)
         x = self._pieces.x
-        y, dy, ddy = self._y(j, q - x[j], x[j + 1] - q)
-        return self._physical(y, dy, ddy, self._pieces.is_u[j])
+        return self._kinematics(j, q - x[j], x[j + 1] - q)
 
     def node_offsets(self) -> FloatArray:
         """``w_law(s_k) - w_k`` at every node [m²/s²] (see the module notes)."""
@@ -344,8 +307,7 @@ class TimeLaw:
             cands.append(np.where(inside, r, 0.0))
         dx = np.stack(cands)  # (candidates, pieces)
         # One piece per column: the piece data broadcast over the candidates.
-        y, dy, ddy = self._y(np.arange(width.size), dx, width - dx)
-        w, _, a, jerk = self._physical(y, dy, ddy, p.is_u)
+        w, _, a, jerk = self._kinematics(np.arange(width.size), dx, width - dx)
         out = {}
         for name, val in (("w", w), ("a", a), ("jerk", jerk)):
             i_max = np.argmax(val, axis=0)
@@ -436,8 +398,7 @@ class TimeLaw:
         """``s, w, v, a, jerk`` at times ``t`` [SI], the kinematics from the local offsets."""
         j, dx, dr = self._invert(np.atleast_1d(np.asarray(t, dtype=np.float64)))
         p = self._pieces
-        y, dy, ddy = self._y(j, dx, dr)
-        w, v, a, jerk = self._physical(y, dy, ddy, p.is_u[j])
+        w, v, a, jerk = self._kinematics(j, dx, dr)
         q = np.where(dx <= dr, p.x[j] + dx, p.x[j + 1] - dr)
         return q, w, v, a, jerk
 
