@@ -50,6 +50,7 @@ from functools import cached_property
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
+from ._law_numpy import backend
 
 __all__ = ["STANDSTILL_EXPONENT", "LawChain", "TimeLaw"]
 
@@ -266,11 +267,11 @@ class TimeLaw:
 
         The three broadcast together. Each piece is evaluated from the nearer knot: accurate
         relative to its own size next to a standstill, where ``y`` tends to 0. Compiled
-        (:mod:`speedplan.timing._law_kernel`).
+        (:mod:`speedplan.timing._law_kernel`; numpy before numba is loaded).
         """
-        from . import _law_kernel
-
-        return _law_kernel.kinematics(self._pieces, j, dx, dr)
+        out: tuple[FloatArray, FloatArray, FloatArray, FloatArray] = backend().kinematics(
+            self._pieces, j, dx, dr)
+        return out
 
     def kinematics(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """Return ``w, v, a, jerk`` at arc lengths ``q`` [m] (SI units)."""
@@ -330,12 +331,10 @@ class TimeLaw:
         relative precision. A stretch that starts at a standstill end is integrated with
         ``σ = y²`` (``w`` linear there, ``1/v ~ σ^{-1/2}``) or ``σ = y³`` (``u`` linear,
         ``1/v ~ σ^{-2/3}``): the integrand becomes smooth. Compiled
-        (:mod:`speedplan.timing._law_kernel`).
+        (:mod:`speedplan.timing._law_kernel`; numpy before numba is loaded).
         """
-        from . import _law_kernel
-
         right = np.zeros(j.shape, dtype=bool) if from_right is None else from_right
-        out: FloatArray = _law_kernel.integrals(self._pieces, j, lo, hi, right)
+        out: FloatArray = backend().integrals(self._pieces, j, lo, hi, right)
         return out
 
     @cached_property
@@ -380,17 +379,16 @@ class TimeLaw:
         standstill end when it has one (else from its left knot): next to a stop the offset
         keeps full relative precision, where an arc length near a long path's end would be
         quantised to 1e-16 of the path (and the speed with it). Starts from the piece's own
-        power law (``σ = τ³`` in ``u``, ``τ²`` in ``w`` at a standstill, linear otherwise);
+        power law (``σ = τ³`` in ``u``, ``τ²`` in ``w`` at a standstill, else linear, or in
+        the compiled kernel the third-order kinematic expansion at the left knot);
         Newton steps are kept only inside the bracket, bisection otherwise. Compiled, one
-        iteration per time (:mod:`speedplan.timing._law_kernel`).
+        iteration per time (:mod:`speedplan.timing._law_kernel`; numpy before numba is loaded).
         """
-        from . import _law_kernel
-
         p = self._pieces
         T = self.knot_times
         t = np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration)
         j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, p.c.size - 1)
-        dx, dr = _law_kernel.invert(p, T, j, t)
+        dx, dr = backend().invert(p, T, j, t)
         return j, dx, dr
 
     def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
