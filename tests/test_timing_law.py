@@ -184,7 +184,8 @@ def test_chain_of_laws_meets_at_rest():
 def test_compiled_and_numpy_time_laws_agree():
     # The time law runs on numpy until numba is loaded (a fresh environment's first plan()),
     # then compiled: both give the same law to rounding, at standstills and moving ends too.
-    from speedplan.timing import _law_kernel, _law_numpy
+    from speedplan.core import _law_kernel
+    from speedplan.timing import _law_numpy
 
     rng = np.random.default_rng(7)
     s = np.cumsum(rng.uniform(0.05, 0.15, 400))

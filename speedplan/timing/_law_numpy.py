@@ -1,4 +1,6 @@
-"""The time law's quadrature, inversion and kinematics in numpy: :mod:`._law_kernel`'s interface.
+"""The time law's quadrature, inversion and kinematics in numpy.
+
+The interface of :mod:`speedplan.core._law_kernel`, the compiled version.
 
 Used until numba's compiled code can run without compiling (:func:`backend`): the first
 ``plan()`` of a fresh environment answers with Clarabel while a background process compiles
@@ -21,7 +23,7 @@ __all__ = ["backend", "integrals", "invert", "kinematics"]
 
 
 def backend() -> ModuleType:
-    """:mod:`._law_kernel` when the banded kernel is loaded in this process, else this module.
+    """The compiled kernel when the banded kernel is loaded in this process, else this module.
 
     Once numba has loaded the banded kernel, the time-law kernel loads from numba's cache in
     ~20 ms (the background compilation, :func:`~speedplan.solve.banded.compile_kernel`,
@@ -30,7 +32,7 @@ def backend() -> ModuleType:
     from ..solve.banded import _Kernel
 
     if _Kernel.ready:
-        from . import _law_kernel
+        from ..core import _law_kernel
 
         return _law_kernel
     import sys

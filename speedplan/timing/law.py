@@ -267,7 +267,7 @@ class TimeLaw:
 
         The three broadcast together. Each piece is evaluated from the nearer knot: accurate
         relative to its own size next to a standstill, where ``y`` tends to 0. Compiled
-        (:mod:`speedplan.timing._law_kernel`; numpy before numba is loaded).
+        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
         """
         out: tuple[FloatArray, FloatArray, FloatArray, FloatArray] = backend().kinematics(
             self._pieces, j, dx, dr)
@@ -331,7 +331,7 @@ class TimeLaw:
         relative precision. A stretch that starts at a standstill end is integrated with
         ``σ = y²`` (``w`` linear there, ``1/v ~ σ^{-1/2}``) or ``σ = y³`` (``u`` linear,
         ``1/v ~ σ^{-2/3}``): the integrand becomes smooth. Compiled
-        (:mod:`speedplan.timing._law_kernel`; numpy before numba is loaded).
+        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
         """
         right = np.zeros(j.shape, dtype=bool) if from_right is None else from_right
         out: FloatArray = backend().integrals(self._pieces, j, lo, hi, right)
@@ -382,7 +382,8 @@ class TimeLaw:
         power law (``σ = τ³`` in ``u``, ``τ²`` in ``w`` at a standstill, else linear, or in
         the compiled kernel the third-order kinematic expansion at the left knot);
         Newton steps are kept only inside the bracket, bisection otherwise. Compiled, one
-        iteration per time (:mod:`speedplan.timing._law_kernel`; numpy before numba is loaded).
+        iteration per time (:mod:`speedplan.core._law_kernel`; numpy before numba is
+        loaded).
         """
         p = self._pieces
         T = self.knot_times

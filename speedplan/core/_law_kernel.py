@@ -1,4 +1,9 @@
-"""Compiled time quadrature and time inversion of :class:`~speedplan.timing.law.TimeLaw`.
+"""Compiled quadrature, time inversion and kinematics of :class:`~speedplan.timing.law.TimeLaw`.
+
+Plain arrays in, plain arrays out (the law's chain of quadratic pieces in ``w`` or
+``u = w^{3/4}``); it lives in ``core`` so that :func:`speedplan.solve.banded.compile_kernel`
+(and with it the background compilation of a fresh environment) compiles it together with
+the banded kernel, without the solver layer importing the timing layer.
 
 The numpy formulation (one ``(16, samples)`` array per Newton step, 5-8 passes over memory
 per step, every sample iterated as long as the slowest) cost 30-40 ms for the 10 000 samples
@@ -7,10 +12,11 @@ of a 100 Hz trajectory; here each sample runs its own safeguarded Newton iterati
 1e-15`` of the piece's time), started from the third-order kinematic expansion at the piece's
 left knot (``σ ≈ v τ + a τ²/2 + j τ³/6``), so that one Newton step and the confirming
 integral usually suffice. Results agree with the numpy formulation to rounding (sampled
-states within 2e-15 of their scale on every sample path). Imported by
-:mod:`speedplan.timing.law` on first use: ``import speedplan`` stays free of numba.
-Explicit signatures, cached on disk: with numba's runtime loaded (the banded kernel) the
-module loads in ~20 ms; compiling it takes ~1.5 s, once per installation.
+states within 2e-15 of their scale on every sample path). Used by
+:mod:`speedplan.timing.law` once numba is loaded (before that, the same formulas in numpy:
+``speedplan.timing._law_numpy``): ``import speedplan`` stays free of numba. Explicit
+signatures, cached on disk: with numba's runtime loaded (the banded kernel) the module loads
+in ~20 ms; compiling it takes 1.5-5 s, once per installation.
 """
 
 from __future__ import annotations
@@ -21,8 +27,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from ..core.checks import FloatArray, IntArray
-from ..core.numerics import GAUSS_NODES, GAUSS_WEIGHTS
+from .checks import FloatArray, IntArray
+from .numerics import GAUSS_NODES, GAUSS_WEIGHTS
 
 __all__ = ["integrals", "invert", "kinematics"]
 
