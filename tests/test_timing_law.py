@@ -179,3 +179,40 @@ def test_chain_of_laws_meets_at_rest():
     assert np.all(np.diff(q) >= -1e-15) and q[-1] == pytest.approx(4.0)
     assert chain.time_at(q) == pytest.approx(t, abs=1e-9)
     assert chain.kinematics(np.array([2.0]))[1] == pytest.approx([0.0], abs=1e-12)
+
+
+def test_compiled_and_numpy_time_laws_agree():
+    # The time law runs on numpy until numba is loaded (a fresh environment's first plan()),
+    # then compiled: both give the same law to rounding, at standstills and moving ends too.
+    from speedplan.core import _law_kernel
+    from speedplan.timing import _law_numpy
+
+    rng = np.random.default_rng(7)
+    s = np.cumsum(rng.uniform(0.05, 0.15, 400))
+    s -= s[0]
+    cases = [
+        # Max-jerk start, cruise, max-jerk stop: rest to rest, pieces in u and in w.
+        TimeLaw(s, np.minimum(np.minimum(max_jerk_envelope(s, 0.5),
+                                         max_jerk_envelope(s[-1] - s, 0.5)), 1.0), j_max=0.5),
+        TimeLaw(s, 1.0 + np.sin(s) ** 2, accel_start=0.2, accel_end=-0.1),  # moving ends
+    ]
+    assert cases[0]._pieces.is_u.any()
+    for law in cases:
+        p = law._pieces
+        m = p.c.size
+        j = np.arange(m)
+        right = (p.y_right <= 0.0) & (p.y[:-1] > 0.0)
+        width = np.diff(p.x)
+        args = (p, j, np.zeros(m), width, right)
+        seg = (_law_kernel.integrals(*args), _law_numpy.integrals(*args))
+        assert np.max(np.abs(seg[0] - seg[1]) / seg[1]) < 1e-13
+        T = law.knot_times
+        t = np.sort(rng.uniform(0.0, law.duration, 3000))
+        k = np.clip(np.searchsorted(T, t, side="right") - 1, 0, m - 1)
+        (dx0, dr0), (dx1, dr1) = _law_kernel.invert(p, T, k, t), _law_numpy.invert(p, T, k, t)
+        assert np.max(np.abs(dx0 - dx1)) < 1e-13 * law.length
+        assert np.max(np.abs(dr0 - dr1)) < 1e-13 * law.length
+        dx = width[k] * rng.uniform(0.0, 1.0, k.size)
+        for a, b in zip(_law_kernel.kinematics(p, k, dx, width[k] - dx),
+                        _law_numpy.kinematics(p, k, dx, width[k] - dx), strict=True):
+            assert np.max(np.abs(a - b)) <= 1e-13 * max(np.max(np.abs(b)), 1e-300)

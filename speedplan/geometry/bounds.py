@@ -288,6 +288,10 @@ def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:
     return sk, vk
 
 
+#: Bisection steps of :func:`zone_intervals` per path query (2**depth - 1 points a bracket).
+_BISECT_DEPTH = 5
+
+
 def zone_intervals(
     path: Path, zones: Sequence[SpeedZone] | SpeedZone, *, tol: float = 1e-9
 ) -> list[tuple[float, float, float]]:
@@ -328,15 +332,34 @@ def zone_intervals(
         # Bisect every bracket at once; invariant: flags at a differ from flags at b.
         a, b = s[change], s[change + 1]
         entering = flags[change + 1]
-        for _ in range(int(np.ceil(np.log2(max(s[1], tol) / tol))) + 1):
-            if a.size == 0:
-                break
-            mid = 0.5 * (a + b)
-            p = path.point(mid)
-            inside = shapely.intersects_xy(zone.polygon, p[:, 0], p[:, 1])
-            to_b = inside == entering  # mid already has the state after the crossing
-            b = np.where(to_b, mid, b)
-            a = np.where(to_b, a, mid)
+        steps = int(np.ceil(np.log2(max(s[1], tol) / tol))) + 1
+        while steps > 0 and a.size:
+            # Several bisection steps per path query: every midpoint the next `depth` steps
+            # may visit (a binary tree, each node halving its own bracket as a step would),
+            # tested at once, then the steps taken down the tree: the same brackets as one
+            # step per query, a fraction of the queries.
+            depth = min(steps, _BISECT_DEPTH)
+            los, his, levels = [a], [b], []
+            for _ in range(depth):  # the tree level by level: node i's children 2i, 2i + 1
+                mids = [0.5 * (lo + hi) for lo, hi in zip(los, his, strict=True)]
+                los = [x for lo, m in zip(los, mids, strict=True) for x in (lo, m)]
+                his = [x for m, hi in zip(mids, his, strict=True) for x in (m, hi)]
+                levels.append(np.stack(mids))
+            flat = np.concatenate(levels)  # (nodes, brackets)
+            p = path.point(flat.ravel())
+            inside = shapely.intersects_xy(zone.polygon, p[:, 0], p[:, 1]).reshape(flat.shape)
+            node = np.zeros(a.size, dtype=np.intp)  # index within the level
+            cols = np.arange(a.size)
+            start = 0
+            for level in range(depth):
+                row = start + node
+                mid = flat[row, cols]
+                to_b = inside[row, cols] == entering  # mid has the state after the crossing
+                b = np.where(to_b, mid, b)
+                a = np.where(to_b, a, mid)
+                start += 2**level
+                node = 2 * node + np.where(to_b, 0, 1)  # left child keeps a, right keeps b
+            steps -= depth
         enters = list(b[entering]) if flags[0] == 0 else [0.0, *b[entering]]
         exits = list(a[~entering]) + ([L] if flags[-1] else [])
         out.extend((float(e), float(x), zone.v_max) for e, x in zip(enters, exits, strict=True))

@@ -33,6 +33,7 @@ onto the next leg. For a straight reversal (``δ = 0``) ``Q`` is the waypoint it
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -129,6 +130,7 @@ class CornerShape:
         return (1.0 - self.transition) * self.turn
 
 
+@lru_cache(maxsize=256)  # waypoint paths repeat their turns (a serpentine: 18 right angles)
 def corner_shape(turn: float, transition: float) -> CornerShape:
     """The unit-radius corner turning by ``turn`` (> 0) [rad] with clothoid share ``transition``.
 

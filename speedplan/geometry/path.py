@@ -14,7 +14,7 @@ from ..core.checks import FloatArray, IntArray, as_array, as_scalar, grid_size
 from ..core.errors import InvalidInputError
 from ._checks import as_int
 from .pieces import Piece, SubPiece
-from .primitives import Arc, Clothoid, Line, as_segment, segment_piece
+from .primitives import Arc, Clothoid, ClothoidPiece, Line, as_segment, segment_piece
 
 __all__ = ["Arc", "Clothoid", "Line", "Path", "PathSamples"]
 
@@ -150,8 +150,43 @@ class Path:
         idx = np.clip(np.searchsorted(self.offsets, q, side="right") - 1, 0, len(self.pieces) - 1)
         return q, idx
 
+    @cached_property
+    def _clothoids(self) -> FloatArray | None:
+        """Rows ``k0, k1 - k0, length, theta0`` of the pieces, if all are clothoid pieces.
+
+        ``None`` unless every piece is a plain
+        :class:`~speedplan.geometry.primitives.ClothoidPiece` (lines, arcs, clothoids: every
+        path but NURBS, splines and cut pieces). Curvature and heading are then one
+        vectorised pass over all points, with each piece's own formula and operation order
+        (bitwise the per-piece result): grouping 10 000 points by piece and calling 70 pieces
+        cost ~1 ms a query, and a plan makes many.
+        """
+        if not all(type(p) is ClothoidPiece for p in self.pieces):
+            return None
+        pieces: list[ClothoidPiece] = [p for p in self.pieces if isinstance(p, ClothoidPiece)]
+        return np.array([[p.k0, p.k1 - p.k0, p.length, p.theta0] for p in pieces]).T.copy()
+
+    def _clothoid_values(self, q: FloatArray, idx: IntArray, attr: str) -> FloatArray:
+        """:meth:`ClothoidPiece.curvature` or ``heading`` of each point's piece (see above)."""
+        table = self._clothoids
+        assert table is not None
+        u = q - self.offsets[idx]
+        k0, dk, length = table[0][idx], table[1][idx], table[2][idx]
+        if attr == "curvature":
+            out = k0 + dk * (u / length)
+        else:
+            sharpness = dk / length
+            out = table[3][idx] + u * (k0 + 0.5 * sharpness * u)
+        return np.asarray(out, dtype=np.float64)
+
     def _dispatch(self, s: Any, attr: str) -> FloatArray:
         q, idx = self._locate(s)
+        if attr in ("curvature", "heading") and self._clothoids is not None:
+            return self._clothoid_values(q, idx, attr)
+        return self._by_piece(q, idx, attr)
+
+    def _by_piece(self, q: FloatArray, idx: IntArray, attr: str) -> FloatArray:
+        """``attr`` of each piece at the points located on it (``q``, ``idx``: :meth:`_locate`)."""
         flat, fidx = q.ravel(), idx.ravel()
         trailing = (2,) if attr == "point" else ()
         out = np.empty(flat.shape + trailing)
@@ -348,10 +383,15 @@ class Path:
         ((1, 2), [0.5], [0.0])
         """
         q, idx = self._locate(s)
+        if self._clothoids is not None:  # nothing shared between the three: vectorised
+            return (self._by_piece(q, idx, "point"), self._clothoid_values(q, idx, "heading"),
+                    self._clothoid_values(q, idx, "curvature"))
         flat, fidx = q.ravel(), idx.ravel()
         xy, theta, kappa = np.empty((flat.size, 2)), np.empty(flat.size), np.empty(flat.size)
-        for k in np.unique(fidx):
-            sel = fidx == k
+        order = np.argsort(fidx, kind="stable")  # grouped by piece, as in _by_piece
+        cuts = np.flatnonzero(np.diff(fidx[order])) + 1
+        for sel in np.split(order, cuts) if flat.size else ():
+            k = int(fidx[sel[0]])
             xy[sel], theta[sel], kappa[sel] = self.pieces[k].evaluate(flat[sel] - self.offsets[k])
         return xy.reshape((*q.shape, 2)), theta.reshape(q.shape), kappa.reshape(q.shape)
 

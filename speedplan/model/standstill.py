@@ -35,6 +35,8 @@ def calibrate_standstill_rows(jerk: FloatArray, s: FloatArray, v0: float, a0: fl
         env = max_jerk_envelope(dist, j_max)
         sub = DiscreteProblem(s=s[idx], w_max=env, accel=np.ones(k + 1), decel=np.ones(k + 1),
                               jerk=np.full(k, np.inf))
-        load = np.abs(sub.second_difference @ env) * np.sqrt(env[1:-1]) / (2.0 * j_max)
+        # The stencil product without a sparse matrix (bitwise the same, a fraction of the time).
+        d2 = sub.stencil_apply(sub.second_difference_weights, env)
+        load = np.abs(d2) * np.sqrt(env[1:-1]) / (2.0 * j_max)
         rows = slice(0, k) if idx.start == 0 else slice(jerk.size - k, jerk.size)
         jerk[rows] *= np.maximum(1.0, load)

@@ -389,6 +389,8 @@ def compile_kernel() -> None:
         _Kernel.background.wait()
         _Kernel.background = None
     solve_relaxation_banded(_example_problem())
+    from ..core import _law_kernel  # noqa: F401  # the time law's kernel, into the same cache
+
     _Kernel.ready = True
 
 

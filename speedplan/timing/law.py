@@ -50,7 +50,7 @@ from functools import cached_property
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
-from ..core.numerics import GAUSS_NODES, GAUSS_WEIGHTS
+from ._law_numpy import backend
 
 __all__ = ["STANDSTILL_EXPONENT", "LawChain", "TimeLaw"]
 
@@ -261,61 +261,24 @@ class TimeLaw:
         out: IntArray = np.clip(np.searchsorted(x, q, side="right") - 1, 0, x.size - 2)
         return out
 
-    def _y(self, j: IntArray, dx: FloatArray, dr: FloatArray
-           ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``y, y', y''`` on pieces ``j`` at ``dx`` after the left knot (``dr`` before the right).
+    def _kinematics(self, j: IntArray, dx: FloatArray, dr: FloatArray
+                    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``w, v, a, jerk`` on pieces ``j`` at ``dx`` after the left knot, ``dr`` before the right.
 
-        ``y`` is evaluated from the nearer knot: accurate relative to its own size next to a
-        standstill, where it tends to 0.
+        The three broadcast together. Each piece is evaluated from the nearer knot: accurate
+        relative to its own size next to a standstill, where ``y`` tends to 0. Compiled
+        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
         """
-        p = self._pieces
-        y, right, cj = self._y_only(j, dx, dr)
-        dy = np.where(right, p.g_right[j] - cj * dr, p.g[j] + cj * dx)
-        return y, dy, cj
-
-    def _y_only(self, j: IntArray, dx: FloatArray, dr: FloatArray
-                ) -> tuple[FloatArray, np.ndarray, FloatArray]:
-        """``y`` of :meth:`_y` alone (with the side it was evaluated from and ``y''``)."""
-        p = self._pieces
-        cj = p.c[j]
-        right = dx > dr
-        y = np.where(right, p.y_right[j] - p.g_right[j] * dr + 0.5 * cj * dr * dr,
-                     p.y[j] + p.g[j] * dx + 0.5 * cj * dx * dx)
-        return np.maximum(y, 0.0), right, cj
-
-    @staticmethod
-    def _w(y: FloatArray, cube: FloatArray, is_u: np.ndarray) -> FloatArray:
-        """``w`` from ``y`` and its cube root (``y = u = w^{3/4}`` where ``is_u``)."""
-        w: FloatArray = np.where(is_u, y * cube, y)
-        return w
-
-    def _speed(self, j: IntArray, dx: FloatArray, dr: FloatArray) -> FloatArray:
-        """``v`` alone at offsets ``(dx, dr)`` of pieces ``j`` (as :meth:`_physical` gives it).
-
-        ``j`` may be of the shape of ``dx`` or broadcast against it (one piece per column).
-        """
-        y = self._y_only(j, dx, dr)[0]
-        v: FloatArray = np.sqrt(self._w(y, np.cbrt(y), self._pieces.is_u[j]))
-        return v
-
-    @staticmethod
-    def _physical(y: FloatArray, dy: FloatArray, ddy: FloatArray, is_u: np.ndarray
-                  ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """``w, v, a, j`` from ``y, y', y''`` (``y = u = w^{3/4}`` where ``is_u``)."""
-        cube = np.cbrt(y)
-        w = TimeLaw._w(y, cube, is_u)
-        v = np.sqrt(w)
-        a = np.where(is_u, (2.0 / 3.0) * cube * dy, 0.5 * dy)
-        jerk = np.where(is_u, (2.0 / 9.0) * dy * dy + (2.0 / 3.0) * y * ddy, 0.5 * ddy * v)
-        return w, v, a, jerk
+        out: tuple[FloatArray, FloatArray, FloatArray, FloatArray] = backend().kinematics(
+            self._pieces, j, dx, dr)
+        return out
 
     def kinematics(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """Return ``w, v, a, jerk`` at arc lengths ``q`` [m] (SI units)."""
         q = np.asarray(q, dtype=np.float64)
         j = self._locate(q)
         x = self._pieces.x
-        y, dy, ddy = self._y(j, q - x[j], x[j + 1] - q)
-        return self._physical(y, dy, ddy, self._pieces.is_u[j])
+        return self._kinematics(j, q - x[j], x[j + 1] - q)
 
     def node_offsets(self) -> FloatArray:
         """``w_law(s_k) - w_k`` at every node [m²/s²] (see the module notes)."""
@@ -345,8 +308,7 @@ class TimeLaw:
             cands.append(np.where(inside, r, 0.0))
         dx = np.stack(cands)  # (candidates, pieces)
         # One piece per column: the piece data broadcast over the candidates.
-        y, dy, ddy = self._y(np.arange(width.size), dx, width - dx)
-        w, _, a, jerk = self._physical(y, dy, ddy, p.is_u)
+        w, _, a, jerk = self._kinematics(np.arange(width.size), dx, width - dx)
         out = {}
         for name, val in (("w", w), ("a", a), ("jerk", jerk)):
             i_max = np.argmax(val, axis=0)
@@ -368,24 +330,11 @@ class TimeLaw:
         (``lo`` nearer to it): next to a standstill at the right end the offsets then keep full
         relative precision. A stretch that starts at a standstill end is integrated with
         ``σ = y²`` (``w`` linear there, ``1/v ~ σ^{-1/2}``) or ``σ = y³`` (``u`` linear,
-        ``1/v ~ σ^{-2/3}``): the integrand becomes smooth.
+        ``1/v ~ σ^{-2/3}``): the integrand becomes smooth. Compiled
+        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
         """
-        p = self._pieces
-        width = p.x[j + 1] - p.x[j]
         right = np.zeros(j.shape, dtype=bool) if from_right is None else from_right
-        at_rest = np.where(right, p.y_right[j] <= 0.0, p.y[j] <= 0.0) & (lo <= 0.0)
-        power = np.where(p.is_u[j], 3.0, 2.0)
-        span = hi - lo
-        t = GAUSS_NODES[:, None]
-        tw = GAUSS_WEIGHTS[:, None]
-        off = np.where(at_rest, span * t**power, lo + span * t)  # from the anchoring knot
-        jac = np.where(at_rest, span * power * t ** (power - 1.0), span)
-        dx = np.where(right, width - off, off)
-        dr = np.where(right, off, width - off)
-        v = self._speed(j, dx, dr)  # j broadcasts: piece data gathered once per column
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f = np.where(jac > 0, jac / v, 0.0)
-        out: FloatArray = np.sum(tw * f, axis=0)
+        out: FloatArray = backend().integrals(self._pieces, j, lo, hi, right)
         return out
 
     @cached_property
@@ -430,46 +379,17 @@ class TimeLaw:
         standstill end when it has one (else from its left knot): next to a stop the offset
         keeps full relative precision, where an arc length near a long path's end would be
         quantised to 1e-16 of the path (and the speed with it). Starts from the piece's own
-        power law (``σ = τ³`` in ``u``, ``τ²`` in ``w`` at a standstill, linear otherwise);
-        Newton steps are kept only inside the bracket, bisection otherwise.
+        power law (``σ = τ³`` in ``u``, ``τ²`` in ``w`` at a standstill, else linear, or in
+        the compiled kernel the third-order kinematic expansion at the left knot);
+        Newton steps are kept only inside the bracket, bisection otherwise. Compiled, one
+        iteration per time (:mod:`speedplan.core._law_kernel`; numpy before numba is
+        loaded).
         """
         p = self._pieces
         T = self.knot_times
         t = np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration)
         j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, p.c.size - 1)
-        width = p.x[j + 1] - p.x[j]
-        span_t = T[j + 1] - T[j]
-        rest_left = p.y[j] <= 0.0
-        rest_right = (p.y_right[j] <= 0.0) & ~rest_left
-        power = np.where(p.is_u[j], 3.0, 2.0)
-        # Time measured from the offset's origin: the right knot for a right standstill.
-        tau = np.where(rest_right, T[j + 1] - t, t - T[j])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            frac = np.clip(np.where(span_t > 0, tau / span_t, 0.0), 0.0, 1.0)
-        off = width * np.where(rest_left | rest_right, frac**power, frac)
-        lo, hi = np.zeros_like(off), width.copy()
-        ttol = 1e-15 * np.maximum(span_t, 1e-300)
-        act = np.flatnonzero((tau > 0) & (tau < span_t))  # at a knot the offset is exact
-        for _ in range(100):
-            if act.size == 0:
-                break
-            ja, wa, oa, rr = j[act], width[act], off[act], rest_right[act]
-            part = self._integral(ja, 0.0 * oa, oa, rr)
-            f = part - tau[act]  # increasing in the offset
-            lo[act] = np.where(f <= 0, oa, lo[act])
-            hi[act] = np.where(f >= 0, oa, hi[act])
-            v = self._speed(ja, np.where(rr, wa - oa, oa), np.where(rr, oa, wa - oa))
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                newton = oa - f * v
-            inside = (newton >= lo[act]) & (newton <= hi[act])
-            converged = np.abs(f) <= ttol[act]
-            new = np.where(converged, oa, np.where(inside, newton, 0.5 * (lo[act] + hi[act])))
-            off[act] = new
-            moving = ~converged & (np.abs(new - oa) > 4e-16 * np.maximum(np.abs(new), 1e-300))
-            act = act[moving]
-        off = np.where(tau >= span_t, width, np.where(tau <= 0, 0.0, off))
-        dx = np.where(rest_right, width - off, off)
-        dr = np.where(rest_right, off, width - off)
+        dx, dr = backend().invert(p, T, j, t)
         return j, dx, dr
 
     def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
@@ -477,8 +397,7 @@ class TimeLaw:
         """``s, w, v, a, jerk`` at times ``t`` [SI], the kinematics from the local offsets."""
         j, dx, dr = self._invert(np.atleast_1d(np.asarray(t, dtype=np.float64)))
         p = self._pieces
-        y, dy, ddy = self._y(j, dx, dr)
-        w, v, a, jerk = self._physical(y, dy, ddy, p.is_u[j])
+        w, v, a, jerk = self._kinematics(j, dx, dr)
         q = np.where(dx <= dr, p.x[j] + dx, p.x[j + 1] - dr)
         return q, w, v, a, jerk
 
