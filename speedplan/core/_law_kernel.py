@@ -40,14 +40,17 @@ _RULE = np.ascontiguousarray(np.stack((
     GAUSS_NODES, GAUSS_WEIGHTS, GAUSS_NODES**2, 2.0 * GAUSS_NODES, GAUSS_NODES**3,
     3.0 * GAUSS_NODES**2)), dtype=np.float64)
 
-_PIECES = "f8[::1], f8[::1], f8[::1], f8[::1], b1[::1], f8[::1], f8[::1]"
+#: The law's piece arrays as one argument (``x, y, g, c, is_u, y_right, g_right``, see
+#: :func:`_arrays`).
+_PIECES = "Tuple((f8[::1], f8[::1], f8[::1], f8[::1], b1[::1], f8[::1], f8[::1]))"
+Pieces = tuple[FloatArray, FloatArray, FloatArray, FloatArray, np.ndarray, FloatArray,
+               FloatArray]
 
 
-@njit("f8(f8[::1], f8[::1], f8[::1], f8[::1], b1[::1], f8[::1], f8[::1], i8, f8, f8)",
-      cache=True, error_model="numpy")
-def _speed(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray, is_u: BoolArray,
-           y_right: FloatArray, g_right: FloatArray, j: int, dx: float, dr: float) -> float:
+@njit(f"f8({_PIECES}, i8, f8, f8)", cache=True, error_model="numpy")
+def _speed(pieces: Pieces, j: int, dx: float, dr: float) -> float:
     """``v`` at offsets ``(dx, dr)`` of piece ``j``: ``TimeLaw._speed`` for one point."""
+    _x, y, g, c, is_u, y_right, g_right = pieces
     cj = c[j]
     if dx > dr:  # from the nearer knot
         val = y_right[j] - g_right[j] * dr + 0.5 * cj * dr * dr
@@ -60,10 +63,10 @@ def _speed(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray, is_u: Boo
 
 
 @njit(f"f8({_PIECES}, i8, f8, f8, b1, f8[:, ::1])", cache=True, error_model="numpy")
-def _integral(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray, is_u: BoolArray,
-              y_right: FloatArray, g_right: FloatArray, j: int, lo: float, hi: float,
-              right: bool, rule: FloatArray) -> float:
+def _integral(pieces: Pieces, j: int, lo: float, hi: float, right: bool,
+              rule: FloatArray) -> float:
     """``TimeLaw._integral`` for one stretch ``[lo, hi]`` of piece ``j``."""
+    x, y, g, c, is_u, y_right, g_right = pieces
     width = x[j + 1] - x[j]
     at_rest = (y_right[j] <= 0.0 if right else y[j] <= 0.0) and lo <= 0.0
     row = 4 if is_u[j] else 2  # the substitution's nodes and Jacobians
@@ -96,20 +99,17 @@ def _integral(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray, is_u: 
             dx, dr = width - off, off
         else:
             dx, dr = off, width - off
-        v = _speed(x, y, g, c, is_u, y_right, g_right, j, dx, dr)
+        v = _speed(pieces, j, dx, dr)
         total += rule[1, i] * (jac / v if jac > 0 else 0.0)
     return total
 
 
 @njit(f"void({_PIECES}, i8[::1], f8[::1], f8[::1], b1[::1], f8[:, ::1], f8[::1])",
       cache=True, error_model="numpy")
-def _integrals_into(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray,
-                    is_u: BoolArray, y_right: FloatArray, g_right: FloatArray, j: IntArray,
-                    lo: FloatArray, hi: FloatArray, right: BoolArray, rule: FloatArray,
-                    out: FloatArray) -> None:
+def _integrals_into(pieces: Pieces, j: IntArray, lo: FloatArray, hi: FloatArray,
+                    right: BoolArray, rule: FloatArray, out: FloatArray) -> None:
     for k in range(j.size):
-        out[k] = _integral(x, y, g, c, is_u, y_right, g_right, j[k], lo[k], hi[k], right[k],
-                           rule)
+        out[k] = _integral(pieces, j[k], lo[k], hi[k], right[k], rule)
 
 
 def integrals(pieces: Any, j: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -117,20 +117,17 @@ def integrals(pieces: Any, j: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     """``∫ ds / v`` over offsets ``[lo, hi]`` of pieces ``j`` (see ``TimeLaw._integral``)."""
     j, lo, hi, right = np.broadcast_arrays(j, lo, hi, right)
     out = np.empty(j.shape)
-    x, y, g, c, is_u, y_right, g_right = _arrays(pieces)
-    _integrals_into(x, y, g, c, is_u, y_right, g_right, _flat(j, np.int64),
-                    _flat(lo, np.float64), _flat(hi, np.float64), _flat(right, np.bool_),
-                    _RULE, out.reshape(-1))
+    _integrals_into(_arrays(pieces), _flat(j, np.int64), _flat(lo, np.float64),
+                    _flat(hi, np.float64), _flat(right, np.bool_), _RULE, out.reshape(-1))
     return out
 
 
 @njit(f"void({_PIECES}, f8[::1], i8[::1], f8[::1], f8[:, ::1], f8[::1], f8[::1])",
       cache=True, error_model="numpy")
-def _invert_into(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray,
-                 is_u: BoolArray, y_right: FloatArray, g_right: FloatArray, T: FloatArray,
-                 j: IntArray, t: FloatArray, rule: FloatArray, dx_out: FloatArray,
-                 dr_out: FloatArray) -> None:
+def _invert_into(pieces: Pieces, T: FloatArray, j: IntArray, t: FloatArray, rule: FloatArray,
+                 dx_out: FloatArray, dr_out: FloatArray) -> None:
     """Offsets reached at times ``t`` in pieces ``j``: ``TimeLaw._invert``'s iteration."""
+    x, y, g, c, is_u, y_right, _g_right = pieces
     for k in range(t.size):
         jk = j[k]
         width = x[jk + 1] - x[jk]
@@ -161,17 +158,16 @@ def _invert_into(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray,
         ttol = 1e-15 * max(span_t, 1e-300)
         if tau > 0 and tau < span_t:  # at a knot the offset is exact
             for _ in range(100):
-                part = _integral(x, y, g, c, is_u, y_right, g_right, jk, 0.0 * off, off,
-                                 rest_right, rule)
+                part = _integral(pieces, jk, 0.0 * off, off, rest_right, rule)
                 f = part - tau  # increasing in the offset
                 if f <= 0:
                     lo = off
                 if f >= 0:
                     hi = off
                 if rest_right:
-                    v = _speed(x, y, g, c, is_u, y_right, g_right, jk, width - off, off)
+                    v = _speed(pieces, jk, width - off, off)
                 else:
-                    v = _speed(x, y, g, c, is_u, y_right, g_right, jk, off, width - off)
+                    v = _speed(pieces, jk, off, width - off)
                 newton = off - f * v
                 converged = abs(f) <= ttol
                 if converged:
@@ -198,25 +194,23 @@ def invert(pieces: Any, T: np.ndarray, j: np.ndarray, t: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray]:
     """Offsets ``(dx, dr)`` from the left and right knots of pieces ``j`` at times ``t``."""
     dx, dr = np.empty(t.shape), np.empty(t.shape)
-    x, y, g, c, is_u, y_right, g_right = _arrays(pieces)
-    _invert_into(x, y, g, c, is_u, y_right, g_right, _flat(T, np.float64),
-                 _flat(j, np.int64), _flat(t, np.float64), _RULE, dx.reshape(-1),
-                 dr.reshape(-1))
+    _invert_into(_arrays(pieces), _flat(T, np.float64), _flat(j, np.int64),
+                 _flat(t, np.float64), _RULE, dx.reshape(-1), dr.reshape(-1))
     return dx, dr
 
 
 @njit(f"void({_PIECES}, i8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])",
       cache=True, error_model="numpy")
-def _kinematics_into(x: FloatArray, y: FloatArray, g: FloatArray, c: FloatArray,
-                     is_u: BoolArray, y_right: FloatArray, g_right: FloatArray, j: IntArray,
-                     dx: FloatArray, dr: FloatArray, w_out: FloatArray, v_out: FloatArray,
-                     a_out: FloatArray, jerk_out: FloatArray) -> None:
+def _kinematics_into(pieces: Pieces, j: IntArray, dx: FloatArray, dr: FloatArray,
+                     w_out: FloatArray, v_out: FloatArray, a_out: FloatArray,
+                     jerk_out: FloatArray) -> None:
     """``w, v, a, jerk`` at offsets ``(dx, dr)`` of pieces ``j``.
 
     ``y, y', y''`` from the nearer knot (accurate relative to its own size next to a
     standstill), then ``w = y`` or ``u^{4/3}``, ``v = sqrt(w)``, ``a = y'/2`` or
     ``(2/3) u^{1/3} u'``, jerk ``y'' v / 2`` or ``(2/9) u'² + (2/3) u u''``.
     """
+    _x, y, g, c, is_u, y_right, g_right = pieces
     for k in range(j.size):
         jk, dxk, drk = j[k], dx[k], dr[k]
         cj = c[jk]
@@ -246,10 +240,9 @@ def kinematics(pieces: Any, j: np.ndarray, dx: np.ndarray, dr: np.ndarray
     """``w, v, a, jerk`` at offsets ``(dx, dr)`` of pieces ``j`` (broadcast together)."""
     j, dx, dr = np.broadcast_arrays(j, dx, dr)
     out = tuple(np.empty(j.shape) for _ in range(4))
-    x, y, g, c, is_u, y_right, g_right = _arrays(pieces)
-    _kinematics_into(x, y, g, c, is_u, y_right, g_right, _flat(j, np.int64),
-                     _flat(dx, np.float64), _flat(dr, np.float64), out[0].reshape(-1),
-                     out[1].reshape(-1), out[2].reshape(-1), out[3].reshape(-1))
+    _kinematics_into(_arrays(pieces), _flat(j, np.int64), _flat(dx, np.float64),
+                     _flat(dr, np.float64), out[0].reshape(-1), out[1].reshape(-1),
+                     out[2].reshape(-1), out[3].reshape(-1))
     return out[0], out[1], out[2], out[3]
 
 
@@ -257,8 +250,7 @@ def _flat(a: np.ndarray, dtype: type) -> np.ndarray:
     return np.ascontiguousarray(np.asarray(a, dtype=dtype).reshape(-1))
 
 
-def _arrays(p: Any) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, BoolArray,
-                             FloatArray, FloatArray]:
+def _arrays(p: Any) -> Pieces:
     """The piece arrays of a ``TimeLaw._pieces``, contiguous as the signatures require."""
     return (np.ascontiguousarray(p.x), np.ascontiguousarray(p.y), np.ascontiguousarray(p.g),
             np.ascontiguousarray(p.c), np.ascontiguousarray(p.is_u),
