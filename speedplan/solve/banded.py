@@ -420,23 +420,23 @@ def kernel_ready(*, start: bool = True) -> bool:
 COMPILE_LOCK_STALE = 600.0
 
 
-def _lock_path() -> str:
-    """One lock per copy of speedplan, numba version, cache directory and interpreter."""
+def _lock_path(module_file: str | None = None) -> str:
+    """One lock per kernel module (default the relaxation's), numba, cache and interpreter."""
     import numba
 
-    key = "|".join((os.path.abspath(ipm.__file__), numba.__version__,
+    key = "|".join((os.path.abspath(module_file or ipm.__file__), numba.__version__,
                     os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
     digest = hashlib.sha256(key.encode()).hexdigest()[:16]
     return os.path.join(tempfile.gettempdir(), f"speedplan-kernel-{digest}.lock")
 
 
-def _claim_compile_lock() -> bool:
+def _claim_compile_lock(path: str | None = None) -> bool:
     """Whether this process may start the background compilation (no other one is running).
 
     Worker processes of :func:`~speedplan.plan_many` all start cold; the lock file makes one
     of them compile while the others answer with Clarabel until the cache has the kernel.
     """
-    path = _lock_path()
+    path = path or _lock_path()
     for _ in range(2):
         try:
             os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
@@ -472,8 +472,14 @@ def kernel_for_auto(*, wait: bool) -> bool:
     return False
 
 
-def _spawn_compile() -> subprocess.Popen[bytes] | None:
-    """Start ``python -c "...compile_kernel()"`` on this very copy of speedplan."""
+def _spawn_compile(
+    module: str = "speedplan.solve.banded", function: str = "compile_kernel",
+    lock: str | None = None,
+) -> subprocess.Popen[bytes] | None:
+    """Start ``python -c "from module import function; function()"`` on this copy of speedplan.
+
+    The lock file ``lock`` (default the relaxation kernel's) is removed when it ends.
+    """
     if not sys.executable:
         return None
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -482,11 +488,11 @@ def _spawn_compile() -> subprocess.Popen[bytes] | None:
     # Lowest priority: the compilation must not slow down the process that is waiting for
     # answers (it uses Clarabel meanwhile).
     code = ("import os, sys; hasattr(os, 'nice') and os.nice(19)\n"
-            "from speedplan.solve.banded import compile_kernel\n"
-            "try:\n    compile_kernel()\nfinally:\n"
+            f"from {module} import {function}\n"
+            f"try:\n    {function}()\nfinally:\n"
             "    os.path.exists(sys.argv[1]) and os.remove(sys.argv[1])\n")
     try:
-        return subprocess.Popen([sys.executable, "-c", code, _lock_path()], env=env,
+        return subprocess.Popen([sys.executable, "-c", code, lock or _lock_path()], env=env,
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
     except OSError:

@@ -17,7 +17,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.checks import FloatArray
-from .banded_nlp import STARTS, solve_banded_nlp
+from .banded_nlp import LATERAL_STARTS, STARTS, solve_banded_nlp
 from .ipopt_ import RefineResult, refine_ipopt
 from .problem import DiscreteProblem
 
@@ -75,7 +75,7 @@ def refine(
     last: tuple[FloatArray, str] = (np.asarray(w0, dtype=np.float64), "not run")
     iterations = 0
     found: list[float] = []
-    for start in STARTS:
+    for start in LATERAL_STARTS if problem.lateral_families else STARTS:
         res = solve_banded_nlp(problem, w0, start)
         iterations += res.iterations
         status = f"banded/{start.name}: {res.status}"
