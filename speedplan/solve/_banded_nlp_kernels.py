@@ -41,7 +41,7 @@ SIGNATURES: dict[str, str] = {
     "objective": f"float64(int64, {_F}, {_F}, {_F}, {_F}, {_F})",
     "gaps": f"void({_F}, {_F}, {_F}, {_F}, {_F}, {_F}, {_F}, {_F}, {_F})",
     "residual": f"void({_F}, {_F}, {_F}, {_F}, int64, {_F})",
-    "barrier": f"float64(int64, {_F}, {_F}, {_F}, {_F}, {_F}, float64, {_F}, float64)",
+    "barrier": f"UniTuple(float64, 2)(int64, {_F}, {_F}, {_F}, {_F}, {_F}, float64, {_F})",
     "errors": (f"UniTuple(float64, 2)(int64, int64, {_F}, {_F}, {_F}, {_F}, {_F}, {_F}, "
                f"{_F}, float64, float64)"),
     "newton": (f"UniTuple(float64, 2)(int64, int64, {_F}, {_F}, {_F}, {_F}, {_F}, {_F}, "
@@ -170,17 +170,17 @@ def residual(
 
 @njit(cache=True)
 def barrier(
-    mode: int, a: FloatArray, b: FloatArray, x: FloatArray, p: FloatArray, q: FloatArray, rho:
-    float, g: FloatArray, mu: float
-) -> float:  # pragma: no cover - compiled
-    """``f(x) + ρ Σ (p + q) - μ Σ log g`` (``nan`` or ``inf`` outside the bounds)."""
+    mode: int, a: FloatArray, b: FloatArray, x: FloatArray, p: FloatArray, q: FloatArray,
+    rho: float, g: FloatArray
+) -> tuple[float, float]:  # pragma: no cover - compiled
+    """The barrier's parts ``(f(x) + ρ Σ (p + q), Σ log g)`` (``nan``, ``-inf`` off bounds)."""
     logs = 0.0
     for i in range(g.size):
         logs += np.log(g[i])
     pen = 0.0
     for i in range(p.size):
         pen += p[i] + q[i]
-    return _objective_value(mode, a, b, x) + rho * pen - mu * logs
+    return _objective_value(mode, a, b, x) + rho * pen, logs
 
 
 @njit(cache=True)

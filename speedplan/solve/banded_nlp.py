@@ -35,8 +35,8 @@ import numpy as np
 from ..core.checks import FloatArray, IntArray
 from .problem import DiscreteProblem
 
-__all__ = ["LATERAL_STARTS", "STARTS", "BandedNlpResult", "Start", "compile_nlp_kernels", "nlp_kernels_ready",
-           "solve_banded_nlp"]
+__all__ = ["LATERAL_STARTS", "STARTS", "BandedNlpResult", "Start", "compile_nlp_kernels",
+           "nlp_kernels_ready", "solve_banded_nlp"]
 
 #: Lower bound on interior ``w`` (unit scale) when the problem has none: keeps ``sqrt(w)``
 #: and ``1/sqrt(w)`` finite; it never binds at a solution (``1/sqrt(w)`` would be huge).
@@ -706,6 +706,8 @@ class _FastPhase(_Phase):
         self.fr, self.kn = rows, rows.kn
         self.mode = mode
         self._gh: tuple[FloatArray, FloatArray, FloatArray] | None = None
+        self._gaps: tuple[FloatArray, ...] | None = None
+        self._barrier: tuple[Any, ...] | None = None
 
     def _grad_hess(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Gradient and Hessian of the objective at ``x`` (kept for the same ``x``)."""
@@ -716,8 +718,13 @@ class _FastPhase(_Phase):
         return self._gh[1], self._gh[2]
 
     def gaps(self, pt: _Point) -> FloatArray:
+        # The line search and the accepted step ask for the gaps of the same point.
+        c = self._gaps
+        if c is not None and c[0] is pt.x and c[1] is pt.s and c[2] is pt.p and c[3] is pt.q:
+            return c[4]
         g = np.empty(2 * self.m + 2 * self.rows.size + 2 * self.ne)
         self.kn.gaps(pt.x, pt.s, pt.p, pt.q, self.lb, self.ub, self.fr.lo, self.fr.hi, g)
+        self._gaps = (pt.x, pt.s, pt.p, pt.q, g)
         return g
 
     def residual(self, ev: _Eval | _FastEval, pt: _Point) -> FloatArray:
@@ -726,7 +733,14 @@ class _FastPhase(_Phase):
         return out
 
     def barrier(self, pt: _Point, g: FloatArray, mu: float) -> float:
-        return float(self.kn.barrier(*self.mode, pt.x, pt.p, pt.q, self.rho, g, mu))
+        # Kept per point: the accepted trial point's barrier is asked again (perhaps at a new
+        # mu) as the next iterate's; only mu * Σ log g depends on mu.
+        c = self._barrier
+        if c is None or c[0] is not pt.x or c[1] is not pt.p or c[2] is not pt.q \
+                or c[3] is not g:
+            value, logs = self.kn.barrier(*self.mode, pt.x, pt.p, pt.q, self.rho, g)
+            c = self._barrier = (pt.x, pt.p, pt.q, g, value, logs)
+        return float(c[4] - mu * c[5])
 
     def errors(self, pt: _Point, ev: _Eval, g: FloatArray, jty: FloatArray,
                mu: float) -> tuple[float, float]:
