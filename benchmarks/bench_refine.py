@@ -128,8 +128,11 @@ def load_corpus(path: Path, prefix: str = "") -> list[Case]:
         def get(name: str, i: int = i) -> Any:
             return z[f"{i}/{name}"]
         w_min = get("w_min")
-        lateral = (StencilRows(coef=get("lat_coef"), bound=get("lat_bound"))
-                   if f"{i}/lat_coef" in z else None)
+        names = [("lat_coef", "lat_bound")] + [(f"lat{j}_coef", f"lat{j}_bound")
+                                                for j in range(4)]  # older files: lat_coef
+        fams = tuple(StencilRows(coef=get(c), bound=get(b)) for c, b in names
+                     if f"{i}/{c}" in z)
+        lateral = fams if fams else None
         p = DiscreteProblem(
             s=get("s"), w_max=get("w_max"), accel=get("accel"), decel=get("decel"),
             jerk=get("jerk"), w_start=float(get("ends")[0]), w_end=float(get("ends")[1]),

@@ -7,6 +7,7 @@ the relaxation's certified lower bound, and the problem's own row checks for fea
 
 from __future__ import annotations
 
+import os
 import warnings
 
 import casadi as ca
@@ -188,6 +189,61 @@ def test_compiled_kernels_compute_what_the_numpy_path_computes(elastic):
     close(ref.new_z(pt.z, 0.7, steps[0][0], g, mu), got.new_z(pt.z, 0.7, steps[0][0], g, mu))
     close(ref.max_step(g, d.z, 0.99), got.max_step(g, d.z, 0.99))
     close(ref.tiny(d.z, g), got.tiny(d.z, g))
+
+
+@pytest.fixture
+def cold_kernels(monkeypatch, tmp_path):
+    """A process whose refinement kernels are neither loaded nor cached; spawns recorded."""
+    from speedplan.solve import banded
+
+    kn = banded_nlp._load_kernels(wait=True)
+    state = {"cached": False, "spawned": [], "compiled": 0}
+    monkeypatch.setattr(banded_nlp._KernelState, "module", None)
+    monkeypatch.setattr(banded_nlp._KernelState, "background", None)
+    monkeypatch.setattr(banded_nlp._KernelState, "spawn_failed", False)
+    monkeypatch.delenv(banded.BACKGROUND_COMPILE_ENV, raising=False)
+
+    def load(*, wait):
+        if not (state["cached"] or wait):
+            return None
+        state["compiled"] += not state["cached"]
+        banded_nlp._KernelState.module = kn
+        return kn
+
+    class Proc:
+        code = None
+
+        def poll(self):
+            return self.code
+
+    def spawn(module, function, lock):
+        assert (module, function) == ("speedplan.solve.banded_nlp", "compile_nlp_kernels")
+        os.remove(lock)  # as the real process does when it is done
+        state["spawned"].append(Proc())
+        return state["spawned"][-1]
+
+    monkeypatch.setattr(banded_nlp, "_load_kernels", load)
+    monkeypatch.setattr(banded, "_kernel_lock_path", lambda f: str(tmp_path / "nlp.lock"))
+    monkeypatch.setattr(banded, "_spawn_compile_of", spawn)
+    return state, kn
+
+
+def test_the_numpy_path_answers_while_the_kernels_compile_in_the_background(cold_kernels):
+    state, kn = cold_kernels
+    assert banded_nlp._kernels() is None and len(state["spawned"]) == 1
+    assert banded_nlp._kernels() is None and len(state["spawned"]) == 1  # still compiling
+    state["spawned"][0].code = 0  # done: the kernels are in the cache now
+    state["cached"] = True
+    assert banded_nlp._kernels() is kn and state["compiled"] == 0
+
+
+def test_without_background_compilation_the_kernels_compile_here(cold_kernels, monkeypatch):
+    from speedplan.solve import banded
+
+    state, kn = cold_kernels
+    monkeypatch.setenv(banded.BACKGROUND_COMPILE_ENV, "0")
+    assert banded_nlp._kernels() is kn
+    assert state["compiled"] == 1 and not state["spawned"]
 
 
 def test_compiled_and_numpy_runs_reach_the_same_point():

@@ -420,23 +420,32 @@ def kernel_ready(*, start: bool = True) -> bool:
 COMPILE_LOCK_STALE = 600.0
 
 
-def _lock_path(module_file: str | None = None) -> str:
-    """One lock per kernel module (default the relaxation's), numba, cache and interpreter."""
+def _lock_path() -> str:
+    """One lock per copy of speedplan, numba version, cache directory and interpreter."""
+    return _kernel_lock_path(ipm.__file__)
+
+
+def _kernel_lock_path(module_file: str) -> str:
+    """The compile lock of the kernel module ``module_file`` (see :func:`_lock_path`)."""
     import numba
 
-    key = "|".join((os.path.abspath(module_file or ipm.__file__), numba.__version__,
+    key = "|".join((os.path.abspath(module_file), numba.__version__,
                     os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
     digest = hashlib.sha256(key.encode()).hexdigest()[:16]
     return os.path.join(tempfile.gettempdir(), f"speedplan-kernel-{digest}.lock")
 
 
-def _claim_compile_lock(path: str | None = None) -> bool:
+def _claim_compile_lock() -> bool:
     """Whether this process may start the background compilation (no other one is running).
 
     Worker processes of :func:`~speedplan.plan_many` all start cold; the lock file makes one
     of them compile while the others answer with Clarabel until the cache has the kernel.
     """
-    path = path or _lock_path()
+    return _claim_lock(_lock_path())
+
+
+def _claim_lock(path: str) -> bool:
+    """Create the lock file ``path``; False if a fresh one exists (as _claim_compile_lock)."""
     for _ in range(2):
         try:
             os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
@@ -472,13 +481,15 @@ def kernel_for_auto(*, wait: bool) -> bool:
     return False
 
 
-def _spawn_compile(
-    module: str = "speedplan.solve.banded", function: str = "compile_kernel",
-    lock: str | None = None,
-) -> subprocess.Popen[bytes] | None:
+def _spawn_compile() -> subprocess.Popen[bytes] | None:
+    """Start ``python -c "...compile_kernel()"`` on this very copy of speedplan."""
+    return _spawn_compile_of("speedplan.solve.banded", "compile_kernel", _lock_path())
+
+
+def _spawn_compile_of(module: str, function: str, lock: str) -> subprocess.Popen[bytes] | None:
     """Start ``python -c "from module import function; function()"`` on this copy of speedplan.
 
-    The lock file ``lock`` (default the relaxation kernel's) is removed when it ends.
+    At the lowest priority; the lock file ``lock`` is removed when it ends.
     """
     if not sys.executable:
         return None
@@ -492,7 +503,7 @@ def _spawn_compile(
             f"try:\n    {function}()\nfinally:\n"
             "    os.path.exists(sys.argv[1]) and os.remove(sys.argv[1])\n")
     try:
-        return subprocess.Popen([sys.executable, "-c", code, lock or _lock_path()], env=env,
+        return subprocess.Popen([sys.executable, "-c", code, lock], env=env,
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
     except OSError:

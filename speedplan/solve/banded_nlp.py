@@ -911,9 +911,9 @@ def nlp_kernels_ready(*, start: bool = True) -> bool:
         return True
     if start and _background_allowed():
         spec = importlib.util.find_spec(_KERNELS)
-        lock = banded._lock_path(spec.origin if spec else None)
-        if banded._claim_compile_lock(lock):
-            _KernelState.background = banded._spawn_compile(
+        lock = banded._kernel_lock_path(spec.origin if spec and spec.origin else _KERNELS)
+        if banded._claim_lock(lock):
+            _KernelState.background = banded._spawn_compile_of(
                 __name__, "compile_nlp_kernels", lock)
             _KernelState.spawn_failed = _KernelState.background is None
     return False
