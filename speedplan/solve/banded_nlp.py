@@ -16,6 +16,12 @@ line search with second-order corrections, inertia correction by a multiple of t
 elastic ``ℓ1`` problem with a proximity term) when the line search fails. The rows are the
 plain ones, ``(c · w) sqrt(w_i) ∈ [-B_i, B_i]``. The answer is re-checked by the caller,
 never trusted.
+
+Each iteration's array work (rows, condensed matrix and its factor, direction, step rules,
+errors, barrier) runs in compiled kernels (:mod:`speedplan.solve._banded_nlp_kernels`, numba)
+once they are in numba's cache, and in the numpy methods below until then (a background
+process compiles them meanwhile, see :func:`nlp_kernels_ready`); the control flow is the same
+code for both.
 """
 
 from __future__ import annotations
@@ -896,6 +902,22 @@ def nlp_kernels_ready(*, start: bool = True) -> bool:
     installation) and ``start`` is true, a background Python process at the lowest priority
     compiles them into the cache (as for the relaxation's kernel, and unless
     ``SPEEDPLAN_BACKGROUND_COMPILE=0``); later calls load them once it is done.
+
+    Parameters
+    ----------
+    start : bool
+        Start the background compilation if the kernels are not cached.
+
+    Returns
+    -------
+    bool
+        Whether :func:`solve_banded_nlp` uses the compiled kernels now.
+
+    Examples
+    --------
+    >>> compile_nlp_kernels()
+    >>> nlp_kernels_ready(start=False)
+    True
     """
     from . import banded
 
