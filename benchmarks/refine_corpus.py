@@ -12,9 +12,15 @@ model layer and of later changes to the relaxation.
 The issue's case (``L = 8.149...``, ``v0 = 0.0934...``, ``a0 = -0.1535...``) is always the
 first entry, on the default grid and on ``n = 2000``.
 
+With ``--lateral`` the requests are instead those of ``benchmarks/lateral_exactness.py``'s
+fuzz (same seed, same draws: random G2 waypoint paths with lateral-jerk and yaw-rate limits,
+from rest to rest), every leg whose relaxation is not exact: with these rows the relaxation is
+almost never exact and every ``plan()`` goes through the refinement.
+
 Usage::
 
     python benchmarks/refine_corpus.py --out benchmarks/data/refine_corpus.npz --draws 400
+    python benchmarks/refine_corpus.py --lateral --draws 40 --max-keep 200 --out /tmp/lat.npz
 """
 
 from __future__ import annotations
@@ -48,9 +54,8 @@ def problem_arrays(p: DiscreteProblem) -> dict[str, Any]:
     if p.w_min is None:
         out["w_min"] = np.zeros(p.n)
     out["ends"] = np.array([p.w_start, p.w_end])
-    if p.lateral_families:  # the corpus stores one family
-        (lat,) = p.lateral_families
-        out["lat_coef"], out["lat_bound"] = lat.coef, lat.bound
+    for j, lat in enumerate(p.lateral_families):  # lateral jerk, yaw rate
+        out[f"lat{j}_coef"], out[f"lat{j}_bound"] = lat.coef, lat.bound
     return out
 
 
@@ -72,6 +77,28 @@ def draw_request(rng: np.random.Generator, paths: list[tuple[str, sp.Path]]) -> 
     return {"name": name, "path": path, "limits": lim, "kw": kw}
 
 
+LGV = dict(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+
+
+def lateral_jobs(draws: int, seed: int) -> list[tuple[str, sp.Path, sp.Limits, dict[str, Any],
+                                                      int | None]]:
+    """The requests of ``lateral_exactness.py``'s fuzz (``--cases draws --seed seed``)."""
+    rng = np.random.default_rng(seed)
+    jobs: list[tuple[str, sp.Path, sp.Limits, dict[str, Any], int | None]] = []
+    for i in range(draws):
+        k = int(rng.integers(4, 9))
+        pts = np.cumsum(rng.uniform(-10, 10, size=(k, 2)), axis=0)
+        try:
+            path = sp.Path.from_waypoints(pts, max_deviation=float(rng.uniform(0.1, 1.0)))
+        except InvalidInputError:
+            continue
+        j_lat = float(np.exp(rng.uniform(np.log(0.05), np.log(3))))
+        yaw = None if rng.random() < 0.3 else float(rng.uniform(0.2, 2))
+        jobs.append((f"fuzz{i} j_lat={j_lat:.3g} yaw={yaw if yaw is None else f'{yaw:.3g}'}",
+                     path, sp.Limits(**LGV, j_lat_max=j_lat, yaw_rate_max=yaw), {}, None))
+    return jobs
+
+
 def relax(p: DiscreteProblem) -> tuple[Any, float]:
     """Relaxation only (``refine='never'``) and the scale ``max(w_max)`` refine_ipopt sees."""
     with warnings.catch_warnings():
@@ -86,6 +113,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--draws", type=int, default=400)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--max-keep", type=int, default=24)
+    ap.add_argument("--lateral", action="store_true",
+                    help="lateral_exactness.py's fuzz requests (--draws cases) instead")
     args = ap.parse_args(argv)
     paths = [("line", ISSUE_PATH)] + [
         (f, read_path(PATHS / f)) for f in ("warehouse_loop.json", "u_turn.json",
@@ -96,32 +125,44 @@ def main(argv: list[str] | None = None) -> None:
         ("issue", ISSUE_PATH, ISSUE_LIMITS, ISSUE_KW, None),
         ("issue n=2000", ISSUE_PATH, ISSUE_LIMITS, ISSUE_KW, 2000),
     ]
-    for _ in range(args.draws):
-        d = draw_request(rng, paths)
-        jobs.append((d["name"], d["path"], d["limits"], d["kw"], None))
+    if args.lateral:
+        jobs = lateral_jobs(args.draws, args.seed)
+    else:
+        for _ in range(args.draws):
+            d = draw_request(rng, paths)
+            jobs.append((d["name"], d["path"], d["limits"], d["kw"], None))
     saved: dict[str, Any] = {}
     labels: list[str] = []
     t0 = time.perf_counter()
     for k, (name, path, lim, kw, n) in enumerate(jobs):
         if len(labels) >= args.max_keep:
             break
-        try:
-            p = build_model(PlanRequest.create(path, lim, n=n, **kw)).problem
-            sol, w_scale = relax(p)
+        try:  # every leg with a free speed law (not a forced max-jerk motion)
+            problems = [leg.problem for leg in
+                        build_model(PlanRequest.create(path, lim, n=n, **kw)).legs
+                        if hasattr(leg, "problem")]
         except (InfeasibleError, InvalidInputError, SolverError):
             continue
-        if sol.exact:
-            continue
-        label = (f"{name} n={p.n} v_max={lim.v_max:.3g} a_max={lim.a_max:.3g} "
-                 f"j_max={lim.j_max:.3g} " + " ".join(f"{a}={v:.3g}" for a, v in kw.items()))
-        i = len(labels)
-        labels.append(label)
-        for key, val in problem_arrays(p).items():
-            saved[f"{i}/{key}"] = val
-        saved[f"{i}/w0"] = sol.relaxation.w / w_scale
-        saved[f"{i}/lower_bound"] = np.array(sol.lower_bound)
-        print(f"{i:3d} (draw {k}) {label}: violation {sol.relaxation.jerk_violation:.3g}",
-              flush=True)
+        for leg, p in enumerate(problems):
+            if len(labels) >= args.max_keep:
+                break
+            try:
+                sol, w_scale = relax(p)
+            except (InfeasibleError, InvalidInputError, SolverError):
+                continue
+            if sol.exact:
+                continue
+            label = (f"{name}{f' leg {leg}' if len(problems) > 1 else ''} n={p.n} "
+                     f"v_max={lim.v_max:.3g} a_max={lim.a_max:.3g} j_max={lim.j_max:.3g} "
+                     + " ".join(f"{a}={v:.3g}" for a, v in kw.items()))
+            i = len(labels)
+            labels.append(label)
+            for key, val in problem_arrays(p).items():
+                saved[f"{i}/{key}"] = val
+            saved[f"{i}/w0"] = sol.relaxation.w / w_scale
+            saved[f"{i}/lower_bound"] = np.array(sol.lower_bound)
+            print(f"{i:3d} (draw {k}) {label}: violation {sol.relaxation.jerk_violation:.3g}",
+                  flush=True)
     saved["labels"] = np.array(labels)
     np.savez_compressed(args.out, **saved)
     print(f"# saved {len(labels)} problems to {args.out} in {time.perf_counter() - t0:.0f} s")

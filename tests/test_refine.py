@@ -7,6 +7,7 @@ the relaxation's certified lower bound, and the problem's own row checks for fea
 
 from __future__ import annotations
 
+import os
 import warnings
 
 import casadi as ca
@@ -120,6 +121,150 @@ def test_condensed_newton_matrix_matches_automatic_differentiation():
     np.testing.assert_allclose(rows.jac(ev, dx), j_ad @ dx, rtol=1e-12, atol=1e-12)
 
 
+def _small_problem(rng) -> DiscreteProblem:
+    n = 12
+    s = np.cumsum(np.concatenate(([0.0], rng.uniform(0.5, 1.5, n - 1))))
+    jerk = rng.uniform(0.5, 2.0, n - 2)
+    jerk[3] = np.inf  # an absent row
+    lateral = StencilRows(coef=rng.normal(size=(n - 2, 3)), bound=rng.uniform(1, 2, n - 2))
+    return DiscreteProblem(s=s, w_max=np.ones(n), accel=np.ones(n - 1), decel=np.ones(n - 1),
+                           jerk=jerk, w_start=0.2, w_end=0.3, lateral=lateral)
+
+
+@pytest.mark.parametrize("elastic", [False, True])
+def test_compiled_kernels_compute_what_the_numpy_path_computes(elastic):
+    # Every step of an iteration, on a random point: same formulas, only the rounding of the
+    # sums and of the banded factorisation may differ.
+    kn = banded_nlp._load_kernels(wait=True)
+    rng = np.random.default_rng(1)
+    p = _small_problem(rng)
+    rows = banded_nlp._Rows(p)
+    lb, ub = banded_nlp._bounds(p)
+    x = rng.uniform(0.2, 0.9, p.n - 2)
+    rows.scale(rows.evaluate(x), 0.5)  # scaled rows: the kernels must use the scales too
+    fast = banded_nlp._FastRows(rows, kn)
+    if elastic:
+        x_ref = rng.uniform(0.2, 0.9, p.n - 2)
+        obj = banded_nlp._proximity(x_ref, 0.3)
+        mode = (1, banded_nlp._proximity_weights(x_ref, 0.3), x_ref)
+    else:
+        tau = p.tau.astype(float)
+        obj, mode = banded_nlp._travel_time(tau), (0, tau, tau)
+    kw = {"elastic": elastic, "rho": 1000.0 if elastic else 0.0}
+    ref = banded_nlp._Phase(rows, lb, ub, obj, **kw)
+    got = banded_nlp._FastPhase(fast, lb, ub, obj, mode, **kw)
+    e = rows.size if elastic else 0
+    s = banded_nlp._push_inside(rows.evaluate(x).c, rows.lo, rows.hi, 1e-2)
+    pt = banded_nlp._Point(x, s, rng.uniform(0.1, 1, e), rng.uniform(0.1, 1, e),
+                           rng.normal(size=rows.size), np.zeros(0))
+    g = ref.gaps(pt)
+    pt = pt._replace(z=0.1 / g * rng.uniform(0.5, 2.0, g.size))
+    mu = 0.05
+
+    def close(a, b):
+        np.testing.assert_allclose(np.asarray(b, float), np.asarray(a, float), rtol=1e-10,
+                                   atol=1e-12)
+
+    ev, fev = rows.evaluate(x), fast.evaluate(x)
+    close(ev.c, fev.c)
+    jty = rows.jac_t(ev, pt.y)
+    close(jty, fast.jac_t(fev, pt.y))
+    close(g, got.gaps(pt))
+    close(ref.residual(ev, pt), got.residual(fev, pt))
+    close(ref.barrier(pt, g, mu), got.barrier(pt, g, mu))
+    close(ref.errors(pt, ev, g, jty, mu), got.errors(pt, fev, g, jty, mu))
+    for delta_last in (0.0, 1e-3):
+        (nt, d_ref, c_ref), (ft, d_got, c_got) = (
+            ph.newton(pt, e_, g, jty, mu, delta_last) for ph, e_ in ((ref, ev), (got, fev)))
+        assert (d_ref, c_ref) == (d_got, c_got)
+        for name in nt._fields[1:]:
+            close(getattr(nt, name), getattr(ft, name))
+    rp = ref.residual(ev, pt)
+    d, fd = ref.direction(nt, ev, rp), got.direction(ft, fev, rp)
+    for name in d._fields:
+        close(getattr(d, name), getattr(fd, name))
+    steps = ref.dual_step(pt, g, nt, d, mu, 0.99), got.dual_step(pt, g, ft, fd, mu, 0.99)
+    for a, b in zip(*steps, strict=True):
+        close(a, b)
+    close(ref.new_z(pt.z, 0.7, steps[0][0], g, mu), got.new_z(pt.z, 0.7, steps[0][0], g, mu))
+    close(ref.max_step(g, d.z, 0.99), got.max_step(g, d.z, 0.99))
+    close(ref.tiny(d.z, g), got.tiny(d.z, g))
+
+
+@pytest.fixture
+def cold_kernels(monkeypatch, tmp_path):
+    """A process whose refinement kernels are neither loaded nor cached; spawns recorded."""
+    from speedplan.solve import banded
+
+    kn = banded_nlp._load_kernels(wait=True)
+    state = {"cached": False, "spawned": [], "compiled": 0}
+    monkeypatch.setattr(banded_nlp._KernelState, "module", None)
+    monkeypatch.setattr(banded_nlp._KernelState, "background", None)
+    monkeypatch.setattr(banded_nlp._KernelState, "spawn_failed", False)
+    monkeypatch.delenv(banded.BACKGROUND_COMPILE_ENV, raising=False)
+
+    def load(*, wait):
+        if not (state["cached"] or wait):
+            return None
+        state["compiled"] += not state["cached"]
+        banded_nlp._KernelState.module = kn
+        return kn
+
+    class Proc:
+        code = None
+
+        def poll(self):
+            return self.code
+
+    def spawn(module, function, lock):
+        assert (module, function) == ("speedplan.solve.banded_nlp", "compile_nlp_kernels")
+        os.remove(lock)  # as the real process does when it is done
+        state["spawned"].append(Proc())
+        return state["spawned"][-1]
+
+    monkeypatch.setattr(banded_nlp, "_load_kernels", load)
+    monkeypatch.setattr(banded, "_kernel_lock_path", lambda f: str(tmp_path / "nlp.lock"))
+    monkeypatch.setattr(banded, "_spawn_compile_of", spawn)
+    return state, kn
+
+
+def test_the_numpy_path_answers_while_the_kernels_compile_in_the_background(cold_kernels):
+    state, kn = cold_kernels
+    assert banded_nlp._kernels() is None and len(state["spawned"]) == 1
+    assert banded_nlp._kernels() is None and len(state["spawned"]) == 1  # still compiling
+    state["spawned"][0].code = 0  # done: the kernels are in the cache now
+    state["cached"] = True
+    assert banded_nlp._kernels() is kn and state["compiled"] == 0
+
+
+def test_without_background_compilation_the_kernels_compile_here(cold_kernels, monkeypatch):
+    from speedplan.solve import banded
+
+    state, kn = cold_kernels
+    monkeypatch.setenv(banded.BACKGROUND_COMPILE_ENV, "0")
+    assert banded_nlp._kernels() is kn
+    assert state["compiled"] == 1 and not state["spawned"]
+
+
+def test_compiled_and_numpy_runs_reach_the_same_point():
+    p = _unit(_paper(("pw lin", "rnd", "logrnd"), 300, 0, lateral=True))
+    w0 = solve_relaxation(p).w
+    for start in banded_nlp.LATERAL_STARTS:
+        a = banded_nlp.solve_banded_nlp(p, w0, start, compiled=False)
+        b = banded_nlp.solve_banded_nlp(p, w0, start, compiled=True)
+        assert (a.status, a.restorations) == (b.status, b.restorations)
+        assert abs(a.iterations - b.iterations) <= 2
+        assert abs(p.travel_time(a.w) / p.travel_time(b.w) - 1) <= 1e-8
+    # The restoration phase (elastic rows, proximity objective) on both paths.
+    p = _unit(_paper(("rnd", "cnst", "cnst"), 100, 0))
+    w0 = p.w_max.copy()
+    w0[0] = w0[-1] = 0.0
+    a, b = (banded_nlp.solve_banded_nlp(p, w0, banded_nlp.STARTS[0], compiled=c)
+            for c in (False, True))
+    assert b.restorations >= 1 and (a.status, a.restorations) == (b.status, b.restorations)
+    assert abs(p.travel_time(a.w) / p.travel_time(b.w) - 1) <= 1e-8
+
+
 @pytest.mark.parametrize("family,seed", [(("rnd", "cnst", "logrnd"), s) for s in range(4)]
                          + [(("pw lin", "rnd", "logrnd"), 0), (("pw cnst", "reg", "logrnd"), 2),
                             (("rnd", "rnd", "logrnd"), 4)])
@@ -149,6 +294,17 @@ def test_best_of_the_starts_is_returned():
     assert p.travel_time(res.w) == min(accepted) or (
         abs(first_two[0] - first_two[1]) <= refine_module.AGREE * first_two[0]
         and p.travel_time(res.w) == min(first_two))
+    assert p.travel_time(res.w) <= min(accepted) * (1 + refine_module.AGREE)
+
+
+def test_lateral_problems_try_the_scaled_starts_first_and_keep_the_best():
+    p = _unit(_paper(("pw lin", "rnd", "logrnd"), 300, 0, lateral=True))
+    w0 = solve_relaxation(p).w
+    res = refine(p, w0)
+    each = [banded_nlp.solve_banded_nlp(p, w0, start) for start in banded_nlp.LATERAL_STARTS]
+    accepted = [p.travel_time(r.w) for r in each if r.success and _feasible(p, r.w)]
+    assert res.status.split(":")[0] in ("banded/ipopt-default", "banded/scaled")
+    assert res.iterations == sum(r.iterations for r in each[:2])  # the first two agreed
     assert p.travel_time(res.w) <= min(accepted) * (1 + refine_module.AGREE)
 
 

@@ -425,9 +425,14 @@ COMPILE_LOCK_STALE = 600.0
 
 def _lock_path() -> str:
     """One lock per copy of speedplan, numba version, cache directory and interpreter."""
+    return _kernel_lock_path(ipm.__file__)
+
+
+def _kernel_lock_path(module_file: str) -> str:
+    """The compile lock of the kernel module ``module_file`` (see :func:`_lock_path`)."""
     import numba
 
-    key = "|".join((os.path.abspath(ipm.__file__), numba.__version__,
+    key = "|".join((os.path.abspath(module_file), numba.__version__,
                     os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
     digest = hashlib.sha256(key.encode()).hexdigest()[:16]
     return os.path.join(tempfile.gettempdir(), f"speedplan-kernel-{digest}.lock")
@@ -439,7 +444,11 @@ def _claim_compile_lock() -> bool:
     Worker processes of :func:`~speedplan.plan_many` all start cold; the lock file makes one
     of them compile while the others answer with Clarabel until the cache has the kernel.
     """
-    path = _lock_path()
+    return _claim_lock(_lock_path())
+
+
+def _claim_lock(path: str) -> bool:
+    """Create the lock file ``path``; False if a fresh one exists (as _claim_compile_lock)."""
     for _ in range(2):
         try:
             os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
@@ -477,6 +486,14 @@ def kernel_for_auto(*, wait: bool) -> bool:
 
 def _spawn_compile() -> subprocess.Popen[bytes] | None:
     """Start ``python -c "...compile_kernel()"`` on this very copy of speedplan."""
+    return _spawn_compile_of("speedplan.solve.banded", "compile_kernel", _lock_path())
+
+
+def _spawn_compile_of(module: str, function: str, lock: str) -> subprocess.Popen[bytes] | None:
+    """Start ``python -c "from module import function; function()"`` on this copy of speedplan.
+
+    At the lowest priority; the lock file ``lock`` is removed when it ends.
+    """
     if not sys.executable:
         return None
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -485,11 +502,11 @@ def _spawn_compile() -> subprocess.Popen[bytes] | None:
     # Lowest priority: the compilation must not slow down the process that is waiting for
     # answers (it uses Clarabel meanwhile).
     code = ("import os, sys; hasattr(os, 'nice') and os.nice(19)\n"
-            "from speedplan.solve.banded import compile_kernel\n"
-            "try:\n    compile_kernel()\nfinally:\n"
+            f"from {module} import {function}\n"
+            f"try:\n    {function}()\nfinally:\n"
             "    os.path.exists(sys.argv[1]) and os.remove(sys.argv[1])\n")
     try:
-        return subprocess.Popen([sys.executable, "-c", code, _lock_path()], env=env,
+        return subprocess.Popen([sys.executable, "-c", code, lock], env=env,
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
     except OSError:

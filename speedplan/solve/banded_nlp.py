@@ -16,21 +16,33 @@ line search with second-order corrections, inertia correction by a multiple of t
 elastic ``ℓ1`` problem with a proximity term) when the line search fails. The rows are the
 plain ones, ``(c · w) sqrt(w_i) ∈ [-B_i, B_i]``. The answer is re-checked by the caller,
 never trusted.
+
+Each iteration's array work (rows, condensed matrix and its factor, direction, step rules,
+errors, barrier) runs in compiled kernels (:mod:`speedplan.solve._banded_nlp_kernels`, numba)
+once they are in numba's cache, and in the numpy methods below until then (a background
+process compiles them meanwhile, see :func:`nlp_kernels_ready`); the control flow is the same
+code for both.
 """
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
+import os
+import subprocess
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import pairwise
-from typing import NamedTuple
+from types import ModuleType
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
 from .problem import DiscreteProblem
 
-__all__ = ["STARTS", "BandedNlpResult", "Start", "solve_banded_nlp"]
+__all__ = ["LATERAL_STARTS", "STARTS", "BandedNlpResult", "Start", "compile_nlp_kernels",
+           "nlp_kernels_ready", "solve_banded_nlp"]
 
 #: Lower bound on interior ``w`` (unit scale) when the problem has none: keeps ``sqrt(w)``
 #: and ``1/sqrt(w)`` finite; it never binds at a solution (``1/sqrt(w)`` would be huge).
@@ -92,6 +104,20 @@ STARTS = (
     Start("near", mu_init=1e-2, push=1e-4, gradient_scaling=False),
     Start("ipopt-default", mu_init=0.1, push=1e-2, gradient_scaling=True),
     Start("nearer", mu_init=1e-3, push=1e-4, gradient_scaling=False),
+)
+
+#: The starts for problems with lateral-jerk (or yaw-rate) rows, in this order. Unscaled, the
+#: near starts stall there: on the 88 refinements of ``benchmarks/lateral_exactness.py
+#: --cases 40`` ``near`` ended at the iteration limit on 39 and ``nearer`` on 64, while both
+#: scaled starts (``scaled`` is IPOPT's start and scaling with the first barrier parameter of
+#: ``near``) were accepted on 87 and agreed to :data:`~speedplan.solve.refine.AGREE` on 86, there
+#: within 4e-8 of the best of all four starts. The near starts remain the safeguard when
+#: the scaled ones disagree or fail.
+LATERAL_STARTS = (
+    STARTS[1],
+    Start("scaled", mu_init=1e-2, push=1e-2, gradient_scaling=True),
+    STARTS[0],
+    STARTS[2],
 )
 
 
@@ -266,9 +292,13 @@ def _travel_time(tau: FloatArray) -> _Objective:
     )
 
 
+def _proximity_weights(x_ref: FloatArray, zeta: float) -> FloatArray:
+    return zeta * np.minimum(1.0, 1.0 / np.abs(x_ref)) ** 2
+
+
 def _proximity(x_ref: FloatArray, zeta: float) -> _Objective:
     """IPOPT's restoration objective without the penalty: ``ζ/2 ||D (x - x_ref)||²``."""
-    d2 = zeta * np.minimum(1.0, 1.0 / np.abs(x_ref)) ** 2
+    d2 = _proximity_weights(x_ref, zeta)
     return _Objective(
         value=lambda x: 0.5 * _dot(d2, (x - x_ref) ** 2),
         grad=lambda x: d2 * (x - x_ref),
@@ -408,7 +438,7 @@ class _Phase:
         lo, hi = self.rows.lo, self.rows.hi
         return np.concatenate((pt.x - self.lb, self.ub - pt.x, pt.s - lo, hi - pt.s, pt.p, pt.q))
 
-    def residual(self, ev: _Eval, pt: _Point) -> FloatArray:
+    def residual(self, ev: _Eval | _FastEval, pt: _Point) -> FloatArray:
         r = ev.c - pt.s
         return r + pt.p - pt.q if self.ne else r
 
@@ -472,6 +502,33 @@ class _Phase:
         dq = (dy - nt.r_q) / nt.sig[self.slices[5]]
         return _Point(dx, ds, dp, dq, dy, np.concatenate((dx, -dx, ds, -ds, dp, dq)))
 
+    def dual_step(self, pt: _Point, g: FloatArray, nt: _Newton, d: _Point, mu: float,
+                  tau: float) -> tuple[FloatArray, float, float]:
+        """The bound multipliers' step, its largest step length and the barrier's slope."""
+        mg = mu / g
+        dz = mg - pt.z - nt.sig * d.z
+        a_dual = _max_step(pt.z, dz, tau)
+        dphi = _dot(self.obj.grad(pt.x), d.x) - _dot(mg, d.z)
+        if self.ne:
+            dphi += self.rho * float(d.p.sum() + d.q.sum())
+        return dz, a_dual, dphi
+
+    @staticmethod
+    def new_z(z: FloatArray, a_dual: float, dz: FloatArray, g: FloatArray,
+              mu: float) -> FloatArray:
+        """IPOPT's safeguard: keep each bound multiplier within a factor of mu / gap."""
+        return np.minimum(np.maximum(z + a_dual * dz, mu / (KAPPA_SIGMA * g)),
+                          KAPPA_SIGMA * mu / g)
+
+    @staticmethod
+    def max_step(v: FloatArray, dv: FloatArray, tau: float) -> float:
+        return _max_step(v, dv, tau)
+
+    @staticmethod
+    def tiny(dv: FloatArray, g: FloatArray) -> float:
+        """``max |dv| / (1 + g)`` (IPOPT's tiny-step test)."""
+        return float(np.max(np.abs(dv) / (1.0 + g)))
+
     def trial(self, pt: _Point, d: _Point, alpha: float) -> _Trial:
         """The primal point ``pt + α d`` (multipliers unchanged), evaluated."""
         x = pt.x + alpha * d.x
@@ -505,8 +562,8 @@ class _Phase:
         Returns ``(verdict, trial, step, α)``; a ``None`` verdict means no step was accepted.
         """
         theta, dphi = ref.theta, ref.dphi
-        alpha = _max_step(g, d.z, tau)
-        if float(np.max(np.abs(d.z) / (1.0 + g))) < 10 * np.finfo(float).eps:
+        alpha = self.max_step(g, d.z, tau)
+        if self.tiny(d.z, g) < 10 * np.finfo(float).eps:
             return False, self.trial(pt, d, 1.0), d, 1.0  # tiny step: take it (tiny_step_tol)
         # IPOPT's smallest step before restoration (its eq. 23).
         alpha_min = GAMMA_THETA
@@ -527,7 +584,7 @@ class _Phase:
                 c_soc, theta_old = alpha * rp + tr.residual, theta
                 for _ in range(MAX_SOC):
                     soc = self.direction(nt, ev, c_soc)
-                    a_soc = _max_step(g, soc.z, tau)
+                    a_soc = self.max_step(g, soc.z, tau)
                     ts = self.trial(pt, soc, a_soc)
                     accepted = self.verdict(ts, alpha, ref)
                     if accepted is not None:
@@ -574,12 +631,7 @@ class _Phase:
             if delta > 0:
                 delta_last = delta
             d = self.direction(nt, ev, rp)
-            mg = mu / g
-            dz = mg - pt.z - nt.sig * d.z
-            a_dual = _max_step(pt.z, dz, tau)
-            dphi = _dot(self.obj.grad(pt.x), d.x) - _dot(mg, d.z)
-            if self.ne:
-                dphi += self.rho * float(d.p.sum() + d.q.sum())
+            dz, a_dual, dphi = self.dual_step(pt, g, nt, d, mu, tau)
             theta = float(np.abs(rp).sum())
             phi = self.barrier(pt, g, mu)
             ref = _Reference(theta, phi, dphi, mu, theta_min, theta_max, filt)
@@ -594,10 +646,7 @@ class _Phase:
                 filt.append(((1 - GAMMA_THETA) * theta, phi - GAMMA_PHI * theta))
             ev, rp = tr.ev, tr.residual
             g = self.gaps(tr.point)
-            # IPOPT's safeguard: keep each bound multiplier within a factor of mu / gap.
-            z = np.minimum(np.maximum(pt.z + a_dual * dz, mu / (KAPPA_SIGMA * g)),
-                           KAPPA_SIGMA * mu / g)
-            pt = tr.point._replace(y=pt.y + alpha * step.y, z=z)
+            pt = tr.point._replace(y=pt.y + alpha * step.y, z=self.new_z(pt.z, a_dual, dz, g, mu))
             if self.stop is not None:
                 stop = self.stop(ev, pt)
                 if stop is not None:
@@ -606,6 +655,155 @@ class _Phase:
         if status == "MaxIterations" and best_e <= ACCEPTABLE_TOL:
             return _Outcome("Acceptable", best, mu, filt, it, n_fact)
         return _Outcome(status, pt, mu, filt, it, n_fact)
+
+
+class _FastEval(NamedTuple):
+    """Row values and, per flattened family row, ``D (R_f, 3)``, ``c · w`` and ``sqrt(w)``."""
+
+    c: FloatArray
+    d: FloatArray
+    load: FloatArray
+    sq: FloatArray
+
+
+class _FastRows:
+    """:class:`_Rows` (scaled as it is) with the family rows flattened for the kernels."""
+
+    def __init__(self, rows: _Rows, kernels: ModuleType) -> None:
+        self.rows, self.kn = rows, kernels
+        self.n, self.size, self.lo, self.hi = rows.n, rows.size, rows.lo, rows.hi
+        fams = rows.fams
+        self.kk = np.ascontiguousarray(np.concatenate([fa.k for fa in fams]), dtype=np.int64) \
+            if fams else np.zeros(0, dtype=np.int64)
+        self.cc = np.ascontiguousarray(np.concatenate([fa.c for fa in fams]), dtype=np.float64) \
+            if fams else np.zeros((0, 3))
+        self.rr = np.ascontiguousarray(np.concatenate([fa.r for fa in fams]), dtype=np.float64) \
+            if fams else np.zeros(0)
+
+    def full(self, x: FloatArray) -> FloatArray:
+        return self.rows.full(x)
+
+    def evaluate(self, x: FloatArray) -> _FastEval:
+        nf = self.kk.size
+        ev = _FastEval(np.empty(self.size), np.empty((nf, 3)), np.empty(nf), np.empty(nf))
+        self.kn.evaluate(self.rows.w_start, self.rows.w_end, x, self.kk, self.cc, self.rr, *ev)
+        return ev
+
+    def jac_t(self, ev: _FastEval, v: FloatArray) -> FloatArray:
+        out = np.empty(self.n - 2)
+        self.kn.jac_t(v, self.kk, ev.d, out)
+        return out
+
+
+class _FastPhase(_Phase):
+    """:class:`_Phase` with each step's array work done by the compiled kernels.
+
+    Same method, same formulas (the kernels' module docstring); only the rounding of sums
+    differs. ``objective`` is given as the kernels' ``(mode, a, b)``.
+    """
+
+    def __init__(
+        self, rows: _FastRows, lb: FloatArray, ub: FloatArray, objective: _Objective,
+        mode: tuple[int, FloatArray, FloatArray], *, elastic: bool, rho: float = 0.0,
+        stop: Callable[[_Eval, _Point], str | None] | None = None,
+    ) -> None:
+        super().__init__(rows, lb, ub, objective, elastic=elastic, rho=rho,  # type: ignore[arg-type]
+                         stop=stop)
+        self.fr, self.kn = rows, rows.kn
+        self.mode = mode
+        self._gh: tuple[FloatArray, FloatArray, FloatArray] | None = None
+        self._gaps: tuple[FloatArray, ...] | None = None
+        self._barrier: tuple[Any, ...] | None = None
+
+    def _grad_hess(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Gradient and Hessian of the objective at ``x`` (kept for the same ``x``)."""
+        if self._gh is None or self._gh[0] is not x:
+            grad, hess = np.empty(x.size), np.empty(x.size)
+            self.kn.objective(*self.mode, x, grad, hess)
+            self._gh = (x, grad, hess)
+        return self._gh[1], self._gh[2]
+
+    def gaps(self, pt: _Point) -> FloatArray:
+        # The line search and the accepted step ask for the gaps of the same point.
+        c = self._gaps
+        if c is not None and c[0] is pt.x and c[1] is pt.s and c[2] is pt.p and c[3] is pt.q:
+            return c[4]
+        g = np.empty(2 * self.m + 2 * self.rows.size + 2 * self.ne)
+        self.kn.gaps(pt.x, pt.s, pt.p, pt.q, self.lb, self.ub, self.fr.lo, self.fr.hi, g)
+        self._gaps = (pt.x, pt.s, pt.p, pt.q, g)
+        return g
+
+    def residual(self, ev: _Eval | _FastEval, pt: _Point) -> FloatArray:
+        out = np.empty(ev.c.size)
+        self.kn.residual(ev.c, pt.s, pt.p, pt.q, self.ne, out)
+        return out
+
+    def barrier(self, pt: _Point, g: FloatArray, mu: float) -> float:
+        # Kept per point: the accepted trial point's barrier is asked again (perhaps at a new
+        # mu) as the next iterate's; only mu * Σ log g depends on mu.
+        c = self._barrier
+        if c is None or c[0] is not pt.x or c[1] is not pt.p or c[2] is not pt.q \
+                or c[3] is not g:
+            value, logs = self.kn.barrier(*self.mode, pt.x, pt.p, pt.q, self.rho, g)
+            c = self._barrier = (pt.x, pt.p, pt.q, g, value, logs)
+        return float(c[4] - mu * c[5])
+
+    def errors(self, pt: _Point, ev: _Eval, g: FloatArray, jty: FloatArray,
+               mu: float) -> tuple[float, float]:
+        grad, _ = self._grad_hess(pt.x)
+        res = self.residual(ev, pt)
+        e0, e_mu = self.kn.errors(self.m, self.ne, grad, jty, pt.y, pt.z, g, res, res,
+                                  self.rho, mu)
+        return float(e0), float(e_mu)
+
+    def newton(self, pt: _Point, ev: _Eval, g: FloatArray, jty: FloatArray, mu: float,
+               delta_last: float) -> tuple[_Newton | None, float, int]:
+        m, r, e = self.m, self.rows.size, self.ne
+        grad, hess = self._grad_hess(pt.x)
+        fev: _FastEval = ev  # type: ignore[assignment]
+        ab, factor = np.empty((3, m)), np.empty((3, m))
+        sig = np.empty(g.size)
+        sig_s, sig_e, r_s, r_extra = np.empty(r), np.empty(r), np.empty(r), np.empty(r)
+        r_x, r_p, r_q = np.empty(m), np.empty(e), np.empty(e)
+        delta, count = self.kn.newton(
+            m, e, pt.y, pt.z, g, grad, jty, hess, self.fr.kk, fev.d, self.fr.rr, self.fr.cc,
+            fev.load, fev.sq, self.rho, mu, delta_last,
+            ab, sig, sig_s, sig_e, r_x, r_s, r_p, r_q, r_extra, factor)
+        if delta < 0:
+            return None, DELTA_W_MAX, int(count)
+        if not e:
+            r_p = r_q = pt.p
+        return _Newton(factor, sig, sig_s, sig_e, r_x, r_s, r_p, r_q, r_extra), delta, int(count)
+
+    def direction(self, nt: _Newton, ev: _Eval, r_c: FloatArray) -> _Point:
+        m, r, e = self.m, self.rows.size, self.ne
+        fev: _FastEval = ev  # type: ignore[assignment]
+        dx, ds, dy = np.empty(m), np.empty(r), np.empty(r)
+        dp, dq = (np.empty(e), np.empty(e)) if e else (nt.r_p, nt.r_q)
+        dz = np.empty(2 * m + 2 * r + 2 * e)
+        self.kn.direction(e, nt.factor, nt.sig, nt.sig_s, nt.sig_e, nt.r_x, nt.r_s, nt.r_p,
+                          nt.r_q, nt.r_extra, self.fr.kk, fev.d, r_c, dx, ds, dp, dq, dy, dz)
+        return _Point(dx, ds, dp, dq, dy, dz)
+
+    def dual_step(self, pt: _Point, g: FloatArray, nt: _Newton, d: _Point, mu: float,
+                  tau: float) -> tuple[FloatArray, float, float]:
+        grad, _ = self._grad_hess(pt.x)
+        dz = np.empty(g.size)
+        a_dual, dphi = self.kn.dual_step(self.ne, grad, d.x, pt.z, g, nt.sig, d.z, mu, tau,
+                                         self.rho, dz)
+        return dz, float(a_dual), float(dphi)
+
+    def new_z(self, z: FloatArray, a_dual: float,  # type: ignore[override]
+              dz: FloatArray, g: FloatArray, mu: float) -> FloatArray:
+        out = np.empty(z.size)
+        self.kn.new_z(z, a_dual, dz, g, mu, KAPPA_SIGMA, out)
+        return out
+
+    def max_step(self, v: FloatArray, dv: FloatArray, tau: float) -> float:  # type: ignore[override]
+        return float(self.kn.max_step(v, dv, tau))
+
+    def tiny(self, dv: FloatArray, g: FloatArray) -> float:  # type: ignore[override]
+        return float(self.kn.tiny(dv, g))
 
 
 def _bounds(p: DiscreteProblem) -> tuple[FloatArray, FloatArray]:
@@ -625,9 +823,147 @@ def _elastic_split(r: FloatArray, a: float) -> tuple[FloatArray, FloatArray]:
     return 0.5 * (root - r), 0.5 * (root + r)
 
 
+# --- the compiled kernels: load from numba's cache, or compile in the background ------------
+
+
+class _KernelState:
+    """The kernels module once its every kernel is loaded, and a background compilation."""
+
+    module: ModuleType | None = None
+    background: subprocess.Popen[bytes] | None = None
+    spawn_failed = False
+
+
+_KERNELS = f"{__package__}._banded_nlp_kernels"
+
+
+def _load_cached(disp: Any, sig: str) -> bool:
+    """Load ``disp``'s overload for ``sig`` from numba's on-disk cache; never compiles.
+
+    What :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (as
+    :func:`speedplan.solve.banded._load_from_disk_cache` for the relaxation's kernel).
+    """
+    from numba.core import sigutils
+    from numba.core.compiler_lock import global_compiler_lock
+
+    try:
+        args, _ = sigutils.normalize_signature(sig)  # type: ignore[no-untyped-call]
+        if tuple(args) in disp.overloads:
+            return True
+        with global_compiler_lock:
+            cres = disp._cache.load_overload(sig, disp.targetctx)
+            if cres is None:
+                return False
+            disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+            disp.add_overload(cres)
+        return True
+    except Exception:  # pragma: no cover - numba internals changed: behave as "not cached"
+        return False
+
+
+def _load_kernels(*, wait: bool) -> ModuleType | None:
+    """The kernels module if every kernel loads from the cache, or (``wait``) is compiled."""
+    if _KernelState.module is not None:
+        return _KernelState.module
+    kn = importlib.import_module(_KERNELS)  # imports numba
+    loaded = all(_load_cached(getattr(kn, name), sig) for name, sig in kn.SIGNATURES.items())
+    if not loaded:
+        if not wait:
+            return None
+        for name, sig in kn.SIGNATURES.items():
+            getattr(kn, name).compile(sig)
+    for name in kn.SIGNATURES:
+        getattr(kn, name).disable_compile()  # a call with other types is a bug, not a compile
+    _KernelState.module = kn
+    return kn
+
+
+def compile_nlp_kernels() -> None:
+    """Make the compiled kernels available in this process now: load them, or compile them.
+
+    :func:`solve_banded_nlp` uses its numpy path until they are (:func:`nlp_kernels_ready`).
+
+    Examples
+    --------
+    >>> compile_nlp_kernels()
+    >>> nlp_kernels_ready()
+    True
+    """
+    if _KernelState.background is not None:
+        _KernelState.background.wait()
+        _KernelState.background = None
+    _load_kernels(wait=True)
+
+
+def nlp_kernels_ready(*, start: bool = True) -> bool:
+    """Whether the kernels run now without compiling; else compile them in the background.
+
+    They load from numba's cache when they are there. When they are not (first use after
+    installation) and ``start`` is true, a background Python process at the lowest priority
+    compiles them into the cache (as for the relaxation's kernel, and unless
+    ``SPEEDPLAN_BACKGROUND_COMPILE=0``); later calls load them once it is done.
+
+    Parameters
+    ----------
+    start : bool
+        Start the background compilation if the kernels are not cached.
+
+    Returns
+    -------
+    bool
+        Whether :func:`solve_banded_nlp` uses the compiled kernels now.
+
+    Examples
+    --------
+    >>> compile_nlp_kernels()
+    >>> nlp_kernels_ready(start=False)
+    True
+    """
+    from . import banded
+
+    if _KernelState.module is not None:
+        return True
+    if _KernelState.background is not None:
+        code = _KernelState.background.poll()
+        if code is None:
+            return False
+        _KernelState.background = None
+        _KernelState.spawn_failed = code != 0
+    if _load_kernels(wait=False) is not None:
+        return True
+    if start and _background_allowed():
+        spec = importlib.util.find_spec(_KERNELS)
+        lock = banded._kernel_lock_path(spec.origin if spec and spec.origin else _KERNELS)
+        if banded._claim_lock(lock):
+            _KernelState.background = banded._spawn_compile_of(
+                __name__, "compile_nlp_kernels", lock)
+            _KernelState.spawn_failed = _KernelState.background is None
+    return False
+
+
+def _background_allowed() -> bool:
+    from . import banded
+
+    return (not _KernelState.spawn_failed
+            and os.environ.get(banded.BACKGROUND_COMPILE_ENV) != "0")
+
+
+def _kernels() -> ModuleType | None:
+    """The kernels module if it is available now (see :func:`nlp_kernels_ready`).
+
+    Without background compilation (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could
+    be started) they are compiled here, as the relaxation's kernel is.
+    """
+    if nlp_kernels_ready():
+        return _KernelState.module
+    if _KernelState.background is None and not _background_allowed():
+        return _load_kernels(wait=True)
+    return None
+
+
 def solve_banded_nlp(
     problem: DiscreteProblem, w0: FloatArray, start: Start = STARTS[0], *,
-    max_iter: int = MAX_ITER,
+    max_iter: int = MAX_ITER, compiled: bool | None = None,
 ) -> BandedNlpResult:
     """Run the banded interior-point method from ``w0`` (interior nodes free, ends fixed).
 
@@ -642,6 +978,11 @@ def solve_banded_nlp(
         One of :data:`STARTS`.
     max_iter : int
         Iteration limit, restoration included.
+    compiled : bool, optional
+        Do each iteration's array work in the compiled kernels
+        (:mod:`speedplan.solve._banded_nlp_kernels`, compiling them here if needed) or in
+        numpy; by default the kernels when they are available without compiling (see
+        :func:`nlp_kernels_ready`), numpy otherwise. Same method either way.
 
     Returns
     -------
@@ -680,7 +1021,16 @@ def solve_banded_nlp(
         grad = _travel_time(tau).grad(x)
         tau = tau * min(1.0, SCALING_MAX_GRADIENT / float(np.abs(grad).max()))
         rows.scale(rows.evaluate(x), SCALING_MAX_GRADIENT)
-    main = _Phase(rows, lb, ub, _travel_time(tau), elastic=False)
+    kn = _kernels() if compiled is None else (_load_kernels(wait=True) if compiled else None)
+    prows: _Rows | _FastRows = rows if kn is None else _FastRows(rows, kn)
+
+    def phase(objective: _Objective, mode: tuple[int, FloatArray, FloatArray],
+              **kw: object) -> _Phase:
+        if kn is None:
+            return _Phase(rows, lb, ub, objective, **kw)  # type: ignore[arg-type]
+        return _FastPhase(prows, lb, ub, objective, mode, **kw)  # type: ignore[arg-type]
+
+    main = phase(_travel_time(tau), (0, tau, tau), elastic=False)
     s = _push_inside(rows.evaluate(x).c, rows.lo, rows.hi, start.push)
     empty = np.zeros(0)
     mu = start.mu_init
@@ -701,7 +1051,7 @@ def solve_banded_nlp(
         # Feasibility restoration (IPOPT, Section 3.3): reduce the row violation close to the
         # current point until the original filter accepts the point.
         restorations += 1
-        r0 = main.residual(rows.evaluate(pt.x), pt)
+        r0 = main.residual(prows.evaluate(pt.x), pt)
         theta_r = float(np.abs(r0).sum())
         mu_r = max(mu, float(np.abs(r0).max()))
         pr, qr = _elastic_split(r0, mu_r / RESTO_RHO)
@@ -717,8 +1067,9 @@ def solve_banded_nlp(
                 return None
             return "Restored"
 
-        resto = _Phase(rows, lb, ub, _proximity(pt.x, np.sqrt(mu)), elastic=True,
-                       rho=RESTO_RHO, stop=leave)
+        zeta = np.sqrt(mu)
+        resto = phase(_proximity(pt.x, zeta), (1, _proximity_weights(pt.x, zeta), pt.x),
+                      elastic=True, rho=RESTO_RHO, stop=leave)
         rpt = _Point(pt.x, pt.s, pr, qr, np.zeros(rows.size), empty)
         rout = resto.run(rpt._replace(z=mu_r / resto.gaps(rpt)), mu_r, [], max_iter - iterations)
         iterations += rout.iterations

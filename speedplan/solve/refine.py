@@ -6,7 +6,8 @@ acceptance test passes; only when none passes does it run IPOPT
 (:func:`~speedplan.solve.ipopt_.refine_ipopt`). The problem is nonconvex, so different starts
 can end in different local optima (up to 3 % apart on the benchmark corpus): the best of the
 starts is the safeguard. Each run costs a few milliseconds per thousand nodes, and the last
-start is skipped when the first two agree.
+start is skipped when the first two agree. Problems with lateral-jerk rows run
+:data:`~speedplan.solve.banded_nlp.LATERAL_STARTS` instead (the scaled starts first).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.checks import FloatArray
-from .banded_nlp import STARTS, solve_banded_nlp
+from .banded_nlp import LATERAL_STARTS, STARTS, solve_banded_nlp
 from .ipopt_ import RefineResult, refine_ipopt
 from .problem import DiscreteProblem
 
@@ -75,7 +76,7 @@ def refine(
     last: tuple[FloatArray, str] = (np.asarray(w0, dtype=np.float64), "not run")
     iterations = 0
     found: list[float] = []
-    for start in STARTS:
+    for start in LATERAL_STARTS if problem.has_lateral else STARTS:
         res = solve_banded_nlp(problem, w0, start)
         iterations += res.iterations
         status = f"banded/{start.name}: {res.status}"
