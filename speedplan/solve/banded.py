@@ -348,7 +348,6 @@ def _load_from_disk_cache() -> bool:
     Mirrors what :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's
     dispatcher offers no public "load but do not compile"); any failure means "not loaded".
     """
-    disp: Any = ipm.iterate
     p = _example_problem()
     d, _ = _prepare(p, _positive_feasible(p)[1:-1])
     args = (*_kernel_args(d, *_start(p, d)), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
@@ -356,10 +355,26 @@ def _load_from_disk_cache() -> bool:
 
     try:
         sig = tuple(numba.typeof(a) for a in args)  # type: ignore[no-untyped-call]
-        if sig in disp.overloads:
-            return True
-        from numba.core.compiler_lock import global_compiler_lock
+    except Exception:  # pragma: no cover - numba internals changed: behave as "not cached"
+        return False
+    return load_cached_overload(ipm.iterate, sig)
 
+
+def load_cached_overload(disp: Any, sig: Any) -> bool:
+    """Load numba dispatcher ``disp``'s overload for ``sig`` from the on-disk cache; never compiles.
+
+    ``sig``: a signature string or a tuple of numba types. Mirrors what
+    :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's dispatcher
+    offers no public "load but do not compile"); any failure means "not loaded". Shared with
+    the refinement's kernels (:mod:`speedplan.solve.banded_nlp`).
+    """
+    from numba.core import sigutils
+    from numba.core.compiler_lock import global_compiler_lock
+
+    try:
+        args, _ = sigutils.normalize_signature(sig)  # type: ignore[no-untyped-call]
+        if tuple(args) in disp.overloads:
+            return True
         with global_compiler_lock:
             cres = disp._cache.load_overload(sig, disp.targetctx)
             if cres is None:
@@ -404,12 +419,8 @@ def kernel_ready(*, start: bool = True) -> bool:
     """
     if _Kernel.ready:
         return True
-    if _Kernel.background is not None:
-        code = _Kernel.background.poll()
-        if code is None:
-            return False
-        _Kernel.background = None
-        _Kernel.spawn_failed = code != 0  # never start a failing compilation twice
+    if not background_done(_Kernel):
+        return False
     if _load_from_disk_cache():
         _Kernel.ready = True
         return True
@@ -417,6 +428,23 @@ def kernel_ready(*, start: bool = True) -> bool:
         _Kernel.background = _spawn_compile()
         _Kernel.spawn_failed = _Kernel.background is None
     return False
+
+
+def background_done(state: Any) -> bool:
+    """Whether ``state``'s background compilation (``state.background``) is over, or none ran.
+
+    ``state`` is a class with ``background`` (the process or ``None``) and ``spawn_failed``
+    (set when the process failed: a failing compilation is never started twice), for the
+    relaxation's kernel (:class:`_Kernel`) and the refinement's.
+    """
+    if state.background is None:
+        return True
+    code = state.background.poll()
+    if code is None:
+        return False
+    state.background = None
+    state.spawn_failed = code != 0
+    return True
 
 
 #: A compile lock older than this [s] is taken to be left by a process that died.

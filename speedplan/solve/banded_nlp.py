@@ -837,36 +837,15 @@ class _KernelState:
 _KERNELS = f"{__package__}._banded_nlp_kernels"
 
 
-def _load_cached(disp: Any, sig: str) -> bool:
-    """Load ``disp``'s overload for ``sig`` from numba's on-disk cache; never compiles.
-
-    What :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (as
-    :func:`speedplan.solve.banded._load_from_disk_cache` for the relaxation's kernel).
-    """
-    from numba.core import sigutils
-    from numba.core.compiler_lock import global_compiler_lock
-
-    try:
-        args, _ = sigutils.normalize_signature(sig)  # type: ignore[no-untyped-call]
-        if tuple(args) in disp.overloads:
-            return True
-        with global_compiler_lock:
-            cres = disp._cache.load_overload(sig, disp.targetctx)
-            if cres is None:
-                return False
-            disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
-            disp.add_overload(cres)
-        return True
-    except Exception:  # pragma: no cover - numba internals changed: behave as "not cached"
-        return False
-
-
 def _load_kernels(*, wait: bool) -> ModuleType | None:
     """The kernels module if every kernel loads from the cache, or (``wait``) is compiled."""
     if _KernelState.module is not None:
         return _KernelState.module
+    from .banded import load_cached_overload
+
     kn = importlib.import_module(_KERNELS)  # imports numba
-    loaded = all(_load_cached(getattr(kn, name), sig) for name, sig in kn.SIGNATURES.items())
+    loaded = all(load_cached_overload(getattr(kn, name), sig)
+                 for name, sig in kn.SIGNATURES.items())
     if not loaded:
         if not wait:
             return None
@@ -923,12 +902,8 @@ def nlp_kernels_ready(*, start: bool = True) -> bool:
 
     if _KernelState.module is not None:
         return True
-    if _KernelState.background is not None:
-        code = _KernelState.background.poll()
-        if code is None:
-            return False
-        _KernelState.background = None
-        _KernelState.spawn_failed = code != 0
+    if not banded.background_done(_KernelState):
+        return False
     if _load_kernels(wait=False) is not None:
         return True
     if start and _background_allowed():
