@@ -408,3 +408,15 @@ def test_issue_17_braking_start_on_a_uniform_grid_is_refined():
     assert sol.jerk_violation <= p.jerk_tol
     assert p.linear_violation(sol.w) <= 1e-7 * max(1.0, float(np.max(p.w_max)))
     assert 0.0 <= sol.gap < 0.05
+
+
+def test_the_compiled_kernels_use_the_numpy_paths_inertia_constants():
+    # Written twice on purpose (numba freezes globals into cached code and re-validates the
+    # cache against the kernels' own file only): they must not drift apart.
+    pytest.importorskip("numba")
+    from speedplan.solve import _banded_nlp_kernels as kernels
+    from speedplan.solve import banded_nlp
+
+    names = ("DELTA_W_FIRST", "DELTA_W_MIN", "DELTA_W_MAX", "KAPPA_W_PLUS_FIRST",
+             "KAPPA_W_PLUS", "KAPPA_W_MINUS")
+    assert {n: getattr(kernels, n) for n in names} == {n: getattr(banded_nlp, n) for n in names}

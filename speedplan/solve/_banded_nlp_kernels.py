@@ -26,7 +26,9 @@ from numba import njit
 
 from ..core.checks import FloatArray, IntArray
 
-# IPOPT's inertia-correction constants (the same as in banded_nlp).
+# IPOPT's inertia-correction constants, the numpy path's (banded_nlp). Written here, not
+# imported: numba freezes globals into cached code and re-validates the cache against this
+# file only. tests/test_refine.py checks that the two sets agree.
 DELTA_W_FIRST, DELTA_W_MIN, DELTA_W_MAX = 1e-4, 1e-20, 1e40
 KAPPA_W_PLUS_FIRST, KAPPA_W_PLUS, KAPPA_W_MINUS = 100.0, 8.0, 1.0 / 3.0
 
