@@ -148,11 +148,11 @@ def compare(a_path: str, b_path: str) -> None:
     print(f"{same} of {len(names)} instances bitwise identical")
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def record_or_compare(description: str, record: Any, compare: Any) -> None:
+    """The command line of a ``record OUT`` / ``compare A B`` script (this one, sample_states)."""
+    parser = argparse.ArgumentParser(description=description)
     sub = parser.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("record")
-    r.add_argument("out")
+    sub.add_parser("record").add_argument("out")
     c = sub.add_parser("compare")
     c.add_argument("a")
     c.add_argument("b")
@@ -161,6 +161,10 @@ def main() -> None:
         record(args.out)
     else:
         compare(args.a, args.b)
+
+
+def main() -> None:
+    record_or_compare(__doc__.splitlines()[0], record, compare)
 
 
 if __name__ == "__main__":

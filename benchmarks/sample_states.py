@@ -13,13 +13,13 @@ over all cases (a change of rounding shows as ~1e-16; a change of results would 
 
 from __future__ import annotations
 
-import argparse
 import math
 import warnings
 from typing import Any
 
 import numpy as np
 from bench_all import cases
+from kernel_fingerprint import record_or_compare
 
 import speedplan as sp
 from speedplan.solve.banded import compile_kernel
@@ -72,17 +72,7 @@ def compare(a_path: str, b_path: str) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="cmd", required=True)
-    sub.add_parser("record").add_argument("out")
-    c = sub.add_parser("compare")
-    c.add_argument("a")
-    c.add_argument("b")
-    args = parser.parse_args()
-    if args.cmd == "record":
-        record(args.out)
-    else:
-        compare(args.a, args.b)
+    record_or_compare(__doc__.splitlines()[0], record, compare)
 
 
 if __name__ == "__main__":
