@@ -133,7 +133,7 @@ def plan(
 
 def plan_request(request: PlanRequest) -> SpeedProfile:
     """:func:`plan` for an already validated :class:`~speedplan.model.PlanRequest`."""
-    modelled, model = _model_within_state_slack(request)
+    modelled, model = _model_reaching_the_states(request)
     jumps = [r.s for r in model.rests if r.reason == "curvature jump"]
     if jumps:
         shown = ", ".join(f"{s:.6g}" for s in jumps[:5]) + (", ..." if len(jumps) > 5 else "")
@@ -182,7 +182,7 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
     return replace(profile, verification=check, limits_exceeded=not check.ok)
 
 
-def _model_within_state_slack(request: PlanRequest) -> tuple[PlanRequest, Model]:
+def _model_reaching_the_states(request: PlanRequest) -> tuple[PlanRequest, Model]:
     """The request's model, else with exact reach envelopes, else with a hair more jerk.
 
     Moving boundary states are capped by the max-jerk motion (``reach="max_jerk"``), which
