@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import glob
+import importlib
 import itertools
 import warnings
 
@@ -129,7 +130,15 @@ def _law_check(path, lim, **kw):
     return check_law(law, 0.0, path, leg.bound, lim).verification, law.duration
 
 
-def test_limit_ratios_and_duration_converge_as_the_grid_is_refined():
+@pytest.fixture
+def ungraded(monkeypatch):
+    """User grids exactly uniform: without the grading at the rests (``graded_rest_ends``)."""
+    build = importlib.import_module("speedplan.model.build")
+    monkeypatch.setattr(build, "graded_rest_ends", lambda s, ell_start, ell_end: s)
+
+
+def test_limit_ratios_and_duration_converge_as_the_grid_is_refined(ungraded):
+    # The law itself on uniform grids (a user grid is graded at the rests, test_user_grids).
     path = Path.from_segments([Line(30.0)])
     results = [_law_check(path, LGV, n=n) for n in (300, 600, 1200, 2400)]
     jerk = [check.ratios["jerk"] for check, _ in results]
@@ -141,7 +150,8 @@ def test_limit_ratios_and_duration_converge_as_the_grid_is_refined():
     assert errors[-1] < 1e-5
 
 
-def test_coarse_grid_is_refined_where_the_limits_are_exceeded():
+def test_coarse_grid_is_refined_where_the_limits_are_exceeded(ungraded):
+    # The refinement behind the grading: a law that breaks a tolerance is refined there.
     path = Path.from_segments([Line(30.0)])
     before, _ = _law_check(path, LGV, n=300)
     assert "jerk" in before.violations  # the uniform 300-node law breaks the 5 % tolerance

@@ -23,7 +23,7 @@ from ..geometry import Path, SpeedBound
 from ..solve import DiscreteProblem, DiscreteSolution, solve_problem
 from ..solve.problem import StencilRows
 from .boundary import check_reachable_states, fastest_w, jerk_motion_w, turnaround_speed
-from .grid import adaptive_grid, uniform_grid
+from .grid import adaptive_grid, graded_rest_ends, rest_phase_length, uniform_grid
 from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
 
@@ -275,8 +275,13 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
         request, bound, lo, hi)
     env = _Envelopes.of(request, v0, a0, vf, af, length)
     if request.n is not None or request.ds is not None:
-        n = None if request.n is None else request.n
-        s = uniform_grid(length, n=n, ds=request.ds)
+        s = uniform_grid(length, n=request.n, ds=request.ds)
+        if request.smooth_standstill:
+            s = graded_rest_ends(
+                s, rest_phase_length(lim.a_max, lim.v_max, lim.j_max, length)
+                if v0 == a0 == 0 else None,
+                rest_phase_length(lim.a_decel, lim.v_max, lim.j_max, length)
+                if vf == af == 0 else None)
         _check_moving_ends_resolved(s, lo, v0, a0, vf, af)
     elif request.jerk_limited:
         low = [v for v in (v0, vf) if v > 0] + [
