@@ -63,9 +63,10 @@ def plan(
         Speed, acceleration, braking, lateral acceleration and jerk limits (SI).
     n, ds : int or float, optional
         Uniform grid with ``n`` nodes or step at most ``ds`` [m] (per leg), graded finer
-        near the ends where the vehicle rests when its step is longer than 1/20 of the first
-        jerk phase from rest (:func:`~speedplan.model.grid.graded_rest_ends`: the law's jerk
-        would exceed ``j_max`` there and the grid be refined after a first solve). By default the
+        at a leg's ends where its step is longer than 1/20 of the boundary transient (the
+        first jerk phase from rest, a moving state's change of acceleration;
+        :func:`~speedplan.model.grid.graded_ends`): the law would exceed the limits there and
+        the grid be refined after a first solve. By default the
         grid is adaptive and smoothly graded: ~80 nodes per jerk transition, coarse in long
         cruises.
     v0, a0 : float

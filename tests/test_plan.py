@@ -9,6 +9,7 @@ import warnings
 
 import numpy as np
 import pytest
+from oracles import measure, ruckig_move, within_promise
 from ruckig import InputParameter, Result, Ruckig, Trajectory
 from shared import LGV
 
@@ -132,9 +133,9 @@ def _law_check(path, lim, **kw):
 
 @pytest.fixture
 def ungraded(monkeypatch):
-    """User grids exactly uniform: without the grading at the rests (``graded_rest_ends``)."""
+    """User grids exactly uniform: without the grading at the rests (``graded_ends``)."""
     build = importlib.import_module("speedplan.model.build")
-    monkeypatch.setattr(build, "graded_rest_ends", lambda s, ell_start, ell_end: s)
+    monkeypatch.setattr(build, "graded_ends", lambda s, ell_start, ell_end: s)
 
 
 def test_limit_ratios_and_duration_converge_as_the_grid_is_refined(ungraded):
@@ -323,13 +324,16 @@ def test_a_refinement_that_cannot_resolve_a_jerk_phase_keeps_the_flagged_law():
         assert any(issubclass(w.category, LimitWarning) for w in caught)
 
 
-def test_coarse_user_grid_for_a_braking_start_is_refused_by_name():
+def test_coarse_user_grid_for_a_braking_start_is_graded_to_resolve_it():
     # 2 m at 1/16 mm/s, braking at the start: the law reached rest in the first half cell
-    # of n=120 and the duration was infinite (a NaN-free but never-arriving trajectory).
+    # of n=120 and the duration was infinite (a NaN-free but never-arriving trajectory);
+    # then such grids were refused (InvalidInputError naming the step to use); now the user
+    # grid is graded at its moving ends, to 1/20 of the transient.
     lim = Limits(v_max=6.25e-5, a_max=1e-3, a_lat_max=1e-3, j_max=2e-3)
     line = Path.from_segments([Line(2.0)])
-    with pytest.raises(InvalidInputError, match=r"too coarse for the start state .* default"):
-        plan(line, lim, v0=3.125e-5, a0=-3e-4, n=120)
-    with pytest.raises(InvalidInputError, match=r"too coarse for the end state"):
-        plan(line, lim, vf=3.125e-5, af=3e-4, n=120)
-    assert np.isfinite(plan(line, lim, v0=3.125e-5, a0=-3e-4).duration)
+    for states in ({"v0": 3.125e-5, "a0": -3e-4}, {"vf": 3.125e-5, "af": 3e-4}):
+        profile = plan(line, lim, n=120, **states)
+        assert profile.status == "optimal" and profile.s.size > 120
+        assert within_promise(measure(profile))
+        optimum = ruckig_move(2.0, lim, **states).duration
+        assert optimum is not None and profile.duration == pytest.approx(optimum, rel=1e-5)

@@ -18,6 +18,8 @@ import speedplan as sp
 from speedplan.core.errors import SolverError
 from speedplan.geometry import Line
 from speedplan.model import PlanRequest, build_model
+from speedplan.model.build import leg_on_grid
+from speedplan.model.grid import uniform_grid
 from speedplan.solve import DiscreteProblem, banded_nlp, solve_problem
 from speedplan.solve import refine as refine_module
 from speedplan.solve.clarabel_ import solve_relaxation
@@ -383,19 +385,24 @@ def test_infeasible_rows_are_reported_not_returned_as_success():
     assert isinstance(res, RefineResult)
 
 
-def _issue_problem(n=None) -> DiscreteProblem:
+def _issue_problem(n: int) -> DiscreteProblem:
+    """The problem on the exactly uniform grid of ``n`` nodes (as plan() built it then)."""
     lim = sp.Limits(v_max=1.5103489923280469, a_max=0.8675731399347792, a_lat_max=1,
                     j_max=0.1324661827707745)
     path = sp.Path.from_segments([Line(8.149176458679765)])
-    req = PlanRequest.create(path, lim, v0=0.09343837197243295, a0=-0.15353125453853034, n=n)
+    v0, a0 = 0.09343837197243295, -0.15353125453853034
+    req = PlanRequest.create(path, lim, v0=v0, a0=a0, n=n)
     (leg,) = build_model(req).legs
-    return leg.problem
+    uniform = uniform_grid(path.length, n=n)
+    return leg_on_grid(req, leg.bound, uniform, 0.0, v0, a0, 0.0, 0.0).problem
 
 
 def test_issue_17_braking_start_on_a_uniform_grid_is_refined():
     # Before: IPOPT (adaptive barrier, rows divided by their bound) reported
     # Infeasible_Problem_Detected here and solve_problem raised SolverError. (On the default
-    # grid the relaxation of this request is now exact: the start envelopes of the model.)
+    # grid the relaxation of this request is now exact: the start envelopes of the model; on
+    # plan()'s user grids too, now graded at the braking start: the uniform grid keeps the
+    # refinement exercised.)
     p = _issue_problem(2000)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no fallback warning either

@@ -23,7 +23,7 @@ from ..geometry import Path, SpeedBound
 from ..solve import DiscreteProblem, DiscreteSolution, solve_problem
 from ..solve.problem import StencilRows
 from .boundary import check_reachable_states, fastest_w, jerk_motion_w, turnaround_speed
-from .grid import adaptive_grid, graded_rest_ends, rest_phase_length, uniform_grid
+from .grid import adaptive_grid, graded_ends, rest_phase_length, uniform_grid
 from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
 
@@ -276,12 +276,9 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
     env = _Envelopes.of(request, v0, a0, vf, af, length)
     if request.n is not None or request.ds is not None:
         s = uniform_grid(length, n=request.n, ds=request.ds)
-        if request.smooth_standstill:
-            s = graded_rest_ends(
-                s, rest_phase_length(lim.a_max, lim.v_max, lim.j_max, length)
-                if v0 == a0 == 0 else None,
-                rest_phase_length(lim.a_decel, lim.v_max, lim.j_max, length)
-                if vf == af == 0 else None)
+        if request.jerk_limited:
+            s = graded_ends(s, _transient(request, v0, a0, lim.a_max, length),
+                            _transient(request, vf, -af, lim.a_decel, length))
         _check_moving_ends_resolved(s, lo, v0, a0, vf, af)
     elif request.jerk_limited:
         low = [v for v in (v0, vf) if v > 0] + [
@@ -295,6 +292,35 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
     else:
         s = uniform_grid(length, n=NO_JERK_NODES)
     return leg_on_grid(request, leg_bound, s, lo, v0, a0, vf, af)
+
+
+def _transient(request: PlanRequest, v: float, a: float, a_limit: float,
+               length: float) -> float | None:
+    """Length of a leg's first boundary transient (its last one: ``v = vf``, ``a = -af``).
+
+    At a smooth standstill the first jerk phase from rest (``None`` for the paper's free
+    standstill, where the acceleration may jump). A moving state: the shorter of the
+    distance covered while its acceleration is brought to 0, a jerk transition
+    ``v min(t_j, √(v / j))`` at the lowest speed it passes (the default grid's scale) and,
+    braking, the distance ``v² / (2 |a|)`` to rest at that deceleration.
+    """
+    lim = request.limits
+    j = lim.j_max
+    if v == 0.0 and a == 0.0:
+        return (rest_phase_length(a_limit, lim.v_max, j, length)
+                if request.smooth_standstill else None)
+    low = turnaround_speed(v, a, j) if a < 0 else v
+    speed = low if low > 0 else v
+    t_j = min(a_limit / j, float(np.sqrt(lim.v_max / j)))
+    scale = speed * min(t_j, float(np.sqrt(speed / j)))
+    if a != 0.0:
+        t = abs(a) / j
+        removal = v * t + 0.5 * a * t * t - float(np.sign(a)) * j * t**3 / 6.0
+        if removal > 0.0:
+            scale = min(scale, removal)
+    if a < 0.0:  # and the first step well below the braking distance (_check_moving_ends_resolved)
+        scale = min(scale, 0.5 * v * v / -a)
+    return scale if scale > 0.0 else None
 
 
 def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: float, v0: float,
@@ -390,6 +416,9 @@ def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float
 def _check_moving_ends_resolved(s: FloatArray, lo: float, v0: float, a0: float, vf: float,
                                 af: float) -> None:
     """A user grid must let the speed stay positive over the first (last) half cell.
+
+    The grading of user grids (:func:`_transient`, :func:`~.grid.graded_ends`) makes the end
+    steps shorter than this; what remains refused is a transient below the finest step.
 
     The time law keeps the prescribed acceleration at a moving end; a braking start
     (accelerating arrival) then loses ``|a| h`` of ``w`` over the half cell, so a step

@@ -37,14 +37,14 @@ __all__ = [
     "CRUISE_GRADING",
     "CRUISE_STEP",
     "DEFAULT_PER_PHASE",
+    "END_PER_PHASE",
     "GRADING",
     "MAX_DEFAULT_NODES",
     "MIN_ANCHOR_NODES",
     "MIN_NODES",
     "MIN_RELATIVE_STEP",
-    "REST_PER_PHASE",
     "adaptive_grid",
-    "graded_rest_ends",
+    "graded_ends",
     "graded_steps",
     "nodes_from_steps",
     "rest_phase_length",
@@ -71,11 +71,12 @@ GRADING = 0.01
 MIN_ANCHOR_NODES = 50
 #: Largest relative change between neighbouring steps inside long constant-bound stretches.
 CRUISE_GRADING = 0.1
-#: Nodes per first jerk phase from rest (or last one into rest) of a user grid (``n`` or
-#: ``ds``): the law's jerk there exceeds ``j_max`` by about ``0.4 h / ℓ`` (measured on
-#: straight moves; 12 % on the 1 000-node uniform grids of three sample paths), so 20 nodes
-#: keep it near 2 %, half the jerk tolerance with the grading's 1 %.
-REST_PER_PHASE = 20
+#: Nodes per boundary transient of a user grid (``n`` or ``ds``): the first jerk phase from
+#: rest (last into rest), or the first change of a moving end's acceleration. At a rest the
+#: law's jerk exceeds ``j_max`` by about ``0.4 h / ℓ`` (measured on straight moves; 12 % on
+#: the 1 000-node uniform grids of three sample paths), so 20 nodes keep it near 2 %, half
+#: the jerk tolerance with the grading's 1 %.
+END_PER_PHASE = 20
 #: Largest step inside long constant-bound stretches, as a fraction of the length: nothing
 #: changes there, the steps only grow (by :data:`CRUISE_GRADING` per node) from the fine
 #: transitions on either side.
@@ -111,27 +112,28 @@ def rest_phase_length(a: float, v_max: float, j_max: float,
     return float(j_max * t**3 / 6.0)
 
 
-def graded_rest_ends(s: FloatArray, ell_start: float | None,
+def graded_ends(s: FloatArray, ell_start: float | None,
                      ell_end: float | None) -> FloatArray:
-    """The uniform grid ``s`` with steps of ``ℓ / REST_PER_PHASE`` at the ends where it rests.
+    """The uniform grid ``s`` with steps of ``ℓ / END_PER_PHASE`` at its ends.
 
-    ``ell_start`` (``ell_end``) is the length ``ℓ`` of the first (last) jerk phase, ``None``
-    where the leg does not start (end) at rest. Where the uniform step exceeds
-    ``ℓ / REST_PER_PHASE`` the steps are that over ``2 ℓ`` from the end and then grow by
-    :data:`GRADING` per node back to the uniform step; the other nodes stay those of ``s``.
-    Without it the first law of a coarse grid exceeds ``j_max`` there and
-    :func:`speedplan.plan` refines the grid and solves again.
+    ``ell_start`` (``ell_end``) is the length ``ℓ`` of the first (last) boundary transient
+    (:func:`rest_phase_length` at a rest), ``None`` to keep that end's steps. Where the
+    uniform step exceeds ``ℓ / END_PER_PHASE`` the steps are that over ``2 ℓ`` from the end
+    and then grow by :data:`GRADING` per node back to the uniform step; the other nodes stay
+    those of ``s``. Without it the first law of a coarse grid exceeds ``j_max`` (or the
+    speed bound) there and :func:`speedplan.plan` refines the grid and solves again — or,
+    where three refinements do not reach the transient, reports ``limits_exceeded``.
 
     Examples
     --------
     >>> import numpy as np
     >>> s = np.linspace(0.0, 30.0, 301)
-    >>> g = graded_rest_ends(s, 0.667, None)
+    >>> g = graded_ends(s, 0.667, None)
     >>> float(np.diff(g)[0].round(4)), bool(np.all(g[-150:] == s[-150:]))
     (0.0333, True)
     >>> bool(np.max(np.diff(g)[1:] / np.diff(g)[:-1]) < 1.0101)  # graded back to 0.1
     True
-    >>> bool(np.all(graded_rest_ends(s, 4.0, 4.0) == s))
+    >>> bool(np.all(graded_ends(s, 4.0, 4.0) == s))
     True
     """
     h = float(s[1] - s[0])
@@ -140,9 +142,9 @@ def graded_rest_ends(s: FloatArray, ell_start: float | None,
     zones: list[tuple[int, float, float]] = []
     cells = [0, 0]
     for end, ell in ((0, ell_start), (1, ell_end)):
-        if ell is None or not h * REST_PER_PHASE > ell:
+        if ell is None or not h * END_PER_PHASE > ell:
             continue
-        fine = max(ell / REST_PER_PHASE, MIN_RELATIVE_STEP * length)
+        fine = max(ell / END_PER_PHASE, MIN_RELATIVE_STEP * length)
         zones.append((end, fine, 2.0 * ell))
         cells[end] = int(np.ceil((2.0 * ell + (h - fine) / GRADING) / h))
     if not zones:
