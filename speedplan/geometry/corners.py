@@ -41,7 +41,7 @@ import numpy as np
 from ..core.checks import FloatArray, as_scalar
 from ..core.errors import InvalidInputError
 from ._checks import wrap_angle
-from .primitives import ClothoidPiece
+from .primitives import ClothoidPiece, PieceSpec, clothoid_chain, end_heading
 
 __all__ = ["CUSP_ANGLE", "DEFAULT_DEVIATION", "DEFAULT_TRANSITION", "CornerShape",
            "as_deviation", "corner_shape", "find_reversal", "g2_chain", "g2_corners", "leg_turns"]
@@ -161,18 +161,20 @@ def corner_shape(turn: float, transition: float) -> CornerShape:
 def _corner_pieces(
     start: FloatArray, theta: float, turn: float, radius: float, shape: CornerShape,
     direction: int,
-) -> list[ClothoidPiece]:
-    """Pieces of a corner from ``start`` with vehicle heading ``theta``, signed ``turn``."""
+) -> list[PieceSpec]:
+    """Pieces of a corner from ``start`` with vehicle heading ``theta``, signed ``turn``.
+
+    Each piece after the first starts where the previous one ends (``None``).
+    """
     k = float(np.sign(turn)) / radius
     lc, la = shape.clothoid_length * radius, shape.arc_length * radius
-    out: list[ClothoidPiece] = []
-    point, heading = (float(start[0]), float(start[1])), theta
+    out: list[PieceSpec] = []
+    point: tuple[float, float] | None = (float(start[0]), float(start[1]))
+    heading = theta
     for length, k0, k1 in ((lc, 0.0, k), (la, k, k), (lc, k, 0.0)):
         if length > 0:
-            piece = ClothoidPiece(point, heading, length, k0, k1, direction)
-            end, heading = piece.end
-            point = (float(end[0]), float(end[1]))
-            out.append(piece)
+            out.append((point, heading, length, k0, k1, direction))
+            heading, point = end_heading(heading, length, k0, k1), None
     return out
 
 
@@ -293,7 +295,7 @@ def g2_chain(
     tangent = np.minimum(want, np.minimum(before, after))
 
     unit = np.diff(pts, axis=0) / legs[:, None]
-    pieces: list[ClothoidPiece] = []
+    pieces: list[PieceSpec] = []  # built at the end in one pass (clothoid_chain)
     waypoint_s = np.zeros(n)
     direction = 1
     theta = float(head[0])  # vehicle heading, unwrapped along the path
@@ -307,8 +309,7 @@ def g2_chain(
         has_straight = straight > 1e-12 * legs[i]
         if has_straight:
             p = pts[i] + unit[i] * t_out
-            pieces.append(ClothoidPiece((float(p[0]), float(p[1])), theta, straight, 0.0, 0.0,
-                                        direction))
+            pieces.append(((float(p[0]), float(p[1])), theta, straight, 0.0, 0.0, direction))
         if i == n - 2:
             break
         # The corner at waypoint i + 1; exactly at the first waypoint if it takes the leg.
@@ -332,8 +333,8 @@ def g2_chain(
         theta += 2.0 * bent
         direction = -direction
     waypoint_s[-1] = _length(pieces)
-    return tuple(pieces), waypoint_s
+    return tuple(clothoid_chain(pieces)), waypoint_s
 
 
-def _length(pieces: list[ClothoidPiece]) -> float:
-    return float(sum(p.length for p in pieces))
+def _length(pieces: list[PieceSpec]) -> float:
+    return float(sum(p[2] for p in pieces))

@@ -24,16 +24,17 @@ from typing import Any
 
 import numpy as np
 
-from ..core.checks import FloatArray, as_scalar
+from ..core.checks import FloatArray, IntArray, as_scalar
 from ..core.errors import InvalidInputError
 from ._checks import as_direction, as_reverse
 from .pieces import GAUSS_NODES, GAUSS_WEIGHTS, Piece
 
-__all__ = ["Arc", "Clothoid", "ClothoidPiece", "Line", "Segment", "as_segment", "segment_piece",
-           "turn_integral"]
+__all__ = ["Arc", "Clothoid", "ClothoidPiece", "Line", "PieceSpec", "Segment", "as_segment",
+           "clothoid_chain", "end_heading", "segment_piece", "turn_integral"]
 
 #: Largest heading change over one quadrature cell of a clothoid [rad].
 _CELL_TURN = 0.25
+_EMPTY = np.empty(0)
 
 
 def _set_checked(segment: Any, **checks: Callable[[str, Any], Any]) -> None:
@@ -209,15 +210,11 @@ class ClothoidPiece(Piece):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "direction", as_direction("direction", self.direction))
-        turn = max(abs(self.k0), abs(self.k1)) * self.length
-        m = int(np.clip(np.ceil(turn / _CELL_TURN), 1, 1_000_000))
-        knots = np.linspace(0.0, self.length, m + 1)
-        steps = self._integrate(knots[:-1], knots[1:])
-        xy = np.asarray(self.start, dtype=np.float64) + np.vstack(
-            (np.zeros((1, 2)), np.cumsum(steps, axis=0))
-        )
+        ((knots, steps),) = _tabulate(np.array([self.theta0]), np.array([self.length]),
+                                      np.array([self.k0]), np.array([self.k1]),
+                                      np.array([float(self.direction)]))
         object.__setattr__(self, "_knots", knots)
-        object.__setattr__(self, "_knot_xy", xy)
+        object.__setattr__(self, "_knot_xy", np.asarray(self.start, dtype=np.float64) + steps)
 
     @property
     def end(self) -> tuple[FloatArray, float]:
@@ -271,6 +268,80 @@ class ClothoidPiece(Piece):
         return ClothoidPiece((float(end[0]), float(end[1])), theta + turn, self.length,
                              -self.k1, -self.k0,
                              -self.direction if swap_direction else self.direction)
+
+
+def _cells(turn: FloatArray) -> IntArray:
+    """Quadrature cells of pieces whose heading turns by at most ``turn`` [rad]."""
+    return np.clip(np.ceil(turn / _CELL_TURN), 1, 1_000_000).astype(np.intp)
+
+
+def _tabulate(theta0: FloatArray, length: FloatArray, k0: FloatArray, k1: FloatArray,
+              direction: FloatArray) -> list[tuple[FloatArray, FloatArray]]:
+    """Knots and knot positions relative to the start (first row 0) of clothoid pieces [m].
+
+    One vectorised pass for all pieces with the same number of cells (what keeps building a
+    path of 70 pieces cheap); per piece the arithmetic of :meth:`ClothoidPiece._integrate`,
+    knots as ``np.linspace(0, length, m + 1)`` and a running sum of the cell steps.
+    """
+    counts = _cells(np.maximum(np.abs(k0), np.abs(k1)) * length)
+    out: list[tuple[FloatArray, FloatArray]] = [(_EMPTY, _EMPTY)] * length.size
+    for m in np.unique(counts).tolist():
+        rows = np.flatnonzero(counts == m)
+        size = length[rows, None]
+        knots = np.arange(m + 1) * (size / m)  # what np.linspace computes
+        knots[:, -1] = size[:, 0]
+        a, width = knots[:, :-1], np.diff(knots, axis=1)
+        sharpness = ((k1[rows] - k0[rows]) / length[rows])[:, None, None]
+        u = a[..., None] + width[..., None] * GAUSS_NODES
+        th = theta0[rows, None, None] + u * (k0[rows, None, None] + 0.5 * sharpness * u)
+        scaled = width * direction[rows, None]
+        steps = np.empty((rows.size, m + 1, 2))
+        steps[:, 0] = 0.0
+        steps[:, 1:, 0] = (np.cos(th) * scaled[..., None]) @ GAUSS_WEIGHTS
+        steps[:, 1:, 1] = (np.sin(th) * scaled[..., None]) @ GAUSS_WEIGHTS
+        np.cumsum(steps, axis=1, out=steps)
+        for r, row in enumerate(rows.tolist()):
+            out[row] = (knots[r], steps[r])
+    return out
+
+
+#: A piece's description for :func:`clothoid_chain`: start point (``None``: where the
+#: previous piece ends), vehicle heading [rad], length [m], curvatures k0, k1 [1/m], direction.
+PieceSpec = tuple[tuple[float, float] | None, float, float, float, float, int]
+
+
+def end_heading(theta0: float, length: float, k0: float, k1: float) -> float:
+    """Heading at the end of a clothoid piece [rad], as :attr:`ClothoidPiece.end` gives it."""
+    return theta0 + length * (k0 + 0.5 * ((k1 - k0) / length) * length)
+
+
+def clothoid_chain(specs: list[PieceSpec]) -> list[ClothoidPiece]:
+    """The pieces of ``specs``, tabulated in one vectorised pass.
+
+    The same pieces as ``ClothoidPiece(start, theta0, length, k0, k1, direction)`` one by
+    one, a start of ``None`` being the previous piece's end point.
+    """
+    if not specs:
+        return []
+    theta0, length, k0, k1, direction = (np.array([s[i] for s in specs], dtype=np.float64)
+                                         for i in range(1, 6))
+    pieces: list[ClothoidPiece] = []
+    start: tuple[float, float] | None = None
+    for spec, (knots, steps) in zip(specs, _tabulate(theta0, length, k0, k1, direction),
+                                    strict=True):
+        if spec[0] is not None:
+            start = spec[0]
+        assert start is not None
+        xy = np.asarray(start, dtype=np.float64) + steps
+        piece = ClothoidPiece.__new__(ClothoidPiece)
+        for name, value in zip(("start", "theta0", "length", "k0", "k1", "direction",
+                                "_knots", "_knot_xy"),
+                               (start, *spec[1:5], as_direction("direction", spec[5]), knots,
+                                xy), strict=True):
+            object.__setattr__(piece, name, value)
+        pieces.append(piece)
+        start = (float(xy[-1, 0]), float(xy[-1, 1]))
+    return pieces
 
 
 def turn_integral(a: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray]:
