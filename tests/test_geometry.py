@@ -299,3 +299,21 @@ def test_arc_points_match_the_circle_at_every_scale():
         centre = np.array([R, -R]) + R * np.array([-np.sin(theta0), np.cos(theta0)])
         circle = centre + R * np.column_stack((np.sin(theta0 + s / R), -np.cos(theta0 + s / R)))
         np.testing.assert_allclose(p.point(s), circle, rtol=0, atol=4e-15 * max(R, 1.0))
+
+
+def test_from_segments_pieces_equal_pieces_chained_one_by_one():
+    # from_segments tabulates all pieces in one pass (clothoid_chain); the oracle builds each
+    # ClothoidPiece alone from the previous one's end point and end heading.
+    from speedplan.geometry.primitives import ClothoidPiece
+
+    rng = np.random.default_rng(7)
+    for scale in (1e-3, 1.0, 1e3):
+        p = _random_chain(rng, scale)
+        point, theta = p.pieces[0].start, p.pieces[0].theta0
+        for q in p.pieces:
+            alone = ClothoidPiece(point, theta, q.length, q.k0, q.k1, q.direction)
+            assert (q.start, q.theta0) == (alone.start, alone.theta0)
+            np.testing.assert_array_equal(q._knots, alone._knots)
+            np.testing.assert_array_equal(q._knot_xy, alone._knot_xy)
+            end, theta = alone.end
+            point = (float(end[0]), float(end[1]))

@@ -14,7 +14,18 @@ from ..core.checks import FloatArray, IntArray, as_array, as_scalar, grid_size
 from ..core.errors import InvalidInputError
 from ._checks import as_int
 from .pieces import Piece, SubPiece
-from .primitives import Arc, Clothoid, ClothoidPiece, Line, as_segment, segment_piece, turn_integral
+from .primitives import (
+    Arc,
+    Clothoid,
+    ClothoidPiece,
+    Line,
+    PieceSpec,
+    as_segment,
+    clothoid_chain,
+    end_heading,
+    segment_spec,
+    turn_integral,
+)
 
 __all__ = ["Arc", "Clothoid", "Line", "Path", "PathSamples"]
 
@@ -606,14 +617,13 @@ class Path:
             raise InvalidInputError("`segments` is empty; pass at least one segment")
         xy = as_array("start", start, ndim=1, length=2)
         theta = as_scalar("heading", heading)
-        pieces: list[Piece] = []
-        point = (float(xy[0]), float(xy[1]))
+        specs: list[PieceSpec] = []
+        point: tuple[float, float] | None = (float(xy[0]), float(xy[1]))
         for i, seg in enumerate(segments):
-            piece = segment_piece(as_segment(seg, f"segments[{i}]"), point, theta)
-            pieces.append(piece)
-            end, theta = piece.end
-            point = (float(end[0]), float(end[1]))
-        return cls(tuple(pieces))
+            spec = segment_spec(as_segment(seg, f"segments[{i}]"), point, theta)
+            specs.append(spec)
+            theta, point = end_heading(*spec[1:5]), None  # the next starts where this ends
+        return cls(tuple(clothoid_chain(specs)))
 
     @classmethod
     def from_waypoints(

@@ -30,7 +30,7 @@ from ._checks import as_direction, as_reverse
 from .pieces import GAUSS_NODES, GAUSS_WEIGHTS, Piece
 
 __all__ = ["Arc", "Clothoid", "ClothoidPiece", "Line", "PieceSpec", "Segment", "as_segment",
-           "clothoid_chain", "end_heading", "segment_piece", "turn_integral"]
+           "clothoid_chain", "end_heading", "segment_piece", "segment_spec", "turn_integral"]
 
 #: Largest heading change over one quadrature cell of a clothoid [rad].
 _CELL_TURN = 0.25
@@ -147,7 +147,7 @@ class Clothoid:
 
 Segment = Line | Arc | Clothoid
 
-_FIELDS: dict[str, tuple[type[Line] | type[Arc] | type[Clothoid], tuple[str, ...]]] = {
+_FIELDS: dict[str, tuple[type[Line | Arc | Clothoid], tuple[str, ...]]] = {
     "line": (Line, ("length",)),
     "arc": (Arc, ("radius", "angle")),
     "clothoid": (Clothoid, ("length", "k0", "k1")),
@@ -387,12 +387,18 @@ def turn_integral(a: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray]
     return sum_re, sum_im
 
 
-def segment_piece(seg: Segment, start: tuple[float, float], theta0: float) -> ClothoidPiece:
-    """The piece of ``seg`` starting at ``start`` with vehicle heading ``theta0`` [rad]."""
+def segment_spec(seg: Segment, start: tuple[float, float] | None, theta0: float) -> PieceSpec:
+    """The :data:`PieceSpec` of ``seg`` from ``start`` with vehicle heading ``theta0`` [rad]."""
     d = -1 if seg.reverse else 1
     if isinstance(seg, Line):
-        return ClothoidPiece(start, theta0, seg.length, 0.0, 0.0, d)
+        return (start, theta0, seg.length, 0.0, 0.0, d)
     if isinstance(seg, Arc):
         k = float(np.sign(seg.angle)) / seg.radius
-        return ClothoidPiece(start, theta0, seg.radius * abs(seg.angle), k, k, d)
-    return ClothoidPiece(start, theta0, seg.length, seg.k0, seg.k1, d)
+        return (start, theta0, seg.radius * abs(seg.angle), k, k, d)
+    return (start, theta0, seg.length, seg.k0, seg.k1, d)
+
+
+def segment_piece(seg: Segment, start: tuple[float, float], theta0: float) -> ClothoidPiece:
+    """The piece of ``seg`` starting at ``start`` with vehicle heading ``theta0`` [rad]."""
+    _, theta0, length, k0, k1, d = segment_spec(seg, start, theta0)
+    return ClothoidPiece(start, theta0, length, k0, k1, d)
