@@ -296,6 +296,7 @@ def g2_chain(
 
     unit = np.diff(pts, axis=0) / legs[:, None]
     pieces: list[PieceSpec] = []  # built at the end in one pass (clothoid_chain)
+    length = _RunningLength()
     waypoint_s = np.zeros(n)
     direction = 1
     theta = float(head[0])  # vehicle heading, unwrapped along the path
@@ -315,12 +316,12 @@ def g2_chain(
         # The corner at waypoint i + 1; exactly at the first waypoint if it takes the leg.
         start = pts[i + 1] - unit[i] * t_in if i > 0 or has_straight else pts[0]
         corner, bent = shapes[i + 1], float(bend[i + 1])
-        entry = _length(pieces)
+        entry = length(pieces)
         if corner is not None:
             radius = t_in / corner.tangent
             pieces += _corner_pieces(start, theta, bent, radius, corner, direction)
         # The symmetric corner's middle; at a cusp its end, the cusp point.
-        waypoint_s[i + 1] = _length(pieces) if cusp[i + 1] else 0.5 * (entry + _length(pieces))
+        waypoint_s[i + 1] = length(pieces) if cusp[i + 1] else 0.5 * (entry + length(pieces))
         if not cusp[i + 1]:
             theta += bent
             continue
@@ -332,9 +333,22 @@ def g2_chain(
             pieces += _corner_pieces(q, theta + bent, bent, radius, corner, -direction)
         theta += 2.0 * bent
         direction = -direction
-    waypoint_s[-1] = _length(pieces)
+    waypoint_s[-1] = length(pieces)
     return tuple(clothoid_chain(pieces)), waypoint_s
 
 
-def _length(pieces: list[PieceSpec]) -> float:
-    return float(sum(p[2] for p in pieces))
+class _RunningLength:
+    """``sum`` of the lengths of a growing list of pieces [m], adding only the new ones.
+
+    The same additions in the same order as ``sum(...)`` over the whole list each time (so
+    the same float), without the quadratic cost.
+    """
+
+    def __init__(self) -> None:
+        self.count, self.total = 0, 0.0
+
+    def __call__(self, pieces: list[PieceSpec]) -> float:
+        for p in pieces[self.count:]:
+            self.total += p[2]
+        self.count = len(pieces)
+        return float(self.total)

@@ -315,6 +315,9 @@ def end_heading(theta0: float, length: float, k0: float, k1: float) -> float:
     return theta0 + length * (k0 + 0.5 * ((k1 - k0) / length) * length)
 
 
+_PIECE_FIELDS = ("start", "theta0", "length", "k0", "k1", "direction", "_knots", "_knot_xy")
+
+
 def clothoid_chain(specs: list[PieceSpec]) -> list[ClothoidPiece]:
     """The pieces of ``specs``, tabulated in one vectorised pass.
 
@@ -334,11 +337,9 @@ def clothoid_chain(specs: list[PieceSpec]) -> list[ClothoidPiece]:
         assert start is not None
         xy = np.asarray(start, dtype=np.float64) + steps
         piece = ClothoidPiece.__new__(ClothoidPiece)
-        for name, value in zip(("start", "theta0", "length", "k0", "k1", "direction",
-                                "_knots", "_knot_xy"),
-                               (start, *spec[1:5], as_direction("direction", spec[5]), knots,
-                                xy), strict=True):
-            object.__setattr__(piece, name, value)
+        # The fields a frozen dataclass's __init__ would set, in one update of its __dict__.
+        vars(piece).update(zip(_PIECE_FIELDS, (
+            start, *spec[1:5], as_direction("direction", spec[5]), knots, xy), strict=True))
         pieces.append(piece)
         start = (float(xy[-1, 0]), float(xy[-1, 1]))
     return pieces
