@@ -413,3 +413,27 @@ def test_profile_from_waypoints_takes_the_path_options():
         sp.profile_from_waypoints(pts, kind="spline", max_deviation=0.1, **limits)
     with pytest.raises(InvalidInputError, match="`headings` applies to kind='clothoid'"):
         sp.profile_from_waypoints(pts, headings=[0, 0.7, 1.5], **limits)
+
+
+@pytest.mark.parametrize("pts", [
+    [[0, 0], [10, 0], [10, 10], [0, 10], [0, 20]],
+    [[0, 0], [10, 0], [4, 0], [4, 5], [0, 9], [3, 20], [3, 10]],  # two cusps
+    (np.random.default_rng(3).uniform(0, 1e3, (25, 2))).tolist(),
+    (np.random.default_rng(4).uniform(0, 1e-2, (25, 2))).tolist(),
+])
+def test_pieces_built_in_one_pass_equal_pieces_built_one_by_one(pts):
+    # g2_chain tabulates all pieces at once (clothoid_chain); each must be the piece its
+    # own constructor builds, and each corner piece must start where the previous one ends.
+    from speedplan.geometry.primitives import ClothoidPiece
+
+    pieces = Path.from_waypoints(pts, max_deviation=float(np.ptp(pts)) / 50).pieces
+    for before, p in zip((None, *pieces[:-1]), pieces, strict=True):
+        alone = ClothoidPiece(p.start, p.theta0, p.length, p.k0, p.k1, p.direction)
+        np.testing.assert_array_equal(p._knots, alone._knots)
+        np.testing.assert_allclose(p._knot_xy, alone._knot_xy, rtol=0,
+                                   atol=1e-15 * max(1.0, float(np.abs(alone._knot_xy).max())))
+        if before is not None:
+            end, heading = before.end
+            assert np.linalg.norm(end - np.asarray(p.start)) <= 1e-12 * max(1.0, np.ptp(pts))
+            if p.direction == before.direction:
+                assert abs(heading - p.theta0) <= 1e-12

@@ -232,3 +232,88 @@ def test_path_is_immutable_and_has_a_short_repr():
 def test_spline_that_doubles_back_is_rejected_as_a_cusp():
     with pytest.raises(InvalidInputError, match=r"`xy`.*cusp"):
         Path.from_waypoints([[1.0, 0.0], [0.0, 0.0], [1.0, 0.0]], kind="spline")
+
+
+def _random_chain(rng: np.random.Generator, scale: float) -> Path:
+    """Lines, arcs and clothoids of length ~``scale``, some reversed (cusps), any order."""
+    segs: list[Line | Arc | Clothoid] = []
+    for _ in range(int(rng.integers(1, 12))):
+        kind, reverse = rng.integers(3), bool(rng.random() < 0.3)
+        length = scale * 10 ** rng.uniform(-1, 1)
+        if kind == 0:
+            segs.append(Line(length, reverse=reverse))
+        elif kind == 1:
+            angle = rng.uniform(-7, 7)
+            segs.append(Arc(length / abs(angle), angle, reverse=reverse))
+        else:
+            k0, k1 = rng.uniform(-7, 7, 2) / length
+            segs.append(Clothoid(length, k0, k1, reverse=reverse))
+    start = scale * rng.uniform(-100, 100, 2)
+    return Path.from_segments(segs, start=start, heading=rng.uniform(-10, 10))
+
+
+def _each_piece(p: Path, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Piece index and position of each ``s``, one point and one piece call at a time."""
+    k = np.clip(np.searchsorted(p.offsets, s, side="right") - 1, 0, len(p.pieces) - 1)
+    xy = [p.pieces[i].point(np.array(si - p.offsets[i])) for i, si in zip(k, s, strict=True)]
+    return k, np.array(xy)
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
+def test_vectorised_points_agree_with_each_piece_on_random_chains(scale):
+    # Path.point evaluates all clothoid pieces in one pass (a power series from each
+    # quadrature cell's start); the oracle is each piece's own Gauss-Legendre rule.
+    rng = np.random.default_rng(int(scale * 1000))
+    worst = 0.0
+    for _ in range(40):
+        p = _random_chain(rng, scale)
+        s = np.concatenate((rng.uniform(0, p.length, 500), p.offsets))
+        got = p.point(s)
+        k, want = _each_piece(p, s)
+        extent = float(np.abs(want).max())
+        worst = max(worst, float(np.abs(got - want).max()) / max(extent, 1.0))
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * max(1.0, extent / 1000.0))
+        # Lines stay exact: start + u * direction, as in the piece.
+        lines = [i for i, q in enumerate(p.pieces) if q.k0 == q.k1 == 0.0]
+        on_line = np.isin(k, lines)
+        np.testing.assert_array_equal(got[on_line], want[on_line])
+    assert worst > 0.0 or scale == 1e-3  # the two methods differ, by rounding only
+
+
+def test_vectorised_points_follow_cusps_of_waypoint_paths():
+    # from_waypoints drives a reversal in reverse after the cusp (direction -1 pieces).
+    p = Path.from_waypoints([[0, 0], [10, 0], [4, 0], [4, 5], [0, 9], [3, 20], [3, 10]])
+    assert p.cusps.size == 2 and -1 in p.direction(p.offsets[:-1])
+    s = np.linspace(0.0, p.length, 3001)
+    _, want = _each_piece(p, s)
+    np.testing.assert_allclose(p.point(s), want, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(p.evaluate(s)[0], want, rtol=0, atol=1e-12)
+
+
+def test_arc_points_match_the_circle_at_every_scale():
+    # Closed form: centre + R (sin(θ0 + s/R), -cos(θ0 + s/R)) for a left arc.
+    for R in (1e-3, 0.7, 2e3):
+        theta0 = 0.3
+        p = Path.from_segments([Arc(R, 5.0)], start=(R, -R), heading=theta0)
+        s = np.linspace(0.0, p.length, 1001)
+        centre = np.array([R, -R]) + R * np.array([-np.sin(theta0), np.cos(theta0)])
+        circle = centre + R * np.column_stack((np.sin(theta0 + s / R), -np.cos(theta0 + s / R)))
+        np.testing.assert_allclose(p.point(s), circle, rtol=0, atol=4e-15 * max(R, 1.0))
+
+
+def test_from_segments_pieces_equal_pieces_chained_one_by_one():
+    # from_segments tabulates all pieces in one pass (clothoid_chain); the oracle builds each
+    # ClothoidPiece alone from the previous one's end point and end heading.
+    from speedplan.geometry.primitives import ClothoidPiece
+
+    rng = np.random.default_rng(7)
+    for scale in (1e-3, 1.0, 1e3):
+        p = _random_chain(rng, scale)
+        point, theta = p.pieces[0].start, p.pieces[0].theta0
+        for q in p.pieces:
+            alone = ClothoidPiece(point, theta, q.length, q.k0, q.k1, q.direction)
+            assert (q.start, q.theta0) == (alone.start, alone.theta0)
+            np.testing.assert_array_equal(q._knots, alone._knots)
+            np.testing.assert_array_equal(q._knot_xy, alone._knot_xy)
+            end, theta = alone.end
+            point = (float(end[0]), float(end[1]))

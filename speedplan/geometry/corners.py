@@ -41,7 +41,7 @@ import numpy as np
 from ..core.checks import FloatArray, as_scalar
 from ..core.errors import InvalidInputError
 from ._checks import wrap_angle
-from .primitives import ClothoidPiece
+from .primitives import ClothoidPiece, PieceSpec, clothoid_chain, end_heading
 
 __all__ = ["CUSP_ANGLE", "DEFAULT_DEVIATION", "DEFAULT_TRANSITION", "CornerShape",
            "as_deviation", "corner_shape", "find_reversal", "g2_chain", "g2_corners", "leg_turns"]
@@ -161,18 +161,20 @@ def corner_shape(turn: float, transition: float) -> CornerShape:
 def _corner_pieces(
     start: FloatArray, theta: float, turn: float, radius: float, shape: CornerShape,
     direction: int,
-) -> list[ClothoidPiece]:
-    """Pieces of a corner from ``start`` with vehicle heading ``theta``, signed ``turn``."""
+) -> list[PieceSpec]:
+    """Pieces of a corner from ``start`` with vehicle heading ``theta``, signed ``turn``.
+
+    Each piece after the first starts where the previous one ends (``None``).
+    """
     k = float(np.sign(turn)) / radius
     lc, la = shape.clothoid_length * radius, shape.arc_length * radius
-    out: list[ClothoidPiece] = []
-    point, heading = (float(start[0]), float(start[1])), theta
+    out: list[PieceSpec] = []
+    point: tuple[float, float] | None = (float(start[0]), float(start[1]))
+    heading = theta
     for length, k0, k1 in ((lc, 0.0, k), (la, k, k), (lc, k, 0.0)):
         if length > 0:
-            piece = ClothoidPiece(point, heading, length, k0, k1, direction)
-            end, heading = piece.end
-            point = (float(end[0]), float(end[1]))
-            out.append(piece)
+            out.append((point, heading, length, k0, k1, direction))
+            heading, point = end_heading(heading, length, k0, k1), None
     return out
 
 
@@ -293,7 +295,8 @@ def g2_chain(
     tangent = np.minimum(want, np.minimum(before, after))
 
     unit = np.diff(pts, axis=0) / legs[:, None]
-    pieces: list[ClothoidPiece] = []
+    pieces: list[PieceSpec] = []  # built at the end in one pass (clothoid_chain)
+    length = _RunningLength()
     waypoint_s = np.zeros(n)
     direction = 1
     theta = float(head[0])  # vehicle heading, unwrapped along the path
@@ -307,19 +310,18 @@ def g2_chain(
         has_straight = straight > 1e-12 * legs[i]
         if has_straight:
             p = pts[i] + unit[i] * t_out
-            pieces.append(ClothoidPiece((float(p[0]), float(p[1])), theta, straight, 0.0, 0.0,
-                                        direction))
+            pieces.append(((float(p[0]), float(p[1])), theta, straight, 0.0, 0.0, direction))
         if i == n - 2:
             break
         # The corner at waypoint i + 1; exactly at the first waypoint if it takes the leg.
         start = pts[i + 1] - unit[i] * t_in if i > 0 or has_straight else pts[0]
         corner, bent = shapes[i + 1], float(bend[i + 1])
-        entry = _length(pieces)
+        entry = length(pieces)
         if corner is not None:
             radius = t_in / corner.tangent
             pieces += _corner_pieces(start, theta, bent, radius, corner, direction)
         # The symmetric corner's middle; at a cusp its end, the cusp point.
-        waypoint_s[i + 1] = _length(pieces) if cusp[i + 1] else 0.5 * (entry + _length(pieces))
+        waypoint_s[i + 1] = length(pieces) if cusp[i + 1] else 0.5 * (entry + length(pieces))
         if not cusp[i + 1]:
             theta += bent
             continue
@@ -331,9 +333,22 @@ def g2_chain(
             pieces += _corner_pieces(q, theta + bent, bent, radius, corner, -direction)
         theta += 2.0 * bent
         direction = -direction
-    waypoint_s[-1] = _length(pieces)
-    return tuple(pieces), waypoint_s
+    waypoint_s[-1] = length(pieces)
+    return tuple(clothoid_chain(pieces)), waypoint_s
 
 
-def _length(pieces: list[ClothoidPiece]) -> float:
-    return float(sum(p.length for p in pieces))
+class _RunningLength:
+    """``sum`` of the lengths of a growing list of pieces [m], adding only the new ones.
+
+    The same additions in the same order as ``sum(...)`` over the whole list each time (so
+    the same float), without the quadratic cost.
+    """
+
+    def __init__(self) -> None:
+        self.count, self.total = 0, 0.0
+
+    def __call__(self, pieces: list[PieceSpec]) -> float:
+        for p in pieces[self.count:]:
+            self.total += p[2]
+        self.count = len(pieces)
+        return float(self.total)

@@ -14,7 +14,18 @@ from ..core.checks import FloatArray, IntArray, as_array, as_scalar, grid_size
 from ..core.errors import InvalidInputError
 from ._checks import as_int
 from .pieces import Piece, SubPiece
-from .primitives import Arc, Clothoid, ClothoidPiece, Line, as_segment, segment_piece
+from .primitives import (
+    Arc,
+    Clothoid,
+    ClothoidPiece,
+    Line,
+    PieceSpec,
+    as_segment,
+    clothoid_chain,
+    end_heading,
+    segment_spec,
+    turn_integral,
+)
 
 __all__ = ["Arc", "Clothoid", "Line", "Path", "PathSamples"]
 
@@ -159,12 +170,82 @@ class Path:
         path but NURBS, splines and cut pieces). Curvature and heading are then one
         vectorised pass over all points, with each piece's own formula and operation order
         (bitwise the per-piece result): grouping 10 000 points by piece and calling 70 pieces
-        cost ~1 ms a query, and a plan makes many.
+        cost ~1 ms a query, and a plan makes many. Positions likewise (:meth:`_cells`,
+        :meth:`_clothoid_points`), equal to the per-piece result to rounding.
         """
         if not all(type(p) is ClothoidPiece for p in self.pieces):
             return None
         pieces: list[ClothoidPiece] = [p for p in self.pieces if isinstance(p, ClothoidPiece)]
         return np.array([[p.k0, p.k1 - p.k0, p.length, p.theta0] for p in pieces]).T.copy()
+
+    @cached_property
+    def _cells(self) -> tuple[FloatArray, IntArray, IntArray, tuple[FloatArray, ...]] | None:
+        """The quadrature cells of all pieces, for :meth:`_clothoid_points`.
+
+        ``(starts, first, last, rows)``: the cells' start on the path [m] (sorted), the index
+        of each piece's first and last cell, and per cell the rows ``u, x, y, d cos θ,
+        d sin θ, κ, dκ/ds, curved`` at its start (local arc length, position, travel
+        direction ``d = ±1`` times the heading's unit vector, curvature, whether the cell
+        is curved).
+        ``None`` unless the pieces are all plain clothoid pieces.
+        """
+        if self._clothoids is None:
+            return None
+        pieces: list[ClothoidPiece] = [p for p in self.pieces if isinstance(p, ClothoidPiece)]
+        counts = np.array([p._knots.size - 1 for p in pieces])
+        last = np.cumsum(counts) - 1
+        first = last - counts + 1
+        knots = np.concatenate([p._knots[:-1] for p in pieces])
+        xy = np.concatenate([p._knot_xy[:-1] for p in pieces])
+        owner = np.repeat(np.arange(len(pieces)), counts)
+        k0, dk, length, theta0 = (row[owner] for row in self._clothoids)
+        sharpness = dk / length
+        theta = theta0 + knots * (k0 + 0.5 * sharpness * knots)  # ClothoidPiece.heading
+        kappa = k0 + dk * (knots / length)  # ClothoidPiece.curvature
+        direction = self._directions[owner].astype(np.float64)  # ±1: products stay exact
+        curved = (kappa != 0.0) | (sharpness != 0.0)
+        # Separate contiguous rows: one gather each is ~10x faster than a (8, cells) take.
+        rows = tuple(np.ascontiguousarray(r) for r in (
+            knots, xy[:, 0], xy[:, 1], direction * np.cos(theta), direction * np.sin(theta),
+            kappa, sharpness, curved))
+        return self.offsets[owner] + knots, first, last, rows
+
+    def _clothoid_points(self, q: FloatArray, idx: IntArray) -> FloatArray | None:
+        """:meth:`ClothoidPiece.point` of each point's piece, in one pass over all points.
+
+        Each point starts from the tabulated start of its quadrature cell and adds
+        :func:`~speedplan.geometry.primitives.turn_integral` of the step: the same position
+        to rounding as the piece's Gauss–Legendre rule without its 32 cosines and sines a
+        point, and no grouping by piece (10 000 points: 3.1 -> 1.2 ms on the serpentine).
+        Lines are exact (``start + u · direction``), as in the piece. ``None`` when some
+        step would turn by more than 1 rad (a piece of over 250 000 rad).
+        """
+        cells = self._cells
+        assert cells is not None
+        starts, first, last, rows = cells
+        flat, fidx = q.ravel(), idx.ravel()
+        table = self._clothoids
+        assert table is not None
+        u = np.minimum(np.maximum(flat - self.offsets[fidx], 0.0), table[2][fidx])
+        # The cell holding u, kept within its piece where rounding of the path's positions
+        # would put a point at a join into the neighbour's cell.
+        j = np.minimum(np.maximum(np.searchsorted(starts, flat, side="right") - 1, first[fidx]),
+                       last[fidx])
+        u0, x0, y0, cos0, sin0, curved = (r[j] for r in rows[:5] + rows[7:])
+        h = u - u0
+        # Only points on curved cells need the series: on a line it is exactly 1 (lines are
+        # most of a waypoint path's length).
+        re, im = np.ones(h.size), np.zeros(h.size)
+        jb = j[curved]
+        hb = h[curved]
+        try:
+            re[curved], im[curved] = turn_integral(rows[5][jb] * hb, rows[6][jb] * (hb * hb))
+        except ValueError:
+            return None
+        out = np.empty((flat.size, 2))
+        out[:, 0] = x0 + h * (cos0 * re - sin0 * im)
+        out[:, 1] = y0 + h * (sin0 * re + cos0 * im)
+        return out.reshape(*q.shape, 2)
 
     def _clothoid_values(self, q: FloatArray, idx: IntArray, attr: str) -> FloatArray:
         """:meth:`ClothoidPiece.curvature` or ``heading`` of each point's piece (see above)."""
@@ -181,8 +262,13 @@ class Path:
 
     def _dispatch(self, s: Any, attr: str) -> FloatArray:
         q, idx = self._locate(s)
-        if attr in ("curvature", "heading") and self._clothoids is not None:
-            return self._clothoid_values(q, idx, attr)
+        if self._clothoids is not None:
+            if attr in ("curvature", "heading"):
+                return self._clothoid_values(q, idx, attr)
+            if attr == "point":
+                xy = self._clothoid_points(q, idx)
+                if xy is not None:
+                    return xy
         return self._by_piece(q, idx, attr)
 
     def _by_piece(self, q: FloatArray, idx: IntArray, attr: str) -> FloatArray:
@@ -384,7 +470,9 @@ class Path:
         """
         q, idx = self._locate(s)
         if self._clothoids is not None:  # nothing shared between the three: vectorised
-            return (self._by_piece(q, idx, "point"), self._clothoid_values(q, idx, "heading"),
+            xy = self._clothoid_points(q, idx)
+            return (self._by_piece(q, idx, "point") if xy is None else xy,
+                    self._clothoid_values(q, idx, "heading"),
                     self._clothoid_values(q, idx, "curvature"))
         flat, fidx = q.ravel(), idx.ravel()
         xy, theta, kappa = np.empty((flat.size, 2)), np.empty(flat.size), np.empty(flat.size)
@@ -530,14 +618,13 @@ class Path:
             raise InvalidInputError("`segments` is empty; pass at least one segment")
         xy = as_array("start", start, ndim=1, length=2)
         theta = as_scalar("heading", heading)
-        pieces: list[Piece] = []
-        point = (float(xy[0]), float(xy[1]))
+        specs: list[PieceSpec] = []
+        point: tuple[float, float] | None = (float(xy[0]), float(xy[1]))
         for i, seg in enumerate(segments):
-            piece = segment_piece(as_segment(seg, f"segments[{i}]"), point, theta)
-            pieces.append(piece)
-            end, theta = piece.end
-            point = (float(end[0]), float(end[1]))
-        return cls(tuple(pieces))
+            spec = segment_spec(as_segment(seg, f"segments[{i}]"), point, theta)
+            specs.append(spec)
+            theta, point = end_heading(*spec[1:5]), None  # the next starts where this ends
+        return cls(tuple(clothoid_chain(specs)))
 
     @classmethod
     def from_waypoints(

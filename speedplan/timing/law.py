@@ -570,6 +570,12 @@ class LawChain:
         t = np.atleast_1d(np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration))
         leg = np.clip(np.searchsorted(self.start_times, t, side="right") - 1, 0,
                       len(self.laws) - 1)
+        if leg.size and leg[0] == leg[-1] == leg.min() == leg.max():
+            # All in one leg (every path without cusps): no masks, no np.unique (~0.5 ms at
+            # 10 000 times), the same values.
+            i = int(leg[0])
+            s, *rest = self.laws[i].state_at(t - self.start_times[i])
+            return (s + self.offsets[i], *rest)
         out: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray] = (
             np.empty(t.shape), np.empty(t.shape), np.empty(t.shape), np.empty(t.shape),
             np.empty(t.shape))
