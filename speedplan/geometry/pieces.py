@@ -6,8 +6,8 @@ pieces with ``length`` and vectorised ``point(u)``, ``heading(u)``, ``curvature(
 * :class:`~speedplan.geometry.primitives.ClothoidPiece` — curvature linear in ``u``: clothoid,
   arc (constant curvature) or line (zero curvature), evaluated to rounding.
 * :class:`CurvePiece` — a parametric curve ``r(τ)`` with derivatives (cubic spline, NURBS),
-  reparametrised by arc length: a Gauss–Legendre table of ``∫|r'|`` inverted by Newton's method
-  once, at construction, into Chebyshev interpolants of ``τ(u)`` accurate to rounding.
+  reparametrised by arc length: a Gauss–Legendre table of ``∫|r'|``, and per cell a Chebyshev
+  interpolant of its inverse ``τ(u)`` accurate to rounding (Newton's method where it is not).
 * :class:`ReversedPiece` — any piece travelled backwards.
 
 Every piece has a ``direction`` of travel: ``+1`` forward, ``-1`` driven in reverse. ``point``
@@ -52,6 +52,9 @@ _CHEB_HALVINGS = 8
 #: Accepted error of the interpolant, as an arc length ``|r'| |Δτ|``, in units of the
 #: curve's length (of 1 m if shorter): a few ulps (the inversion stops at ``1e-14``).
 _CHEB_TOLERANCE = 2e-15
+#: At most this many Newton steps on the Chebyshev interpolant of σ(τ) for the nodes of
+#: τ(u) (quadratic convergence from the linear guess: 4-5 reach rounding).
+_POLY_NEWTON_STEPS = 10
 
 
 def _chebyshev_matrix(degree: int) -> FloatArray:
@@ -68,16 +71,36 @@ _CHEB_POINTS = np.cos(np.pi * np.arange(_CHEB_DEGREE + 1) / _CHEB_DEGREE)
 _CHEB_MATRIX = _chebyshev_matrix(_CHEB_DEGREE)
 #: Midpoints between the Chebyshev points, where an interpolant's error is largest.
 _CHEB_CHECKS = np.cos(np.pi * (np.arange(_CHEB_DEGREE) + 0.5) / _CHEB_DEGREE)
+#: The checks also compared with the 16-point rule (every other one, both ends included).
+_GAUSS_CHECKS = np.unique(np.append(np.arange(0, _CHEB_DEGREE, 2), _CHEB_DEGREE - 1))
+
+
+def _antiderivative(coef: FloatArray) -> FloatArray:
+    """Chebyshev coefficients (one more) of ``∫_{-1}^x Σ coef[:, i] T_i``, row by row."""
+    m, deg = coef.shape[0], coef.shape[1] - 1
+    c = np.concatenate((coef, np.zeros((m, 2))), axis=1)
+    out = np.zeros((m, deg + 2))
+    i = np.arange(1, deg + 2)
+    # ∫T_0 = T_1, ∫T_1 = T_2 / 4, ∫T_i = T_(i+1) / (2(i+1)) - T_(i-1) / (2(i-1)) (i >= 2).
+    out[:, 1:] = (np.where(i == 1, 2.0, 1.0) * c[:, i - 1] - c[:, i + 1]) / (2.0 * i)
+    # The constant term: zero at x = -1, where T_i = (-1)^i.
+    out[:, 0] = -(out[:, 1:] * (-1.0) ** i).sum(axis=1)
+    return out
 
 
 def _clenshaw(coef: FloatArray, x: FloatArray) -> FloatArray:
     """``Σ coef[:, i] T_i(x)`` row by row (``coef`` shape ``(m, degree + 1)``, ``x`` (m,))."""
+    return _clenshaw_t(np.ascontiguousarray(coef.T), x)
+
+
+def _clenshaw_t(rows: FloatArray, x: FloatArray) -> FloatArray:
+    """:func:`_clenshaw` of ``rows = coef.T`` (contiguous per degree: 3x faster sums)."""
     b1 = np.zeros_like(x)
     b2 = np.zeros_like(x)
     two_x = 2.0 * x
-    for i in range(coef.shape[1] - 1, 0, -1):
-        b1, b2 = coef[:, i] + two_x * b1 - b2, b1
-    out: FloatArray = coef[:, 0] + x * b1 - b2
+    for i in range(rows.shape[0] - 1, 0, -1):
+        b1, b2 = rows[i] + two_x * b1 - b2, b1
+    out: FloatArray = rows[0] + x * b1 - b2
     return out
 
 
@@ -152,10 +175,10 @@ class CurvePiece(Piece):
     The arc length ``σ(τ) = ∫|r'|`` is tabulated with a 16-point Gauss–Legendre rule on 8
     cells per polynomial piece, each halved until the rule resolves it (see
     :meth:`_arc_table`); ``τ(u)`` solves ``σ(τ) = u`` by Newton's method kept inside the
-    bracketing table cell, so ``point(u)`` moves at unit speed. That inversion runs at
-    construction, at the Chebyshev points of each cell, into a degree-16 interpolant of
-    ``τ(u)`` checked against it between its points (cells halved until it agrees to a few ulps,
-    see :meth:`_interpolate`): a query costs one Clenshaw sum and one curve evaluation.
+    bracketing table cell, so ``point(u)`` moves at unit speed. Queries use a degree-16
+    Chebyshev interpolant of ``τ(u)`` per cell instead, built at construction and checked
+    against the 16-point rule between its nodes (cells halved until it agrees to a few ulps,
+    see :meth:`_interpolate`): one Clenshaw sum and one curve evaluation per query.
     """
 
     curve: ParametricCurve
@@ -166,7 +189,8 @@ class CurvePiece(Piece):
     _theta: FloatArray = field(init=False, repr=False)
     _dtau: FloatArray = field(init=False, repr=False)
     # Chebyshev interpolants of τ(u): cell starts in u (and the end), the τ at both ends of
-    # each cell, the coefficients of (τ - τ_lo) / (τ_hi - τ_lo) in 2 (u - u_lo) / span - 1,
+    # each cell, the coefficients of (τ - τ_lo) / (τ_hi - τ_lo) in 2 (u - u_lo) / span - 1
+    # (one row per degree, one column per cell),
     # and whether the interpolant is accurate (else the cell inverts by Newton per query).
     _cheb_u: FloatArray = field(init=False, repr=False)
     _cheb_tau: FloatArray = field(init=False, repr=False)
@@ -209,10 +233,11 @@ class CurvePiece(Piece):
     def _interpolate(self) -> None:
         """Chebyshev interpolants of ``τ(u)`` per table cell, halved where not accurate.
 
-        Node values come from the Newton inversion; each interpolant is compared with it
-        halfway between its nodes, where an interpolant's error peaks, and accepted within
-        ``_CHEB_TOLERANCE`` of the length (as arc length ``|r'| |Δτ|``). A query is then one
-        Clenshaw sum instead of Newton steps of 16-point integrals of ``|r'|``.
+        Each interpolant is checked halfway between its nodes, where an interpolant's error
+        peaks, and accepted within ``_CHEB_TOLERANCE`` of the length (see
+        :meth:`_fit_cells`); a cell still off after ``_CHEB_HALVINGS`` halvings keeps
+        Newton's method. A query is then one Clenshaw sum instead of Newton steps of 16-point
+        integrals of ``|r'|``.
         """
         u_lo, u_hi = self._arc[:-1], self._arc[1:]
         t_lo, t_hi = self._tau[:-1], self._tau[1:]
@@ -235,32 +260,64 @@ class CurvePiece(Piece):
         set_ = object.__setattr__
         set_(self, "_cheb_u", np.append(u0[order], self.length))
         set_(self, "_cheb_tau", np.column_stack((lo[order], hi[order])))
-        set_(self, "_cheb_coef", coef[order])
+        set_(self, "_cheb_coef", np.ascontiguousarray(coef[order].T))
         set_(self, "_cheb_ok", ok[order])
 
     def _fit_cells(self, u_lo: FloatArray, u_hi: FloatArray, t_lo: FloatArray,
                    t_hi: FloatArray, tol: float) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
-        """Coefficients of each cell's interpolant and whether it passes the check."""
-        span = u_hi - u_lo
+        """Coefficients of each cell's interpolant and whether it passes the check.
+
+        The nodes ``τ(u_k)`` invert a Chebyshev interpolant of ``σ(τ)`` on the cell (from
+        ``|r'|`` at its Chebyshev points: one curve evaluation per point, not Newton steps of
+        integrals). Halfway between the nodes, ``σ`` at the interpolated ``τ`` must give back
+        ``u``: from σ's interpolant at all of them, from the 16-point rule of ``|r'|`` over
+        the cell's start to ``τ`` at every other one. Where ``σ`` is not resolved by its
+        interpolant, the nodes are off and the rule fails the cell.
+        """
+        n = u_lo.size
         width = np.where(t_hi > t_lo, t_hi - t_lo, 1.0)
-        x = np.concatenate((_CHEB_POINTS, _CHEB_CHECKS))
-        u = u_lo[:, None] + span[:, None] * (0.5 * (x[None, :] + 1.0))
-        flat = np.clip(u.ravel(), 0.0, self.length)
-        j = np.clip(np.searchsorted(self._arc, flat, side="right") - 1, 0, self._tau.size - 2)
-        # Newton until its steps stall: the interpolant is checked against these values.
-        ref = self._parameter(flat, j, rel_tol=0.0).reshape(u.shape)
-        nodes = ref[:, :_CHEB_POINTS.size]
+        half = 0.5 * width[:, None]
+        taus = t_lo[:, None] + half * (_CHEB_POINTS[None, :] + 1.0)
+        speed = np.linalg.norm(self.curve(taus.ravel(), 1), axis=-1).reshape(taus.shape)
+        a = speed @ _CHEB_MATRIX.T  # |r'| in y ∈ [-1, 1], τ = t_lo + (width / 2) (y + 1)
+        sigma = _antiderivative(a) * half  # σ(τ) - σ(t_lo), zero at y = -1
+        # Targets: u at the Chebyshev points of [u_lo, u_hi]; Newton on the polynomials from
+        # the linear guess, kept in [-1, 1] (σ grows: |r'| > 0 on cells without cusps).
+        target = (0.5 * (u_hi - u_lo))[:, None] * (_CHEB_POINTS[None, :] + 1.0)
+        y = np.repeat(_CHEB_POINTS[None, :], n, axis=0).copy()
+        rows = np.repeat(np.arange(n), _CHEB_POINTS.size)
+        ca, cs = a.T[:, rows], sigma.T[:, rows]
+        yf, tf, hf = y.ravel(), target.ravel(), np.repeat(half[:, 0], _CHEB_POINTS.size)
+        last = False
+        for _ in range(_POLY_NEWTON_STEPS):
+            step = (_clenshaw_t(cs, yf) - tf) / np.maximum(hf * _clenshaw_t(ca, yf), 1e-300)
+            yf = np.clip(yf - step, -1.0, 1.0)
+            if last:
+                break
+            # Quadratic convergence: after a step below 1e-9, one more reaches rounding.
+            last = not np.abs(step).max(initial=0.0) > 1e-9
+        nodes = t_lo[:, None] + half * (yf.reshape(y.shape) + 1.0)
         nodes[:, 0], nodes[:, -1] = t_hi, t_lo  # x = 1 is the cell's end, x = -1 its start
         coef = ((nodes - t_lo[:, None]) / width[:, None]) @ _CHEB_MATRIX.T
         m = _CHEB_CHECKS.size
         got = t_lo[:, None] + width[:, None] * _clenshaw(
-            np.repeat(coef, m, axis=0), np.tile(_CHEB_CHECKS, u_lo.size)).reshape(-1, m)
-        check = ref[:, _CHEB_POINTS.size:]
-        speed = np.linalg.norm(self.curve(check.ravel(), 1), axis=-1).reshape(check.shape)
-        # Below ``tol`` where |r'| is so large that a few ulps of τ exceed it: Newton's
-        # method cannot do better there either.
-        floor = speed * np.spacing(np.abs(check))
-        ok = (np.abs(got - check) * speed <= tol + floor).all(axis=1)
+            np.repeat(coef, m, axis=0), np.tile(_CHEB_CHECKS, n)).reshape(-1, m)
+        got = np.clip(got, t_lo[:, None], t_hi[:, None])
+        u_check = u_lo[:, None] + (0.5 * (u_hi - u_lo))[:, None] * (_CHEB_CHECKS[None, :] + 1.0)
+        y_got = ((got - t_lo[:, None]) / half - 1.0).ravel()
+        rows_m = np.repeat(np.arange(n), m)
+        off = u_lo[:, None] + _clenshaw_t(sigma.T[:, rows_m], y_got).reshape(got.shape) - u_check
+        # σ's interpolant against the 16-point rule at every other check (it is smooth where
+        # it passes; τ(u)'s interpolant is checked at all of them above).
+        sub = got[:, _GAUSS_CHECKS]
+        arc = self._speed_integral(np.repeat(t_lo, sub.shape[1]), sub.ravel())
+        gauss = u_lo[:, None] + arc.reshape(sub.shape) - u_check[:, _GAUSS_CHECKS]
+        speed = np.linalg.norm(self.curve(got.ravel(), 1), axis=-1).reshape(got.shape)
+        # Below ``tol`` where |r'| is so large that an ulp of τ exceeds it: Newton's method
+        # cannot do better there either.
+        floor = speed * np.spacing(np.abs(got)) + 4.0 * np.spacing(np.abs(u_check))
+        ok = ((np.abs(off) <= tol + floor).all(axis=1)
+              & (np.abs(gauss) <= tol + floor[:, _GAUSS_CHECKS]).all(axis=1))
         return coef, ok
 
     def _arc_table(self, nodes: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -333,7 +390,7 @@ class CurvePiece(Piece):
         u0, u1 = self._cheb_u[c], self._cheb_u[c + 1]
         x = 2.0 * (flat - u0) / np.maximum(u1 - u0, 1e-300) - 1.0
         lo, hi = self._cheb_tau[c, 0], self._cheb_tau[c, 1]
-        tau = np.clip(lo + (hi - lo) * _clenshaw(self._cheb_coef[c], x), lo, hi)
+        tau = np.clip(lo + (hi - lo) * _clenshaw_t(self._cheb_coef[:, c], x), lo, hi)
         newton = ~self._cheb_ok[c]
         if newton.any():
             tau[newton] = self._parameter(flat[newton], j[newton])
