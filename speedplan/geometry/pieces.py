@@ -75,6 +75,13 @@ _CHEB_CHECKS = np.cos(np.pi * (np.arange(_CHEB_DEGREE) + 0.5) / _CHEB_DEGREE)
 _GAUSS_CHECKS = np.unique(np.append(np.arange(0, _CHEB_DEGREE, 2), _CHEB_DEGREE - 1))
 
 
+def _signed_curvature(d1: FloatArray, d2: FloatArray) -> FloatArray:
+    """``(x'y'' - y'x'') / |r'|³`` from the first and second derivatives, shape (m, 2)."""
+    cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    out: FloatArray = cross / np.linalg.norm(d1, axis=-1) ** 3
+    return out
+
+
 def _antiderivative(coef: FloatArray) -> FloatArray:
     """Chebyshev coefficients (one more) of ``∫_{-1}^x Σ coef[:, i] T_i``, row by row."""
     m, deg = coef.shape[0], coef.shape[1] - 1
@@ -391,6 +398,9 @@ class CurvePiece(Piece):
         x = 2.0 * (flat - u0) / np.maximum(u1 - u0, 1e-300) - 1.0
         lo, hi = self._cheb_tau[c, 0], self._cheb_tau[c, 1]
         tau = np.clip(lo + (hi - lo) * _clenshaw_t(self._cheb_coef[:, c], x), lo, hi)
+        # Exactly the table's τ at the ends of a cell (the sum is off by rounding there): a
+        # NURBS path starts and ends on its end control points to the last bit.
+        tau = np.where(flat <= u0, lo, np.where(flat >= u1, hi, tau))
         newton = ~self._cheb_ok[c]
         if newton.any():
             tau[newton] = self._parameter(flat[newton], j[newton])
@@ -448,8 +458,7 @@ class CurvePiece(Piece):
         w = (flat - self._arc[j]) / np.maximum(self._arc[j + 1] - self._arc[j], 1e-300)
         ref = (1.0 - w) * self._theta[j] + w * self._theta[j + 1]
         theta = raw + 2.0 * np.pi * np.round((ref - raw) / (2.0 * np.pi))
-        cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
-        kappa = cross / np.linalg.norm(d1, axis=-1) ** 3
+        kappa = _signed_curvature(d1, d2)
         return r.reshape(*shape, 2), theta.reshape(shape), kappa.reshape(shape)
 
     def _derivatives(self, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -469,15 +478,17 @@ class CurvePiece(Piece):
         return self.evaluate(u)[1]
 
     def curvature(self, u: FloatArray) -> FloatArray:
-        """``(x'y'' - y'x'') / |r'|³`` [1/m]."""
-        return self.evaluate(u)[2]
+        """``(x'y'' - y'x'') / |r'|³`` [1/m] (without the headings of :meth:`evaluate`)."""
+        tau = self._interpolated(*self._cell(u))
+        _, d1, d2 = self._derivatives(tau)
+        return _signed_curvature(d1, d2).reshape(np.shape(u))
 
     def curvature_rate(self, u: FloatArray) -> FloatArray:
         """The central difference of :meth:`Piece.curvature_rate`, both sides in one query."""
         u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
         step = 1e-5 * self.length
         lo, hi = np.maximum(u - step, 0.0), np.minimum(u + step, self.length)
-        kappa = self.evaluate(np.concatenate((lo.ravel(), hi.ravel())))[2]
+        kappa = self.curvature(np.concatenate((lo.ravel(), hi.ravel())))
         out: FloatArray = ((kappa[lo.size:] - kappa[:lo.size]).reshape(u.shape) / (hi - lo))
         return out
 
