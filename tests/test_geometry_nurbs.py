@@ -180,3 +180,90 @@ def test_inner_knot_repeated_more_than_degree_without_a_jump_is_only_a_corner_ch
     np.testing.assert_allclose(p.point([0.5, 1.0, 3.0]), [[0.5, 0], [1, 0], [3, 0]], atol=1e-12)
     with pytest.raises(InvalidInputError, match=r"`knots`.*corner"):
         Path.from_nurbs(1, t, [[0, 0], [1, 0], [1, 0], [1, 5]])
+
+
+def circle_arc_nurbs(center, radius, start, spans, knots):
+    """Rational quadratic NURBS of the circle arc from angle ``start`` through ``spans``.
+
+    Each span (angle < π) is one quadratic Bézier arc (middle weight ``cos(span / 2)``);
+    ``knots`` are the inner knots between spans, each doubled (any increasing values: they
+    change the parametrisation, not the curve).
+    """
+    ctrl, w = [], []
+    angle = start
+    for i, span in enumerate(spans):
+        mid = angle + 0.5 * span
+        pts = [(radius, angle), (radius / np.cos(0.5 * span), mid), (radius, angle + span)]
+        for j, (r, a) in enumerate(pts):
+            if i and j == 0:
+                continue  # the previous span's end
+            ctrl.append(center + r * np.array([np.cos(a), np.sin(a)]))
+            w.append(np.cos(0.5 * span) if j == 1 else 1.0)
+        angle += span
+    t = np.concatenate(([0.0] * 3, np.repeat(knots, 2), [1.0] * 3))
+    return Path.from_nurbs(2, t, np.array(ctrl), np.array(w))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_circle_arc_nurbs_at_arc_length_equals_the_closed_form(seed):
+    # An independent oracle at every s: the circle's point, heading and curvature at angle
+    # start + s / R, whatever the (non-uniform) knots and the cells of the arc-length table.
+    rng = np.random.default_rng(seed)
+    radius = 10.0 ** rng.uniform(-1, 2)
+    center, start = rng.uniform(-50, 50, 2), rng.uniform(-np.pi, np.pi)
+    spans = rng.uniform(0.2, 2.5, rng.integers(1, 5))
+    knots = np.sort(rng.uniform(0.05, 0.95, spans.size - 1))
+    p = circle_arc_nurbs(center, radius, start, spans, knots)
+    assert p.length == pytest.approx(radius * spans.sum(), rel=1e-13)
+    s = np.concatenate((np.linspace(0.0, p.length, 1001), rng.uniform(0, p.length, 1000)))
+    angle = start + s / radius
+    scale = max(radius, 1.0) * (1.0 + np.abs(center).max() / max(radius, 1.0))
+    xy, theta, kappa = p.evaluate(s)
+    exact = center + radius * np.column_stack((np.cos(angle), np.sin(angle)))
+    np.testing.assert_allclose(xy, exact, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(p.point(s), xy, rtol=0, atol=0)
+    # Continuous (unwrapped) from its start, which is the tangent's direction mod 2π.
+    assert abs(np.angle(np.exp(1j * (theta[0] - start - np.pi / 2)))) < 1e-12
+    np.testing.assert_allclose(theta - theta[0], s / radius, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(kappa, 1.0 / radius, rtol=1e-11)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_straight_nurbs_with_non_uniform_knots_moves_at_unit_speed(seed):
+    # Collinear control points in order and any positive weights: a straight segment
+    # travelled monotonically, so the point at arc length s is start + s * direction exactly
+    # (the parametrisation is far from uniform: weights over two decades, random knots).
+    rng = np.random.default_rng(100 + seed)
+    k = int(rng.integers(2, 5))
+    m = int(rng.integers(k + 1, 10))
+    along = np.concatenate(([0.0], np.cumsum(rng.uniform(0.1, 5.0, m - 1))))
+    heading = rng.uniform(-np.pi, np.pi)
+    direction = np.array([np.cos(heading), np.sin(heading)])
+    origin = rng.uniform(-20, 20, 2)
+    ctrl = origin + along[:, None] * direction
+    w = 10.0 ** rng.uniform(-1, 1, m)
+    knots = np.concatenate((np.zeros(k + 1), np.sort(rng.uniform(0, 1, m - k - 1)),
+                            np.ones(k + 1)))
+    p = Path.from_nurbs(k, knots, ctrl, w)
+    assert p.length == pytest.approx(along[-1], rel=1e-13)
+    s = np.concatenate((np.linspace(0.0, p.length, 1001), rng.uniform(0, p.length, 1000)))
+    xy, theta, kappa = p.evaluate(s)
+    scale = max(along[-1], 1.0) + np.abs(origin).max()
+    np.testing.assert_allclose(xy, origin + s[:, None] * direction, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(np.angle(np.exp(1j * (theta - heading))), 0.0, rtol=0,
+                               atol=1e-12)
+    np.testing.assert_allclose(kappa, 0.0, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("weights", [[1, 1, 1.2, 0.7, 1, 1.0], [1, 1e3, 1e-3, 1e3, 1e-3, 1]])
+def test_interpolated_inversion_equals_newton_to_rounding(weights):
+    # The Chebyshev interpolants of τ(u) against Newton's method run until its steps stall:
+    # within a few ulps of τ times |r'| (an arc length), even where |r'| varies by decades.
+    p = Path.from_nurbs(K, KNOTS, CTRL, np.asarray(weights, dtype=float))
+    piece = p.pieces[0]
+    s = np.random.default_rng(7).uniform(0, p.length, 5000)
+    flat, j = piece._cell(s)
+    newton = piece._parameter(flat, j, rel_tol=0.0)
+    speed = np.linalg.norm(piece.curve(newton, 1), axis=1)
+    err = np.abs(piece.parameter(s) - newton) * speed
+    assert (err <= 4e-15 * p.length + 2 * speed * np.spacing(newton)).all()

@@ -73,6 +73,21 @@ class NurbsCurve:
         out: FloatArray = t[(t >= lo) & (t <= hi)]
         return out
 
+    def derivatives(self, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``r, r', r''`` at ``tau`` from one evaluation of each homogeneous derivative.
+
+        The same numbers as ``self(tau, 0)``, ``self(tau, 1)``, ``self(tau, 2)`` with half the
+        B-spline evaluations (each call costs tens of µs besides its points).
+        """
+        lo, hi = self.domain
+        tau = np.clip(np.asarray(tau, dtype=np.float64).ravel(), lo, hi)
+        h0, h1, h2 = (self._homogeneous(tau, nu) for nu in (0, 1, 2))
+        wt = h0[:, 2:3]
+        r = h0[:, :2] / wt
+        r1 = (h1[:, :2] - r * h1[:, 2:3]) / wt
+        r2 = (h2[:, :2] - 2.0 * r1 * h1[:, 2:3] - r * h2[:, 2:3]) / wt
+        return r, r1, r2
+
     def __call__(self, tau: FloatArray, nu: int) -> FloatArray:
         """``nu``-th derivative (0, 1 or 2) at parameters ``tau`` (clipped to the domain)."""
         lo, hi = self.domain

@@ -6,7 +6,8 @@ pieces with ``length`` and vectorised ``point(u)``, ``heading(u)``, ``curvature(
 * :class:`~speedplan.geometry.primitives.ClothoidPiece` — curvature linear in ``u``: clothoid,
   arc (constant curvature) or line (zero curvature), evaluated to rounding.
 * :class:`CurvePiece` — a parametric curve ``r(τ)`` with derivatives (cubic spline, NURBS),
-  reparametrised by arc length: a Gauss–Legendre table of ``∫|r'|`` inverted by Newton's method.
+  reparametrised by arc length: a Gauss–Legendre table of ``∫|r'|``, and per cell a Chebyshev
+  interpolant of its inverse ``τ(u)`` accurate to rounding (Newton's method where it is not).
 * :class:`ReversedPiece` — any piece travelled backwards.
 
 Every piece has a ``direction`` of travel: ``+1`` forward, ``-1`` driven in reverse. ``point``
@@ -21,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
+import numpy.typing as npt
 
 from ..core.checks import FloatArray, IntArray
 from ..core.errors import InvalidInputError
@@ -42,6 +44,71 @@ _INVERSION_STEPS = 60
 #: rounding (a cell takes the 16-point rule).
 _SHORT_NODES, _SHORT_WEIGHTS = SHORT_NODES, SHORT_WEIGHTS
 _SHORT_STEP = 1e-3
+#: Degree of the Chebyshev interpolant of ``τ(u)`` on each cell of a :class:`CurvePiece`.
+_CHEB_DEGREE = 16
+#: At most this many halvings (in ``u``) of a cell whose interpolant is not accurate to
+#: rounding; cells still off after them are inverted by Newton's method at every query.
+_CHEB_HALVINGS = 8
+#: Accepted error of the interpolant, as an arc length ``|r'| |Δτ|``, in units of the
+#: curve's length (of 1 m if shorter): a few ulps (the inversion stops at ``1e-14``).
+_CHEB_TOLERANCE = 2e-15
+#: At most this many Newton steps on the Chebyshev interpolant of σ(τ) for the nodes of
+#: τ(u) (quadratic convergence from the linear guess: 4-5 reach rounding).
+_POLY_NEWTON_STEPS = 10
+
+
+def _chebyshev_matrix(degree: int) -> FloatArray:
+    """Values at the Chebyshev points ``cos(πk/degree)`` to Chebyshev coefficients."""
+    k = np.arange(degree + 1)
+    cos = np.cos(np.pi * np.outer(k, k) / degree)  # T_i(x_k)
+    scale = np.full(degree + 1, 2.0 / degree)
+    scale[[0, -1]] = 1.0 / degree
+    out: FloatArray = scale[:, None] * cos * np.where((k == 0) | (k == degree), 0.5, 1.0)
+    return out
+
+
+_CHEB_POINTS = np.cos(np.pi * np.arange(_CHEB_DEGREE + 1) / _CHEB_DEGREE)
+_CHEB_MATRIX = _chebyshev_matrix(_CHEB_DEGREE)
+#: Midpoints between the Chebyshev points, where an interpolant's error is largest.
+_CHEB_CHECKS = np.cos(np.pi * (np.arange(_CHEB_DEGREE) + 0.5) / _CHEB_DEGREE)
+#: The checks also compared with the 16-point rule (every other one, both ends included).
+_GAUSS_CHECKS = np.unique(np.append(np.arange(0, _CHEB_DEGREE, 2), _CHEB_DEGREE - 1))
+
+
+def _signed_curvature(d1: FloatArray, d2: FloatArray) -> FloatArray:
+    """``(x'y'' - y'x'') / |r'|³`` from the first and second derivatives, shape (m, 2)."""
+    cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    out: FloatArray = cross / np.linalg.norm(d1, axis=-1) ** 3
+    return out
+
+
+def _antiderivative(coef: FloatArray) -> FloatArray:
+    """Chebyshev coefficients (one more) of ``∫_{-1}^x Σ coef[:, i] T_i``, row by row."""
+    m, deg = coef.shape[0], coef.shape[1] - 1
+    c = np.concatenate((coef, np.zeros((m, 2))), axis=1)
+    out = np.zeros((m, deg + 2))
+    i = np.arange(1, deg + 2)
+    # ∫T_0 = T_1, ∫T_1 = T_2 / 4, ∫T_i = T_(i+1) / (2(i+1)) - T_(i-1) / (2(i-1)) (i >= 2).
+    out[:, 1:] = (np.where(i == 1, 2.0, 1.0) * c[:, i - 1] - c[:, i + 1]) / (2.0 * i)
+    # The constant term: zero at x = -1, where T_i = (-1)^i.
+    out[:, 0] = -(out[:, 1:] * (-1.0) ** i).sum(axis=1)
+    return out
+
+
+def _clenshaw(coef: FloatArray, x: FloatArray) -> FloatArray:
+    """``Σ coef[:, i] T_i(x)`` row by row (``coef`` shape ``(m, degree + 1)``, ``x`` (m,))."""
+    return _clenshaw_t(np.ascontiguousarray(coef.T), x)
+
+
+def _clenshaw_t(rows: FloatArray, x: FloatArray) -> FloatArray:
+    """:func:`_clenshaw` of ``rows = coef.T`` (contiguous per degree: 3x faster sums)."""
+    b1 = np.zeros_like(x)
+    b2 = np.zeros_like(x)
+    two_x = 2.0 * x
+    for i in range(rows.shape[0] - 1, 0, -1):
+        b1, b2 = rows[i] + two_x * b1 - b2, b1
+    out: FloatArray = rows[0] + x * b1 - b2
+    return out
 
 
 class Piece:
@@ -115,7 +182,10 @@ class CurvePiece(Piece):
     The arc length ``σ(τ) = ∫|r'|`` is tabulated with a 16-point Gauss–Legendre rule on 8
     cells per polynomial piece, each halved until the rule resolves it (see
     :meth:`_arc_table`); ``τ(u)`` solves ``σ(τ) = u`` by Newton's method kept inside the
-    bracketing table cell, so ``point(u)`` moves at unit speed.
+    bracketing table cell, so ``point(u)`` moves at unit speed. Queries use a degree-16
+    Chebyshev interpolant of ``τ(u)`` per cell instead, built at construction and checked
+    against the 16-point rule between its nodes (cells halved until it agrees to a few ulps,
+    see :meth:`_interpolate`): one Clenshaw sum and one curve evaluation per query.
     """
 
     curve: ParametricCurve
@@ -125,6 +195,14 @@ class CurvePiece(Piece):
     _arc: FloatArray = field(init=False, repr=False)
     _theta: FloatArray = field(init=False, repr=False)
     _dtau: FloatArray = field(init=False, repr=False)
+    # Chebyshev interpolants of τ(u): cell starts in u (and the end), the τ at both ends of
+    # each cell, the coefficients of (τ - τ_lo) / (τ_hi - τ_lo) in 2 (u - u_lo) / span - 1
+    # (one row per degree, one column per cell),
+    # and whether the interpolant is accurate (else the cell inverts by Newton per query).
+    _cheb_u: FloatArray = field(init=False, repr=False)
+    _cheb_tau: FloatArray = field(init=False, repr=False)
+    _cheb_coef: FloatArray = field(init=False, repr=False)
+    _cheb_ok: npt.NDArray[np.bool_] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "direction", as_direction("direction", self.direction))
@@ -157,6 +235,97 @@ class CurvePiece(Piece):
         set_(self, "_theta", theta)
         set_(self, "_dtau", 1.0 / np.maximum(speed, 1e-300))  # dτ/du at the table nodes
         set_(self, "length", float(arc[-1]))
+        self._interpolate()
+
+    def _interpolate(self) -> None:
+        """Chebyshev interpolants of ``τ(u)`` per table cell, halved where not accurate.
+
+        Each interpolant is checked halfway between its nodes, where an interpolant's error
+        peaks, and accepted within ``_CHEB_TOLERANCE`` of the length (see
+        :meth:`_fit_cells`); a cell still off after ``_CHEB_HALVINGS`` halvings keeps
+        Newton's method. A query is then one Clenshaw sum instead of Newton steps of 16-point
+        integrals of ``|r'|``.
+        """
+        u_lo, u_hi = self._arc[:-1], self._arc[1:]
+        t_lo, t_hi = self._tau[:-1], self._tau[1:]
+        tol = _CHEB_TOLERANCE * max(self.length, 1.0)
+        done: list[tuple[npt.NDArray[np.generic], ...]] = []
+        for rnd in range(_CHEB_HALVINGS + 1):
+            coef, ok = self._fit_cells(u_lo, u_hi, t_lo, t_hi, tol)
+            keep = ok | (rnd == _CHEB_HALVINGS) | ~(u_hi - u_lo > 4 * np.spacing(u_hi))
+            done.append((u_lo[keep], t_lo[keep], t_hi[keep], coef[keep], ok[keep]))
+            if keep.all():
+                break
+            bad = ~keep
+            mid = 0.5 * (u_lo[bad] + u_hi[bad])
+            t_mid = self._parameter(*self._cell(mid), rel_tol=0.0) if mid.size else mid
+            u_lo, u_hi = np.concatenate((u_lo[bad], mid)), np.concatenate((mid, u_hi[bad]))
+            t_lo = np.concatenate((t_lo[bad], t_mid))
+            t_hi = np.concatenate((t_mid, t_hi[bad]))
+        u0, lo, hi, coef, ok = (np.concatenate(parts) for parts in zip(*done, strict=True))
+        order = np.argsort(u0, kind="stable")
+        set_ = object.__setattr__
+        set_(self, "_cheb_u", np.append(u0[order], self.length))
+        set_(self, "_cheb_tau", np.column_stack((lo[order], hi[order])))
+        set_(self, "_cheb_coef", np.ascontiguousarray(coef[order].T))
+        set_(self, "_cheb_ok", ok[order])
+
+    def _fit_cells(self, u_lo: FloatArray, u_hi: FloatArray, t_lo: FloatArray,
+                   t_hi: FloatArray, tol: float) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+        """Coefficients of each cell's interpolant and whether it passes the check.
+
+        The nodes ``τ(u_k)`` invert a Chebyshev interpolant of ``σ(τ)`` on the cell (from
+        ``|r'|`` at its Chebyshev points: one curve evaluation per point, not Newton steps of
+        integrals). Halfway between the nodes, ``σ`` at the interpolated ``τ`` must give back
+        ``u``: from σ's interpolant at all of them, from the 16-point rule of ``|r'|`` over
+        the cell's start to ``τ`` at every other one. Where ``σ`` is not resolved by its
+        interpolant, the nodes are off and the rule fails the cell.
+        """
+        n = u_lo.size
+        width = np.where(t_hi > t_lo, t_hi - t_lo, 1.0)
+        half = 0.5 * width[:, None]
+        taus = t_lo[:, None] + half * (_CHEB_POINTS[None, :] + 1.0)
+        speed = np.linalg.norm(self.curve(taus.ravel(), 1), axis=-1).reshape(taus.shape)
+        a = speed @ _CHEB_MATRIX.T  # |r'| in y ∈ [-1, 1], τ = t_lo + (width / 2) (y + 1)
+        sigma = _antiderivative(a) * half  # σ(τ) - σ(t_lo), zero at y = -1
+        # Targets: u at the Chebyshev points of [u_lo, u_hi]; Newton on the polynomials from
+        # the linear guess, kept in [-1, 1] (σ grows: |r'| > 0 on cells without cusps).
+        target = (0.5 * (u_hi - u_lo))[:, None] * (_CHEB_POINTS[None, :] + 1.0)
+        y = np.repeat(_CHEB_POINTS[None, :], n, axis=0).copy()
+        rows = np.repeat(np.arange(n), _CHEB_POINTS.size)
+        ca, cs = a.T[:, rows], sigma.T[:, rows]
+        yf, tf, hf = y.ravel(), target.ravel(), np.repeat(half[:, 0], _CHEB_POINTS.size)
+        last = False
+        for _ in range(_POLY_NEWTON_STEPS):
+            step = (_clenshaw_t(cs, yf) - tf) / np.maximum(hf * _clenshaw_t(ca, yf), 1e-300)
+            yf = np.clip(yf - step, -1.0, 1.0)
+            if last:
+                break
+            # Quadratic convergence: after a step below 1e-9, one more reaches rounding.
+            last = not np.abs(step).max(initial=0.0) > 1e-9
+        nodes = t_lo[:, None] + half * (yf.reshape(y.shape) + 1.0)
+        nodes[:, 0], nodes[:, -1] = t_hi, t_lo  # x = 1 is the cell's end, x = -1 its start
+        coef = ((nodes - t_lo[:, None]) / width[:, None]) @ _CHEB_MATRIX.T
+        m = _CHEB_CHECKS.size
+        got = t_lo[:, None] + width[:, None] * _clenshaw(
+            np.repeat(coef, m, axis=0), np.tile(_CHEB_CHECKS, n)).reshape(-1, m)
+        got = np.clip(got, t_lo[:, None], t_hi[:, None])
+        u_check = u_lo[:, None] + (0.5 * (u_hi - u_lo))[:, None] * (_CHEB_CHECKS[None, :] + 1.0)
+        y_got = ((got - t_lo[:, None]) / half - 1.0).ravel()
+        rows_m = np.repeat(np.arange(n), m)
+        off = u_lo[:, None] + _clenshaw_t(sigma.T[:, rows_m], y_got).reshape(got.shape) - u_check
+        # σ's interpolant against the 16-point rule at every other check (it is smooth where
+        # it passes; τ(u)'s interpolant is checked at all of them above).
+        sub = got[:, _GAUSS_CHECKS]
+        arc = self._speed_integral(np.repeat(t_lo, sub.shape[1]), sub.ravel())
+        gauss = u_lo[:, None] + arc.reshape(sub.shape) - u_check[:, _GAUSS_CHECKS]
+        speed = np.linalg.norm(self.curve(got.ravel(), 1), axis=-1).reshape(got.shape)
+        # Below ``tol`` where |r'| is so large that an ulp of τ exceeds it: Newton's method
+        # cannot do better there either.
+        floor = speed * np.spacing(np.abs(got)) + 4.0 * np.spacing(np.abs(u_check))
+        ok = ((np.abs(off) <= tol + floor).all(axis=1)
+              & (np.abs(gauss) <= tol + floor[:, _GAUSS_CHECKS]).all(axis=1))
+        return coef, ok
 
     def _arc_table(self, nodes: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Table nodes ``τ`` (``nodes``, refined) and the arc length of each cell between them.
@@ -217,9 +386,28 @@ class CurvePiece(Piece):
     def parameter(self, u: FloatArray) -> FloatArray:
         """Curve parameter ``τ`` at local arc lengths ``u`` (flattened)."""
         flat, j = self._cell(u)
-        return self._parameter(flat, j)
+        if not hasattr(self, "_cheb_u"):  # while the interpolants are being built
+            return self._parameter(flat, j)
+        return self._interpolated(flat, j)
 
-    def _parameter(self, flat: FloatArray, j: IntArray) -> FloatArray:
+    def _interpolated(self, flat: FloatArray, j: IntArray) -> FloatArray:
+        """``τ(u)`` from the cells' interpolants (Newton where a cell has none)."""
+        c = np.clip(np.searchsorted(self._cheb_u, flat, side="right") - 1, 0,
+                    self._cheb_u.size - 2)
+        u0, u1 = self._cheb_u[c], self._cheb_u[c + 1]
+        x = 2.0 * (flat - u0) / np.maximum(u1 - u0, 1e-300) - 1.0
+        lo, hi = self._cheb_tau[c, 0], self._cheb_tau[c, 1]
+        tau = np.clip(lo + (hi - lo) * _clenshaw_t(self._cheb_coef[:, c], x), lo, hi)
+        # Exactly the table's τ at the ends of a cell (the sum is off by rounding there): a
+        # NURBS path starts and ends on its end control points to the last bit.
+        tau = np.where(flat <= u0, lo, np.where(flat >= u1, hi, tau))
+        newton = ~self._cheb_ok[c]
+        if newton.any():
+            tau[newton] = self._parameter(flat[newton], j[newton])
+        out: FloatArray = tau
+        return out
+
+    def _parameter(self, flat: FloatArray, j: IntArray, rel_tol: float = 1e-14) -> FloatArray:
         lo, hi = self._tau[j], self._tau[j + 1]
         span = np.maximum(self._arc[j + 1] - self._arc[j], 1e-300)
         # Cubic Hermite start from τ and dτ/du = 1/|r'| at the cell's ends: one Newton step
@@ -229,27 +417,33 @@ class CurvePiece(Piece):
         tau = ((2 * x3 - 3 * x2 + 1) * lo + (-2 * x3 + 3 * x2) * hi
                + span * ((x3 - 2 * x2 + x) * self._dtau[j] + (x3 - x2) * self._dtau[j + 1]))
         tau = np.clip(tau, lo, hi)
-        tol = 1e-14 * max(self.length, 1.0)
+        tol = rel_tol * max(self.length, 1.0)
         f = self._arc[j] + self._speed_integral(lo, tau) - flat  # σ(τ) - u
-        a, b = lo, hi  # σ(a) <= u <= σ(b)
+        a, b = lo.copy(), hi.copy()  # σ(a) <= u <= σ(b)
+        act = np.flatnonzero(np.abs(f) > tol)  # positions still iterating
         for _ in range(_INVERSION_STEPS):
-            if np.all(np.abs(f) <= tol):
+            if act.size == 0:
                 break
-            a, b = np.where(f < 0, tau, a), np.where(f < 0, b, tau)
-            speed = np.linalg.norm(self.curve(tau, 1), axis=-1)
+            fa, ta = f[act], tau[act]
+            a[act] = np.where(fa < 0, ta, a[act])
+            b[act] = np.where(fa < 0, b[act], ta)
+            speed = np.linalg.norm(self.curve(ta, 1), axis=-1)
             # Newton inside the bracket, bisection otherwise: converges however |r'| varies.
-            new = tau - f / np.maximum(speed, 1e-300)
-            new = np.where((new >= a) & (new <= b), new, 0.5 * (a + b))
-            if np.array_equal(new, tau):
-                break  # where |r'| is huge, a step below τ's rounding still moves σ by > tol
+            new = ta - fa / np.maximum(speed, 1e-300)
+            new = np.where((new >= a[act]) & (new <= b[act]), new, 0.5 * (a[act] + b[act]))
+            # Where |r'| is huge, a step below τ's rounding still moves σ by > tol: stop.
+            moved = new != ta
+            act, new, fa, ta = act[moved], new[moved], fa[moved], ta[moved]
             # σ(new) - u = f + ∫_τ^new |r'|: over a short step 4 points do what 16 do over
             # the cell from its start (half the time of the inversion on nurbs_edge.json).
-            near = np.abs(new - tau) <= _SHORT_STEP * (hi - lo)
-            f[near] += self._speed_integral(tau[near], new[near], (_SHORT_NODES, _SHORT_WEIGHTS))
+            near = np.abs(new - ta) <= _SHORT_STEP * (hi[act] - lo[act])
+            fa[near] += self._speed_integral(ta[near], new[near], (_SHORT_NODES, _SHORT_WEIGHTS))
             far = ~near
             if np.any(far):
-                f[far] = self._arc[j[far]] + self._speed_integral(lo[far], new[far]) - flat[far]
-            tau = new
+                k = act[far]
+                fa[far] = self._arc[j[k]] + self._speed_integral(lo[k], new[far]) - flat[k]
+            f[act], tau[act] = fa, new
+            act = act[np.abs(fa) > tol]
         out: FloatArray = tau
         return out
 
@@ -257,16 +451,23 @@ class CurvePiece(Piece):
         """``(point, heading, curvature)`` from one arc-length inversion."""
         shape = np.shape(u)
         flat, j = self._cell(u)
-        tau = self._parameter(flat, j)
-        r, d1, d2 = self.curve(tau, 0), self.curve(tau, 1), self.curve(tau, 2)
+        tau = self._interpolated(flat, j)
+        r, d1, d2 = self._derivatives(tau)
         raw = np.arctan2(d1[:, 1], d1[:, 0]) + (np.pi if self.direction < 0 else 0.0)
         # Nearest 2π-branch to the heading interpolated in the table cell.
         w = (flat - self._arc[j]) / np.maximum(self._arc[j + 1] - self._arc[j], 1e-300)
         ref = (1.0 - w) * self._theta[j] + w * self._theta[j + 1]
         theta = raw + 2.0 * np.pi * np.round((ref - raw) / (2.0 * np.pi))
-        cross = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
-        kappa = cross / np.linalg.norm(d1, axis=-1) ** 3
+        kappa = _signed_curvature(d1, d2)
         return r.reshape(*shape, 2), theta.reshape(shape), kappa.reshape(shape)
+
+    def _derivatives(self, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``r, r', r''`` at ``tau``: in one pass when the curve offers it (NURBS)."""
+        both = getattr(self.curve, "derivatives", None)
+        if both is not None:
+            out: tuple[FloatArray, FloatArray, FloatArray] = both(tau)
+            return out
+        return self.curve(tau, 0), self.curve(tau, 1), self.curve(tau, 2)
 
     def point(self, u: FloatArray) -> FloatArray:
         """Positions at local arc lengths ``u`` [m]."""
@@ -277,8 +478,19 @@ class CurvePiece(Piece):
         return self.evaluate(u)[1]
 
     def curvature(self, u: FloatArray) -> FloatArray:
-        """``(x'y'' - y'x'') / |r'|³`` [1/m]."""
-        return self.evaluate(u)[2]
+        """``(x'y'' - y'x'') / |r'|³`` [1/m] (without the headings of :meth:`evaluate`)."""
+        tau = self._interpolated(*self._cell(u))
+        _, d1, d2 = self._derivatives(tau)
+        return _signed_curvature(d1, d2).reshape(np.shape(u))
+
+    def curvature_rate(self, u: FloatArray) -> FloatArray:
+        """The central difference of :meth:`Piece.curvature_rate`, both sides in one query."""
+        u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
+        step = 1e-5 * self.length
+        lo, hi = np.maximum(u - step, 0.0), np.minimum(u + step, self.length)
+        kappa = self.curvature(np.concatenate((lo.ravel(), hi.ravel())))
+        out: FloatArray = ((kappa[lo.size:] - kappa[:lo.size]).reshape(u.shape) / (hi - lo))
+        return out
 
 
 @dataclass(frozen=True, eq=False)
