@@ -35,6 +35,16 @@ there: the law reproduces that motion exactly, acceleration starts at 0 and the 
 A last, local correction (piecewise quadratic over the final stretch, curvature
 ``O(offset / length²)``) makes the end value exact.
 
+**Without a jerk limit** nothing asks for a continuous acceleration, and the dual-cell
+smoothing would cost the speed bound: where the discrete ``w`` bends upwards (braking onto a
+bound step, at a corner) the dual-cell law rises above both adjacent nodes over the half cell
+after the kink, by up to an eighth of the neighbour's excess, so the node bounds (the
+minimum of ``mu+`` over the two adjacent cells, :func:`speedplan.model.build.node_bounds`)
+no longer keep it under the bound. The law is then ``w`` linear on each cell (``linear=True``,
+constant acceleration per cell as in the discrete problem): it passes through every node, lies
+on the chord, so under ``mu+`` wherever both ends are, and its time is the discrete problem's
+own, ``2 h / (v_k + v_{k+1})`` per cell.
+
 Everything is a chain of quadratic pieces in ``w`` or ``u``: speed, acceleration and jerk
 follow in closed form, their extremes over each piece too (:meth:`TimeLaw.extremes`, what
 :meth:`SpeedProfile.verify` checks), and ``t(s) = ∫ ds / v`` by Gauss–Legendre quadrature
@@ -50,6 +60,7 @@ from functools import cached_property
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
+from ..core.errors import InvalidInputError
 from ._law_numpy import backend
 
 __all__ = ["STANDSTILL_EXPONENT", "LawChain", "TimeLaw"]
@@ -77,7 +88,9 @@ class _Pieces:
 
 @dataclass(frozen=True, eq=False)
 class TimeLaw:
-    """C¹ speed law ``w(s)`` through the discrete solution and the exact time law it implies.
+    """Speed law ``w(s)`` through the discrete solution and the exact time law it implies.
+
+    C¹ (the dual-cell law of the module notes), or with ``linear`` piecewise linear.
 
     Parameters
     ----------
@@ -89,6 +102,10 @@ class TimeLaw:
         Jerk limit [m/s³] of a smooth standstill: ends at rest then follow the max-jerk start
         (stop) in ``u = w^{3/4}`` over the nodes that lie on it. ``None``: the paper's free
         standstill (the acceleration may jump at rest).
+    linear : bool
+        ``w`` linear on every cell through the nodes (no jerk limit: the acceleration is the
+        secant's, constant per cell, and jumps at nodes); needs ``accel_start``,
+        ``accel_end`` and ``j_max`` to be ``None``.
 
     Examples
     --------
@@ -103,6 +120,13 @@ class TimeLaw:
     ([1.3, 2.7], [0.5, 0.5], [0.0, 0.0])
     >>> bool(abs(law.duration - 2 * (np.sqrt(3.0) - 1.0)) < 1e-12)  # ∫ ds / sqrt(1 + s)
     True
+
+    Without a jerk limit: through the nodes, on the chords, the acceleration of each cell.
+
+    >>> lin = TimeLaw(s, np.minimum(2.0 * s, 1.0), linear=True)
+    >>> w, _, a, _ = lin.kinematics(np.array([0.45, 0.5, 0.55]))
+    >>> np.round(w, 12).tolist(), np.round(a, 12).tolist()
+    ([0.9, 1.0, 1.0], [1.0, 0.0, 0.0])
     """
 
     s: FloatArray
@@ -110,6 +134,14 @@ class TimeLaw:
     accel_start: float | None = None
     accel_end: float | None = None
     j_max: float | None = None
+    linear: bool = False
+
+    def __post_init__(self) -> None:
+        if self.linear and not (self.accel_start is None and self.accel_end is None
+                                and self.j_max is None):
+            raise InvalidInputError(
+                "a `linear` law keeps the secant slopes: `accel_start`, `accel_end` and "
+                "`j_max` must be None")
 
     # ---- construction -------------------------------------------------------------------
     @cached_property
@@ -160,6 +192,8 @@ class TimeLaw:
         3. A trailing ``u``-region reaches ``u = 0`` through a parabola added to it; a moving
            end takes its exact value through a window at the end.
         """
+        if self.linear:
+            return self._linear_pieces()
         s, n = self.s, self.s.size
         w = np.maximum(self.w, 0.0)
         h = np.diff(s)
@@ -241,6 +275,19 @@ class TimeLaw:
             y[m] = w[-1]
             y_r[mid_p0:], g_r[mid_p0:] = y[mid_p0 + 1:], g[mid_p0 + 1:]
         return _Pieces(x=x, y=y, g=g, c=c, is_u=is_u, y_right=y_r, g_right=g_r)
+
+    def _linear_pieces(self) -> _Pieces:
+        """``w`` linear on each cell: the chord, split at the cell's midpoint knot."""
+        s, n = self.s, self.s.size
+        w = np.maximum(self.w, 0.0)
+        x = np.empty(2 * n - 1)
+        x[0::2], x[1::2] = s, s[:-1] + 0.5 * np.diff(s)
+        y = np.empty(2 * n - 1)
+        y[0::2], y[1::2] = w, 0.5 * (w[:-1] + w[1:])
+        slope = np.repeat(np.diff(w) / np.diff(s), 2)  # the cell's secant on both halves
+        m = x.size - 1
+        return _Pieces(x=x, y=y, g=np.append(slope, slope[-1]), c=np.zeros(m),
+                       is_u=np.zeros(m, dtype=bool), y_right=y[1:].copy(), g_right=slope)
 
     def _end_slope(self, val: FloatArray, h: FloatArray, in_u: bool, *, start: bool) -> float:
         """Slope at an end: the prescribed acceleration at a moving end, else the secant."""
@@ -341,8 +388,13 @@ class TimeLaw:
     def knot_times(self) -> FloatArray:
         """Times at the knots [s] (from 0 at the start)."""
         x = self._pieces.x
-        j = np.arange(x.size - 1)
         p = self._pieces
+        if self.linear:  # ∫ ds / sqrt(w) with w linear: 2 Δx / (v_a + v_b), in closed form
+            v = np.sqrt(p.y)
+            with np.errstate(divide="ignore"):
+                seg = 2.0 * np.diff(x) / (v[:-1] + v[1:])
+            return np.concatenate(([0.0], np.cumsum(seg)))
+        j = np.arange(x.size - 1)
         right = (p.y_right <= 0.0) & (p.y[:-1] > 0.0)
         seg = self._integral(j, np.zeros(j.size), np.diff(x), right)
         return np.concatenate(([0.0], np.cumsum(seg)))
