@@ -314,8 +314,15 @@ class TimeLaw:
 
         The three broadcast together. Each piece is evaluated from the nearer knot: accurate
         relative to its own size next to a standstill, where ``y`` tends to 0. Compiled
-        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
+        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded); a ``linear`` law
+        is two lines of numpy.
         """
+        if self.linear:
+            p = self._pieces
+            g = p.g[j]  # one slope per piece (the same at both knots)
+            w = np.maximum(np.where(dx > dr, p.y_right[j] - g * dr, p.y[j] + g * dx), 0.0)
+            shape = w.shape
+            return w, np.sqrt(w), np.broadcast_to(0.5 * g, shape), np.zeros(shape)
         out: tuple[FloatArray, FloatArray, FloatArray, FloatArray] = backend().kinematics(
             self._pieces, j, dx, dr)
         return out
@@ -341,6 +348,12 @@ class TimeLaw:
         a polynomial in the piece's offset, vanishes.
         """
         p = self._pieces
+        if self.linear:  # extremes at the knots; constant acceleration, no jerk
+            a = 0.5 * p.g[:-1]
+            w_max, w_min = np.maximum(p.y[:-1], p.y_right), np.minimum(p.y[:-1], p.y_right)
+            at = np.where(p.y_right > p.y[:-1], p.x[1:], p.x[:-1])
+            zero = np.zeros_like(a)
+            return {"w": (at, w_max, w_min), "a": (p.x[:-1], a, a), "jerk": (p.x[:-1], zero, zero)}
         width = np.diff(p.x)
         cands = [np.zeros_like(width), width]
         with np.errstate(divide="ignore", invalid="ignore"):
