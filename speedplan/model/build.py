@@ -553,13 +553,17 @@ def node_bounds(bound: Any, s: FloatArray, per_interval: int = 8) -> FloatArray:
     cell, so under the bound; the jerk-limited law bends away from the chords only by its
     curvature, ``O(j h²)`` (:mod:`speedplan.timing.law`).
     """
-    frac = np.linspace(0.0, 1.0, per_interval + 1)
-    sub = s[:-1, None] + np.diff(s)[:, None] * frac[None, :]
-    interval_min = bound(sub.ravel()).reshape(sub.shape).min(axis=1)
-    w = bound(s)
+    frac = np.arange(per_interval) / per_interval
+    # Every node once (the start of its interval, and the end of the grid), then the points
+    # inside each interval: one call to the bound.
+    sub = np.append((s[:-1, None] + np.diff(s)[:, None] * frac[None, :]).ravel(), s[-1])
+    sub[::per_interval] = s
+    val = np.asarray(bound(sub), dtype=np.float64)
+    w = val[::per_interval].copy()
+    interval_min = np.minimum(val[:-1].reshape(-1, per_interval).min(axis=1), w[1:])
     w[:-1] = np.minimum(w[:-1], interval_min)
     w[1:] = np.minimum(w[1:], interval_min)
-    return np.asarray(w, dtype=np.float64)
+    return w
 
 
 def _explain(exc: InfeasibleError, leg: Leg) -> InfeasibleError:
