@@ -141,3 +141,35 @@ def test_a_linear_law_is_the_chord_through_the_nodes():
     assert np.allclose(law.time_at(law.position_at(t)), t, rtol=0, atol=1e-12)
     with pytest.raises(sp.InvalidInputError, match="linear"):
         TimeLaw(s, w, accel_start=0.0, linear=True)
+
+
+def test_the_linear_law_in_time_is_constant_acceleration_per_cell():
+    # Rest to rest through a slow stretch: both standstill ends, accelerating and braking cells.
+    s = np.linspace(0.0, 12.0, 61)
+    mu = np.where(np.abs(s - 6.0) < 1.0, 0.5, 4.0)
+    mu[0] = mu[-1] = 0.0
+    w = (mu[None, :] + 2.0 * np.abs(s[:, None] - s[None, :])).min(axis=1)  # |a| <= 1
+    law = TimeLaw(s, w, linear=True)
+    t = np.linspace(0.0, law.duration, 4001)
+    q, ww, v, a, _ = law.state_at(t)
+    # The time law against the closed form of each cell: s(t) from the node times.
+    T = law.node_times
+    k = np.clip(np.searchsorted(T, t, side="right") - 1, 0, s.size - 2)
+    tau = t - T[k]
+    acc = (w[k + 1] - w[k]) / (2.0 * np.diff(s)[k])
+    expected = s[k] + np.sqrt(w[k]) * tau + 0.5 * acc * tau**2
+    assert np.allclose(q, expected, rtol=0, atol=1e-12)
+    assert np.allclose(ww, np.interp(q, s, w), rtol=0, atol=1e-12)
+    assert np.allclose(v, np.sqrt(w[k]) + acc * tau, rtol=0, atol=1e-9)
+    inside = (tau > 1e-9) & (T[k + 1] - t > 1e-9)
+    assert np.allclose(a[inside], acc[inside], rtol=0, atol=1e-12)
+    # Finite differences of the sampled states: the trapezoid rule is off by at most
+    # |Δa| dt / 8 where the acceleration jumps (|Δa| <= 2), the speed changes by <= a dt.
+    dt = t[1] - t[0]
+    assert np.abs(np.diff(q) / dt - 0.5 * (v[1:] + v[:-1])).max() <= 2.0 * dt / 8 + 1e-9
+    assert np.abs(np.diff(v) / dt).max() <= 1.0 + 1e-9
+    assert law.position_at(np.array([law.duration]))[0] == 12.0
+    # Next to the final stop the offset from it keeps its relative precision.
+    eps = 1e-9
+    _, dr = law._invert(np.array([law.duration - eps]))[1:]
+    assert dr[0] == pytest.approx(0.5 * eps**2, rel=1e-9)  # a = -1: dr = a τ² / 2

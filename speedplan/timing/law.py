@@ -43,7 +43,9 @@ minimum of ``mu+`` over the two adjacent cells, :func:`speedplan.model.build.nod
 no longer keep it under the bound. The law is then ``w`` linear on each cell (``linear=True``,
 constant acceleration per cell as in the discrete problem): it passes through every node, lies
 on the chord, so under ``mu+`` wherever both ends are, and its time is the discrete problem's
-own, ``2 h / (v_k + v_{k+1})`` per cell.
+own, ``2 h / (v_k + v_{k+1})`` per cell. Its time law is closed form (``σ = v τ + a τ²/2``
+on each piece): no quadrature and no compiled kernel, so a process that plans only without
+jerk limit never loads numba (loading the cached kernel costs ~1 s in a fresh process).
 
 Everything is a chain of quadratic pieces in ``w`` or ``u``: speed, acceleration and jerk
 follow in closed form, their extremes over each piece too (:meth:`TimeLaw.extremes`, what
@@ -394,6 +396,16 @@ class TimeLaw:
         (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
         """
         right = np.zeros(j.shape, dtype=bool) if from_right is None else from_right
+        if self.linear:  # w linear: 2 (hi - lo) / (v(lo) + v(hi)), from the anchoring knot
+            p = self._pieces
+            y0 = np.where(right, p.y_right[j], p.y[j])
+            slope = np.where(right, -p.g[j], p.g[j])
+            v_lo = np.sqrt(np.maximum(y0 + slope * lo, 0.0))
+            v_hi = np.sqrt(np.maximum(y0 + slope * hi, 0.0))
+            span = hi - lo
+            with np.errstate(divide="ignore", invalid="ignore"):
+                closed: FloatArray = np.where(span > 0, 2.0 * span / (v_lo + v_hi), 0.0)
+            return closed
         out: FloatArray = backend().integrals(self._pieces, j, lo, hi, right)
         return out
 
@@ -454,7 +466,10 @@ class TimeLaw:
         T = self.knot_times
         t = np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration)
         j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, p.c.size - 1)
-        dx, dr = backend().invert(p, T, j, t)
+        if self.linear:
+            dx, dr = _invert_linear(p, T, j, t)
+        else:
+            dx, dr = backend().invert(p, T, j, t)
         return j, dx, dr
 
     def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
@@ -469,6 +484,24 @@ class TimeLaw:
     def position_at(self, t: FloatArray) -> FloatArray:
         """Arc length ``s(t)`` at times ``t`` [m] (see :meth:`state_at`)."""
         return self.state_at(t)[0]
+
+
+def _invert_linear(p: _Pieces, T: FloatArray, j: IntArray, t: FloatArray
+                   ) -> tuple[FloatArray, FloatArray]:
+    """Offsets ``(dx, dr)`` reached at times ``t`` on linear pieces: constant acceleration.
+
+    ``σ = v τ + a τ²/2`` with ``a = w'/2`` from the piece's left knot, or from its right knot
+    when the piece ends at rest (the offset from the stop keeps full relative precision).
+    ``v + a τ / 2 >= v / 2`` along the piece: no cancellation.
+    """
+    width = p.x[j + 1] - p.x[j]
+    rest_right = (p.y_right[j] <= 0.0) & (p.y[j] > 0.0)
+    tau = np.where(rest_right, T[j + 1] - t, t - T[j])
+    v0 = np.sqrt(np.where(rest_right, p.y_right[j], p.y[j]))
+    half_a = np.where(rest_right, -p.g[j], p.g[j]) / 4.0  # a / 2, a = ±w' / 2
+    off = np.clip(tau * (v0 + half_a * tau), 0.0, width)
+    off = np.where(tau >= T[j + 1] - T[j], width, np.where(tau <= 0.0, 0.0, off))
+    return np.where(rest_right, width - off, off), np.where(rest_right, off, width - off)
 
 
 def _fill_region(x: FloatArray, h: FloatArray, val: FloatArray, k0: int, k1: int, n: int,
