@@ -236,7 +236,7 @@ def check_law(law: TimeLaw, offset: float, path: Path,
         rate = curvature_rate(path, spot_glob)[sample_spot]
         lat_jerk = np.abs(v * (rate * w + 2.0 * kappa * a))
     else:
-        lat_jerk = np.zeros_like(w)
+        lat_jerk = np.zeros(1)  # no limit: nothing to evaluate, reported as 0
     per_sample = {"speed": (speed, v, 1.0), "lateral": (lateral, lateral, limits.a_lat_max),
                   "yaw_rate": (yaw, yaw, limits.yaw_rate_max),
                   "lateral_jerk": (lat_jerk, lat_jerk, limits.j_lat_max)}
@@ -245,9 +245,12 @@ def check_law(law: TimeLaw, offset: float, path: Path,
     where: dict[str, float] = {}
     excess = np.zeros(width.size, dtype=bool)
     for name, (load, value, limit) in per_sample.items():
+        if not np.isfinite(limit):  # no limit: the maximum is reported, the ratio is 0
+            maxima[name] = float(np.max(value))
+            ratios[name], where[name] = 0.0, float(glob[0])
+            continue
         ratio_s = load / limit if name != "speed" else load
-        ratio_s = np.where(np.isfinite(ratio_s), ratio_s, np.inf) if np.isfinite(limit) else (
-            np.zeros_like(load))
+        ratio_s = np.where(np.isfinite(ratio_s), ratio_s, np.inf)
         k = int(np.argmax(ratio_s))
         maxima[name] = float(np.max(value))
         ratios[name] = float(ratio_s[k])
