@@ -130,3 +130,31 @@ def within_promise(m: Measured) -> bool:
     return (m.speed <= 1 + PROMISED["speed"] and m.accel <= 1 + PROMISED["accel"]
             and m.decel <= 1 + PROMISED["accel"] and m.jerk <= 1 + PROMISED["jerk"]
             and m.lateral <= 1 + PROMISED["lateral"])
+
+
+def no_jerk_lower_bound(bound, length, a_max, a_decel, v0=0.0, vf=0.0, samples=400_001):
+    """A lower bound on the exact minimum time without a jerk limit [s], and its ``w``.
+
+    The continuous problem: ``w(s) <= bound(s)``, ``-2 a_decel <= w' <= 2 a_max``,
+    ``w(0) = v0²``, ``w(L) = vf²``. Its fastest law is the largest feasible ``w``, the
+    inf-convolution ``min_x [bound(x) + 2 a_max (s - x)⁺ + 2 a_decel (x - s)⁺]``; taken over
+    ``samples`` points only it is larger (a dip between them is missed), and between two
+    samples it lies under both slope-limited lines from their values: integrating ``1 / v``
+    under that tent, in closed form, gives a time that no feasible law beats.
+    """
+    s = np.linspace(0.0, length, samples)
+    mu = np.asarray(bound(s), dtype=np.float64).copy()
+    mu[0], mu[-1] = min(mu[0], v0 * v0), min(mu[-1], vf * vf)
+    A, D = 2.0 * a_max, 2.0 * a_decel
+    forward = A * s + np.minimum.accumulate(mu - A * s)
+    backward = -D * s + np.minimum.accumulate((mu + D * s)[::-1])[::-1]
+    w = np.maximum(np.minimum(forward, backward), 0.0)
+    h = np.diff(s)
+    wa, wb = w[:-1], w[1:]
+    tc = np.clip((wb - wa + D * h) / (A + D), 0.0, h)  # where the two lines cross
+    up = np.sqrt(wa + A * tc)
+    down = np.sqrt(wb + D * (h - tc))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        first = np.where(tc > 0, 2.0 * tc / (up + np.sqrt(wa)), 0.0)
+        second = np.where(h - tc > 0, 2.0 * (h - tc) / (down + np.sqrt(wb)), 0.0)
+    return float(np.sum(first + second)), s, w

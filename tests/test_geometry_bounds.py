@@ -87,6 +87,32 @@ def test_zone_intervals_start_inside_several_crossings_and_sorting():
     assert zone_intervals(p, [SpeedZone(shapely.box(0, 5, 1, 6), 0.1)]) == []
 
 
+def test_zone_intervals_are_remembered_per_path_and_zones_and_stay_exact():
+    from speedplan.geometry import bounds
+
+    p = Path.from_segments([Line(30.0)])
+    slow = SpeedZone(shapely.box(20, -1, 25, 1), 0.2)
+    other = SpeedZone(shapely.box(3, -1, 6, 1), 0.3)
+    first = zone_intervals(p, [slow])
+    assert bounds._zone_intervals(p, [slow], 1e-9) == first  # computed, not only remembered
+    first.append((0.0, 1.0, 9.0))  # the caller's list: the remembered answer is unchanged
+    assert zone_intervals(p, [slow]) == first[:1]
+    # Other zones, another tolerance, another path: their own answers.
+    assert [v for _, _, v in zone_intervals(p, [other])] == [0.3]
+    assert zone_intervals(p, [other, slow]) == sorted(zone_intervals(p, [other])
+                                                      + zone_intervals(p, [slow]))
+    coarse = zone_intervals(p, [slow], tol=1e-3)
+    assert abs(coarse[0][0] - 20.0) < 1e-3
+    q = Path.from_segments([Line(22.0)])
+    assert zone_intervals(q, [slow])[0][1] == 22.0
+    # Many zone sets on one path: a bounded memory, every answer still right.
+    for k in range(3 * bounds._ZONE_CACHE_SIZE):
+        z = SpeedZone(shapely.box(k, -1, k + 0.5, 1), 0.1)
+        (a, b, _), = zone_intervals(p, [z])
+        assert abs(a - k) < 1e-8 and abs(b - k - 0.5) < 1e-8
+    assert len(bounds._ZONE_CACHE[p]) <= bounds._ZONE_CACHE_SIZE
+
+
 def test_speed_zone_validation():
     with pytest.raises(InvalidInputError, match="`polygon`"):
         SpeedZone([(0, 0), (1, 0)], 1.0)

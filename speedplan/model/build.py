@@ -51,11 +51,15 @@ class TimeLawSpec:
         exactly at ends at rest); ``None`` for the free standstill or no jerk limit.
     accel_start, accel_end : float or None
         Prescribed accelerations at moving ends [m/s²]; ``None`` keeps the discrete slope.
+    linear : bool
+        ``w`` linear on each cell (no jerk nor lateral-jerk limit): the law stays on the
+        chords, which the node bounds keep under the speed bound (:func:`node_bounds`).
     """
 
     j_max: float | None
     accel_start: float | None
     accel_end: float | None
+    linear: bool = False
 
 
 @dataclass(frozen=True)
@@ -355,6 +359,8 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
         j_max=lim.j_max if request.smooth_standstill else None,
         accel_start=a0 if v0 > 0 and request.jerk_limited else None,
         accel_end=af if vf > 0 and request.jerk_limited else None,
+        # Without jerk (and lateral-jerk) rows nothing bounds the law's bend: on the chords.
+        linear=not (request.jerk_limited or np.isfinite(lim.j_lat_max)),
     )
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
@@ -576,15 +582,22 @@ def node_bounds(bound: Any, s: FloatArray, per_interval: int = 8) -> FloatArray:
 
     The discrete problem sees the bound only at nodes; taking the minimum over the neighbouring
     intervals keeps the interpolated speed under a bound that drops between nodes (a zone
-    entry, a curvature peak) at an ``O(h)`` cost where the bound is smooth.
+    entry, a curvature peak) at an ``O(h)`` cost where the bound is smooth. Interpolated
+    linearly (the law without a jerk limit) ``w`` stays under the larger node value of each
+    cell, so under the bound; the jerk-limited law bends away from the chords only by its
+    curvature, ``O(j h²)`` (:mod:`speedplan.timing.law`).
     """
-    frac = np.linspace(0.0, 1.0, per_interval + 1)
-    sub = s[:-1, None] + np.diff(s)[:, None] * frac[None, :]
-    interval_min = bound(sub.ravel()).reshape(sub.shape).min(axis=1)
-    w = bound(s)
+    frac = np.arange(per_interval) / per_interval
+    # Every node once (the start of its interval, and the end of the grid), then the points
+    # inside each interval: one call to the bound.
+    sub = np.append((s[:-1, None] + np.diff(s)[:, None] * frac[None, :]).ravel(), s[-1])
+    sub[::per_interval] = s
+    val = np.asarray(bound(sub), dtype=np.float64)
+    w = val[::per_interval].copy()
+    interval_min = np.minimum(val[:-1].reshape(-1, per_interval).min(axis=1), w[1:])
     w[:-1] = np.minimum(w[:-1], interval_min)
     w[1:] = np.minimum(w[1:], interval_min)
-    return np.asarray(w, dtype=np.float64)
+    return w
 
 
 def _explain(exc: InfeasibleError, leg: Leg) -> InfeasibleError:

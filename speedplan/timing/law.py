@@ -35,6 +35,18 @@ there: the law reproduces that motion exactly, acceleration starts at 0 and the 
 A last, local correction (piecewise quadratic over the final stretch, curvature
 ``O(offset / length²)``) makes the end value exact.
 
+**Without a jerk limit** nothing asks for a continuous acceleration, and the dual-cell
+smoothing would cost the speed bound: where the discrete ``w`` bends upwards (braking onto a
+bound step, at a corner) the dual-cell law rises above both adjacent nodes over the half cell
+after the kink, by up to an eighth of the neighbour's excess, so the node bounds (the
+minimum of ``mu+`` over the two adjacent cells, :func:`speedplan.model.build.node_bounds`)
+no longer keep it under the bound. The law is then ``w`` linear on each cell (``linear=True``,
+constant acceleration per cell as in the discrete problem): it passes through every node, lies
+on the chord, so under ``mu+`` wherever both ends are, and its time is the discrete problem's
+own, ``2 h / (v_k + v_{k+1})`` per cell. Its time law is closed form (``σ = v τ + a τ²/2``
+on each piece): no quadrature and no compiled kernel, so a process that plans only without
+jerk limit never loads numba (loading the cached kernel costs ~1 s in a fresh process).
+
 Everything is a chain of quadratic pieces in ``w`` or ``u``: speed, acceleration and jerk
 follow in closed form, their extremes over each piece too (:meth:`TimeLaw.extremes`, what
 :meth:`SpeedProfile.verify` checks), and ``t(s) = ∫ ds / v`` by Gauss–Legendre quadrature
@@ -50,6 +62,7 @@ from functools import cached_property
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
+from ..core.errors import InvalidInputError
 from ._law_numpy import backend
 
 __all__ = ["STANDSTILL_EXPONENT", "LawChain", "TimeLaw"]
@@ -77,7 +90,9 @@ class _Pieces:
 
 @dataclass(frozen=True, eq=False)
 class TimeLaw:
-    """C¹ speed law ``w(s)`` through the discrete solution and the exact time law it implies.
+    """Speed law ``w(s)`` through the discrete solution and the exact time law it implies.
+
+    C¹ (the dual-cell law of the module notes), or with ``linear`` piecewise linear.
 
     Parameters
     ----------
@@ -89,6 +104,10 @@ class TimeLaw:
         Jerk limit [m/s³] of a smooth standstill: ends at rest then follow the max-jerk start
         (stop) in ``u = w^{3/4}`` over the nodes that lie on it. ``None``: the paper's free
         standstill (the acceleration may jump at rest).
+    linear : bool
+        ``w`` linear on every cell through the nodes (no jerk limit: the acceleration is the
+        secant's, constant per cell, and jumps at nodes); needs ``accel_start``,
+        ``accel_end`` and ``j_max`` to be ``None``.
 
     Examples
     --------
@@ -103,6 +122,13 @@ class TimeLaw:
     ([1.3, 2.7], [0.5, 0.5], [0.0, 0.0])
     >>> bool(abs(law.duration - 2 * (np.sqrt(3.0) - 1.0)) < 1e-12)  # ∫ ds / sqrt(1 + s)
     True
+
+    Without a jerk limit: through the nodes, on the chords, the acceleration of each cell.
+
+    >>> lin = TimeLaw(s, np.minimum(2.0 * s, 1.0), linear=True)
+    >>> w, _, a, _ = lin.kinematics(np.array([0.45, 0.5, 0.55]))
+    >>> np.round(w, 12).tolist(), np.round(a, 12).tolist()
+    ([0.9, 1.0, 1.0], [1.0, 0.0, 0.0])
     """
 
     s: FloatArray
@@ -110,6 +136,14 @@ class TimeLaw:
     accel_start: float | None = None
     accel_end: float | None = None
     j_max: float | None = None
+    linear: bool = False
+
+    def __post_init__(self) -> None:
+        if self.linear and not (self.accel_start is None and self.accel_end is None
+                                and self.j_max is None):
+            raise InvalidInputError(
+                "a `linear` law keeps the secant slopes: `accel_start`, `accel_end` and "
+                "`j_max` must be None")
 
     # ---- construction -------------------------------------------------------------------
     @cached_property
@@ -160,6 +194,8 @@ class TimeLaw:
         3. A trailing ``u``-region reaches ``u = 0`` through a parabola added to it; a moving
            end takes its exact value through a window at the end.
         """
+        if self.linear:
+            return self._linear_pieces()
         s, n = self.s, self.s.size
         w = np.maximum(self.w, 0.0)
         h = np.diff(s)
@@ -242,6 +278,19 @@ class TimeLaw:
             y_r[mid_p0:], g_r[mid_p0:] = y[mid_p0 + 1:], g[mid_p0 + 1:]
         return _Pieces(x=x, y=y, g=g, c=c, is_u=is_u, y_right=y_r, g_right=g_r)
 
+    def _linear_pieces(self) -> _Pieces:
+        """``w`` linear on each cell: the chord, split at the cell's midpoint knot."""
+        s, n = self.s, self.s.size
+        w = np.maximum(self.w, 0.0)
+        x = np.empty(2 * n - 1)
+        x[0::2], x[1::2] = s, s[:-1] + 0.5 * np.diff(s)
+        y = np.empty(2 * n - 1)
+        y[0::2], y[1::2] = w, 0.5 * (w[:-1] + w[1:])
+        slope = np.repeat(np.diff(w) / np.diff(s), 2)  # the cell's secant on both halves
+        m = x.size - 1
+        return _Pieces(x=x, y=y, g=np.append(slope, slope[-1]), c=np.zeros(m),
+                       is_u=np.zeros(m, dtype=bool), y_right=y[1:].copy(), g_right=slope)
+
     def _end_slope(self, val: FloatArray, h: FloatArray, in_u: bool, *, start: bool) -> float:
         """Slope at an end: the prescribed acceleration at a moving end, else the secant."""
         accel = self.accel_start if start else self.accel_end
@@ -267,8 +316,15 @@ class TimeLaw:
 
         The three broadcast together. Each piece is evaluated from the nearer knot: accurate
         relative to its own size next to a standstill, where ``y`` tends to 0. Compiled
-        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
+        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded); a ``linear`` law
+        is two lines of numpy.
         """
+        if self.linear:
+            p = self._pieces
+            g = p.g[j]  # one slope per piece (the same at both knots)
+            w = np.maximum(np.where(dx > dr, p.y_right[j] - g * dr, p.y[j] + g * dx), 0.0)
+            shape = w.shape
+            return w, np.sqrt(w), np.broadcast_to(0.5 * g, shape), np.zeros(shape)
         out: tuple[FloatArray, FloatArray, FloatArray, FloatArray] = backend().kinematics(
             self._pieces, j, dx, dr)
         return out
@@ -294,6 +350,12 @@ class TimeLaw:
         a polynomial in the piece's offset, vanishes.
         """
         p = self._pieces
+        if self.linear:  # extremes at the knots; constant acceleration, no jerk
+            a = 0.5 * p.g[:-1]
+            w_max, w_min = np.maximum(p.y[:-1], p.y_right), np.minimum(p.y[:-1], p.y_right)
+            at = np.where(p.y_right > p.y[:-1], p.x[1:], p.x[:-1])
+            zero = np.zeros_like(a)
+            return {"w": (at, w_max, w_min), "a": (p.x[:-1], a, a), "jerk": (p.x[:-1], zero, zero)}
         width = np.diff(p.x)
         cands = [np.zeros_like(width), width]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -334,6 +396,16 @@ class TimeLaw:
         (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
         """
         right = np.zeros(j.shape, dtype=bool) if from_right is None else from_right
+        if self.linear:  # w linear: 2 (hi - lo) / (v(lo) + v(hi)), from the anchoring knot
+            p = self._pieces
+            y0 = np.where(right, p.y_right[j], p.y[j])
+            slope = np.where(right, -p.g[j], p.g[j])
+            v_lo = np.sqrt(np.maximum(y0 + slope * lo, 0.0))
+            v_hi = np.sqrt(np.maximum(y0 + slope * hi, 0.0))
+            span = hi - lo
+            with np.errstate(divide="ignore", invalid="ignore"):
+                closed: FloatArray = np.where(span > 0, 2.0 * span / (v_lo + v_hi), 0.0)
+            return closed
         out: FloatArray = backend().integrals(self._pieces, j, lo, hi, right)
         return out
 
@@ -341,8 +413,13 @@ class TimeLaw:
     def knot_times(self) -> FloatArray:
         """Times at the knots [s] (from 0 at the start)."""
         x = self._pieces.x
-        j = np.arange(x.size - 1)
         p = self._pieces
+        if self.linear:  # ∫ ds / sqrt(w) with w linear: 2 Δx / (v_a + v_b), in closed form
+            v = np.sqrt(p.y)
+            with np.errstate(divide="ignore"):
+                seg = 2.0 * np.diff(x) / (v[:-1] + v[1:])
+            return np.concatenate(([0.0], np.cumsum(seg)))
+        j = np.arange(x.size - 1)
         right = (p.y_right <= 0.0) & (p.y[:-1] > 0.0)
         seg = self._integral(j, np.zeros(j.size), np.diff(x), right)
         return np.concatenate(([0.0], np.cumsum(seg)))
@@ -389,7 +466,10 @@ class TimeLaw:
         T = self.knot_times
         t = np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration)
         j = np.clip(np.searchsorted(T, t, side="right") - 1, 0, p.c.size - 1)
-        dx, dr = backend().invert(p, T, j, t)
+        if self.linear:
+            dx, dr = _invert_linear(p, T, j, t)
+        else:
+            dx, dr = backend().invert(p, T, j, t)
         return j, dx, dr
 
     def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
@@ -404,6 +484,24 @@ class TimeLaw:
     def position_at(self, t: FloatArray) -> FloatArray:
         """Arc length ``s(t)`` at times ``t`` [m] (see :meth:`state_at`)."""
         return self.state_at(t)[0]
+
+
+def _invert_linear(p: _Pieces, T: FloatArray, j: IntArray, t: FloatArray
+                   ) -> tuple[FloatArray, FloatArray]:
+    """Offsets ``(dx, dr)`` reached at times ``t`` on linear pieces: constant acceleration.
+
+    ``σ = v τ + a τ²/2`` with ``a = w'/2`` from the piece's left knot, or from its right knot
+    when the piece ends at rest (the offset from the stop keeps full relative precision).
+    ``v + a τ / 2 >= v / 2`` along the piece: no cancellation.
+    """
+    width = p.x[j + 1] - p.x[j]
+    rest_right = (p.y_right[j] <= 0.0) & (p.y[j] > 0.0)
+    tau = np.where(rest_right, T[j + 1] - t, t - T[j])
+    v0 = np.sqrt(np.where(rest_right, p.y_right[j], p.y[j]))
+    half_a = np.where(rest_right, -p.g[j], p.g[j]) / 4.0  # a / 2, a = ±w' / 2
+    off = np.clip(tau * (v0 + half_a * tau), 0.0, width)
+    off = np.where(tau >= T[j + 1] - T[j], width, np.where(tau <= 0.0, 0.0, off))
+    return np.where(rest_right, width - off, off), np.where(rest_right, off, width - off)
 
 
 def _fill_region(x: FloatArray, h: FloatArray, val: FloatArray, k0: int, k1: int, n: int,

@@ -187,33 +187,58 @@ def check_law(law: TimeLaw, offset: float, path: Path,
     ex = law.extremes()
     knots = law.knots
     width = np.diff(knots)
+    m = width.size
     frac = np.linspace(0.0, 1.0, SAMPLES_PER_PIECE)
-    q = knots[:-1, None] + width[:, None] * frac[None, :]
-    q = np.concatenate((q, ex["w"][0][:, None]), axis=1)  # + the piece's speed maximum
-    shape = q.shape
+    top = ex["w"][0]  # each piece's speed maximum, the sixth sample of the piece
     if breaks is None:
         breaks = bound_breakpoints(path, bound)
-    local = breaks[(breaks >= offset) & (breaks <= offset + law.length)] - offset
+    local = np.clip(breaks[(breaks >= offset) & (breaks <= offset + law.length)] - offset,
+                    0.0, law.length)
     # Each breakpoint counts for the piece(s) it lies in (both, on a knot).
     at = np.searchsorted(knots, local, side="right") - 1
     left = np.searchsorted(knots, local, side="left") - 1
-    extra_piece = np.clip(np.concatenate((at, left)), 0, width.size - 1)
-    q = np.clip(np.concatenate((q.ravel(), local)), 0.0, law.length)
-    glob = offset + q
-    w, v, a, _ = law.kinematics(q)
-    kappa = np.asarray(path.curvature(glob), dtype=np.float64)
+    extra_piece = np.clip(np.concatenate((at, left)), 0, m - 1)
+    # The law on each piece at its own offsets (both sides of a knot: the acceleration may
+    # jump there); the path once per distinct position: neighbouring pieces share a knot,
+    # and a maximum at a knot is that knot.
+    dx = np.concatenate((width[:, None] * frac[None, :], (top - knots[:-1])[:, None]), axis=1)
+    piece = np.arange(m)[:, None]
+    w_p, v_p, a_p, _ = law._kinematics(piece, dx, width[:, None] - dx)
+    w_b, v_b, a_b, _ = law.kinematics(local)
+    w = np.concatenate((w_p.ravel(), w_b))
+    v = np.concatenate((v_p.ravel(), v_b))
+    a = np.concatenate((a_p.ravel(), a_b))
+    inner = knots[:-1, None] + width[:, None] * frac[None, 1:-1]
+    own = (top != knots[:-1]) & (top != knots[1:])
+    n_inner = inner.size
+    where_at = np.empty((m, SAMPLES_PER_PIECE + 1), dtype=np.intp)  # index into `spots`
+    where_at[:, 0] = np.arange(m)
+    where_at[:, SAMPLES_PER_PIECE - 1] = np.arange(1, m + 1)
+    where_at[:, 1:-2] = m + 1 + np.arange(n_inner).reshape(inner.shape)
+    at_top = np.where(top == knots[1:], np.arange(1, m + 1), np.arange(m))
+    where_at[:, -1] = np.where(own, m + 1 + n_inner + np.cumsum(own) - 1, at_top)
+    spots = np.concatenate((knots, inner.ravel(), top[own], local))
+    sample_spot = np.concatenate((where_at.ravel(), spots.size - local.size
+                                  + np.arange(local.size)))
+    shape = where_at.shape
+    spot_glob = offset + spots
+    kappa_spot = np.asarray(path.curvature(spot_glob), dtype=np.float64)
     if isinstance(bound, SpeedBound) and bound.path is path:  # reuse the curvature
-        wb = bound.given_curvature(glob, kappa)
+        wb_spot = bound.given_curvature(spot_glob, kappa_spot)
     else:
-        wb = np.asarray(bound(glob), dtype=np.float64)
+        wb_spot = np.asarray(bound(spot_glob), dtype=np.float64)
+    glob = spot_glob[sample_spot]
+    kappa = kappa_spot[sample_spot]
+    wb = wb_spot[sample_spot]
     with np.errstate(divide="ignore", invalid="ignore"):
         speed = np.where(wb > 0, v / np.sqrt(wb), np.where(v > 0, np.inf, 0.0))
     lateral = np.abs(kappa) * w
     yaw = np.abs(kappa) * v
     if np.isfinite(limits.j_lat_max):
-        lat_jerk = np.abs(v * (curvature_rate(path, glob) * w + 2.0 * kappa * a))
+        rate = curvature_rate(path, spot_glob)[sample_spot]
+        lat_jerk = np.abs(v * (rate * w + 2.0 * kappa * a))
     else:
-        lat_jerk = np.zeros_like(w)
+        lat_jerk = np.zeros(1)  # no limit: nothing to evaluate, reported as 0
     per_sample = {"speed": (speed, v, 1.0), "lateral": (lateral, lateral, limits.a_lat_max),
                   "yaw_rate": (yaw, yaw, limits.yaw_rate_max),
                   "lateral_jerk": (lat_jerk, lat_jerk, limits.j_lat_max)}
@@ -222,9 +247,12 @@ def check_law(law: TimeLaw, offset: float, path: Path,
     where: dict[str, float] = {}
     excess = np.zeros(width.size, dtype=bool)
     for name, (load, value, limit) in per_sample.items():
+        if not np.isfinite(limit):  # no limit: the maximum is reported, the ratio is 0
+            maxima[name] = float(np.max(value))
+            ratios[name], where[name] = 0.0, float(glob[0])
+            continue
         ratio_s = load / limit if name != "speed" else load
-        ratio_s = np.where(np.isfinite(ratio_s), ratio_s, np.inf) if np.isfinite(limit) else (
-            np.zeros_like(load))
+        ratio_s = np.where(np.isfinite(ratio_s), ratio_s, np.inf)
         k = int(np.argmax(ratio_s))
         maxima[name] = float(np.max(value))
         ratios[name] = float(ratio_s[k])
