@@ -97,13 +97,14 @@ def test_no_jerk_plans_are_under_the_bound_and_never_beat_the_exact_optimum(path
     assert dense_ratio(prof) <= 1.0 + 1e-12
     planned = sp.plan(path, lim, **kw)
     assert planned.verify().ok
-    assert sum(leg.s.size for leg in planned.legs) == 1001  # no refinement round
     # Durations: a feasible law cannot beat the exact continuous optimum; the uniform grid
-    # costs O(h) where the bound steps (the last node before a step takes the low side).
+    # costs O(h) where the bound falls steeply (a node takes the minimum over both adjacent
+    # cells): 3.9 % on the serpentine, so the default grid is refined once where the optimum
+    # rides such a node bound (model.build._no_jerk_grid): 1.0 % there.
     bound = planned.speed_bound
     t_exact, _, _ = no_jerk_lower_bound(bound, path.length, lim.a_max, lim.a_decel)
     assert t_exact <= planned.duration
-    assert planned.duration <= 1.05 * t_exact
+    assert planned.duration <= 1.02 * t_exact
 
 
 def test_the_linear_law_on_a_straight_matches_the_closed_form():

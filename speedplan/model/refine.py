@@ -14,7 +14,8 @@ PAD_CELLS = 4
 
 
 def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
-                 anchors: FloatArray | None = None, factor: float = 0.5) -> FloatArray:
+                 anchors: FloatArray | None = None, factor: float = 0.5,
+                 grading: float = GRADING) -> FloatArray:
     """The grid ``s`` with its steps times ``factor`` around the pieces flagged in ``excess``.
 
     ``knots`` are the law's knots (nodes and cell midpoints) and ``excess`` flags each piece
@@ -22,7 +23,8 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
     cells padded by :data:`PAD_CELLS` on each side (never below the default grids' finest
     step, :data:`~speedplan.model.grid.MIN_RELATIVE_STEP` of the length), and graded back to
     the old steps at the rate :data:`~speedplan.model.grid.GRADING`, so the new grid is as
-    smooth as the old one; ``anchors`` (nodes of ``s``) stay nodes.
+    smooth as the old one; ``anchors`` (nodes of ``s``) stay nodes. A law without jerk rows
+    needs no smoothness: ``grading`` may then be coarser.
 
     Examples
     --------
@@ -44,7 +46,7 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
     # Never below the default grids' finest step: finer steps lose the digits of w.
     finest = MIN_RELATIVE_STEP * float(s[-1] - s[0])
     target = np.where(flagged, np.maximum(factor * node_h, np.minimum(node_h, finest)), node_h)
-    target = graded_steps(s, target, np.full(s.size, GRADING))
+    target = graded_steps(s, target, np.full(s.size, grading))
     kept = None if anchors is None or not len(anchors) else np.intersect1d(anchors, s)
     grid = nodes_from_steps(s, target, kept)
     grid_size("n", grid.size)
