@@ -304,6 +304,7 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
         low = [v for v in (v0, vf) if v > 0] + [
             turnaround_speed(v, a, lim.j_max) for v, a in ((v0, a0), (vf, -af))
             if v > 0 and a < 0]
+
         def graded(max_nodes: int = MAX_DEFAULT_NODES) -> FloatArray:
             return adaptive_grid(length, lambda q: env.cap(q, leg_bound(q)), a_max=lim.a_max,
                                  a_decel=lim.a_decel, v_max=lim.v_max, j_max=lim.j_max,
@@ -385,7 +386,7 @@ def _transient(request: PlanRequest, v: float, a: float, a_limit: float,
         removal = v * t + 0.5 * a * t * t - float(np.sign(a)) * j * t**3 / 6.0
         if removal > 0.0:
             scale = min(scale, removal)
-    if a < 0.0:  # and the first step well below the braking distance (_check_moving_ends_resolved)
+    if a < 0.0:  # the first step well below the braking distance: see _check_moving_ends_resolved
         scale = min(scale, 0.5 * v * v / -a)
     return scale if scale > 0.0 else None
 
