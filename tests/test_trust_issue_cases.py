@@ -64,16 +64,23 @@ def test_2_unreachable_boundary_states_are_refused_by_name(length, lim, states, 
         plan(_line(length), lim, n=2000, **states)
 
 
-def test_3_feasible_moving_states_meet_physics():
+@pytest.mark.parametrize(("length", "lim", "states"), [
     # Was SolverError on the default grid, and 0.7 % faster than ruckig (jerk 3x) at n=2000.
-    length = 8.149176458679765
-    lim = Limits(v_max=1.5103489923280469, a_max=0.8675731399347792, a_lat_max=1,
-                 j_max=0.1324661827707745)
-    states = {"v0": 0.09343837197243295, "a0": -0.15353125453853034}
-    _physical(plan(_line(length), lim, **states), length, lim, **states)
+    (8.149176458679765, Limits(v_max=1.5103489923280469, a_max=0.8675731399347792,
+                               a_lat_max=1, j_max=0.1324661827707745),
+     {"v0": 0.09343837197243295, "a0": -0.15353125453853034}),
     # The speed touches 0 on the way (v0 = a0²/2j): was refused as "infinite curvature".
-    lgv = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
-    _physical(plan(_line(20.0), lgv, v0=1.0, a0=-1.0), 20.0, lgv, v0=1.0, a0=-1.0)
+    (20.0, Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5), {"v0": 1.0, "a0": -1.0}),
+    # 6.7 mm from 1.9 cm/s braking (trust fuzz, seed 2): the default grid's micrometre steps
+    # put 5 008 steps in a jerk-limited change of acceleration, and plan() refused it with
+    # "the grid is too fine for the jerk bounds ... use n <= 4001" although ruckig moves it
+    # and the user had asked for no grid at all. The default grid is now coarsened instead.
+    (0.006709230871688701, Limits(v_max=0.24378688544478674, a_max=0.5137314573315448,
+                                  a_lat_max=1, j_max=0.347703249447952),
+     {"v0": 0.01885758778079534, "a0": -0.1145144643144487}),
+])
+def test_3_feasible_moving_states_meet_physics(length, lim, states):
+    _physical(plan(_line(length), lim, **states), length, lim, **states)
 
 
 def test_3_free_standstill_from_a_moving_start_keeps_the_jerk_limit():
@@ -122,14 +129,3 @@ def test_a_short_move_with_tiny_jerk_phases_is_answered_by_the_banded_method():
                for leg in profile.legs)
     _physical(profile, length, lim)
 
-
-def test_a_millimetre_braking_start_gets_a_default_grid_the_relaxation_resolves():
-    # 6.7 mm from 1.9 cm/s braking (trust fuzz, seed 2): the default grid's micrometre steps
-    # put 5 008 steps in a jerk-limited change of acceleration, and plan() refused it with
-    # "the grid is too fine for the jerk bounds ... use n <= 4001" although ruckig moves it
-    # and the user had asked for no grid at all. The default grid is now coarsened instead.
-    length = 0.006709230871688701
-    lim = Limits(v_max=0.24378688544478674, a_max=0.5137314573315448, a_lat_max=1,
-                 j_max=0.347703249447952)
-    states = {"v0": 0.01885758778079534, "a0": -0.1145144643144487}
-    _physical(plan(_line(length), lim, **states), length, lim, **states)

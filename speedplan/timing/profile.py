@@ -309,7 +309,7 @@ class SpeedProfile:
 def law_for(s: FloatArray, w: FloatArray, spec: Any) -> TimeLaw:
     """The :class:`TimeLaw` of a leg's solution under its :class:`~speedplan.model.TimeLawSpec`."""
     return TimeLaw(s, w, accel_start=spec.accel_start, accel_end=spec.accel_end,
-                   j_max=spec.j_max, linear=getattr(spec, "linear", False))
+                   j_max=spec.j_max, linear=spec.linear)
 
 
 def sample_times(duration: float, dt: float) -> FloatArray:
