@@ -183,7 +183,10 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
             "profile.verification, or plan with a finer grid (n or ds)",
             LimitWarning, stacklevel=3,
         )
-    return replace(profile, verification=check, limits_exceeded=not check.ok)
+    # The bound's memo (every position evaluated while planning) stays with the plan, not
+    # with the profile a caller keeps.
+    return replace(profile, verification=check, limits_exceeded=not check.ok,
+                   speed_bound=replace(model.bound, memo=None))
 
 
 def _model_reaching_the_states(request: PlanRequest) -> tuple[PlanRequest, Model]:

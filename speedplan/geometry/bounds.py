@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -243,16 +243,66 @@ class SpeedBound:
     v_limit: Any = None
     offset: float = 0.0
     spans: tuple[SpanLimit, ...] = ()
+    memo: BoundMemo | None = field(default=None, compare=False, repr=False)
 
     def at_offset(self, offset: float) -> SpeedBound:
-        """The same bound read from ``offset`` [m] on: ``s -> mu+(offset + s)``."""
+        """The same bound read from ``offset`` [m] on: ``s -> mu+(offset + s)``.
+
+        Shares the memo (:meth:`memoised`), which is keyed by the path's own arc length.
+        """
         return replace(self, offset=self.offset + float(offset))
+
+    def memoised(self) -> SpeedBound:
+        """The same bound, remembering what it evaluated where evaluating is costly.
+
+        A plan evaluates the bound at the nodes and inside the cells of a grid, again on a
+        refined grid that keeps most cells, and again where it checks the law, at many of the
+        same positions. On a spline or NURBS path each curvature is an arc-length inversion
+        and, with speed zones, each position a point-in-polygon test; there the returned bound
+        looks up the positions it has seen (exactly equal floats) and evaluates only the
+        others (:class:`BoundMemo`). On paths of lines, arcs and clothoids without zones a
+        lookup costs more than the evaluation and ``self`` is returned.
+
+        Examples
+        --------
+        >>> from speedplan import Limits, Path
+        >>> from speedplan.geometry import SpeedBound, SpeedZone
+        >>> p = Path.from_waypoints([(0, 0), (10, 0)])
+        >>> zone = SpeedZone([(2, -1), (4, -1), (4, 1), (2, 1)], v_max=0.5)
+        >>> lim = Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
+        >>> bound = SpeedBound(p, lim, [zone]).memoised()
+        >>> bound([1.0, 3.0]).tolist(), bound.memo.size
+        ([4.0, 0.25], 2)
+        >>> SpeedBound(p, lim).memoised().memo is None
+        True
+        """
+        if self.memo is not None or not (self.zones or not self.path.analytic):
+            return self
+        return replace(self, memo=BoundMemo())
 
     def __call__(self, s: FloatArray) -> FloatArray:
         """Bound at arc lengths ``s`` [m²/s²]."""
+        if self.memo is not None:
+            return self.curvature_and_bound(s)[1]
         q = as_array("s", s) + self.offset if self.offset else s
         return speed_bounds(self.path, self.limits, q, zones=self.zones, v_limit=self.v_limit,
                             spans=self.spans)
+
+    def curvature_and_bound(self, s: Any) -> tuple[FloatArray, FloatArray]:
+        """The path's curvature [1/m] and the bound [m²/s²] at arc lengths ``s`` [m]."""
+        q = as_array("s", s) + self.offset
+        if self.memo is None:
+            kappa = np.asarray(self.path.curvature(q), dtype=np.float64)
+            return kappa, self._given(q, kappa)
+        return self.memo.lookup(q, self._fresh)
+
+    def _fresh(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
+        kappa = np.asarray(self.path.curvature(q), dtype=np.float64)
+        return kappa, self._given(q, kappa)
+
+    def _given(self, q: FloatArray, kappa: FloatArray) -> FloatArray:
+        return _bounds(self.path, self.limits, q, kappa, check_zones(self.zones), self.v_limit,
+                       self.spans)
 
     def given_curvature(self, s: Any, curvature: Any) -> FloatArray:
         """Bound at arc lengths ``s`` [m] where the path's ``curvature`` [1/m] is known.
@@ -267,8 +317,50 @@ class SpeedBound:
             raise InvalidInputError(
                 f"`curvature` must have the shape of `s` {q.shape}; got {kappa.shape}"
             )
-        return _bounds(self.path, self.limits, q, kappa, check_zones(self.zones), self.v_limit,
-                       self.spans)
+        return self._given(q, kappa)
+
+
+class BoundMemo:
+    """Curvature and speed bound already evaluated, keyed by the exact arc length [m].
+
+    Sorted positions with their values; a lookup evaluates only the positions it has not seen
+    (one call for all of them, deduplicated) and keeps them. The table is replaced by one
+    assignment, so a lookup from another thread sees the old table or the new one, never a
+    mix. Pickling keeps no entries: a memo is a cache of one process.
+    """
+
+    __slots__ = ("_table",)
+
+    def __init__(self) -> None:
+        empty = np.empty(0)
+        self._table: tuple[FloatArray, FloatArray, FloatArray] = (empty, empty, empty)
+
+    @property
+    def size(self) -> int:
+        """Number of positions remembered."""
+        return int(self._table[0].size)
+
+    def lookup(self, q: FloatArray, fresh: Any) -> tuple[FloatArray, FloatArray]:
+        """``(curvature, bound)`` at ``q``, with ``fresh(positions)`` for the unseen ones."""
+        keys, kappa_k, w_k = self._table
+        flat = q.ravel()
+        at = np.minimum(np.searchsorted(keys, flat), max(keys.size - 1, 0))
+        hit = keys[at] == flat if keys.size else np.zeros(flat.size, dtype=bool)
+        kappa = np.empty(flat.size)
+        w = np.empty(flat.size)
+        kappa[hit], w[hit] = kappa_k[at[hit]], w_k[at[hit]]
+        if not hit.all():
+            new, back = np.unique(flat[~hit], return_inverse=True)
+            kappa_n, w_n = fresh(new)
+            kappa[~hit], w[~hit] = kappa_n[back], w_n[back]
+            merged = np.concatenate((keys, new))
+            order = np.argsort(merged, kind="stable")  # two sorted runs: linear
+            self._table = (merged[order], np.concatenate((kappa_k, kappa_n))[order],
+                           np.concatenate((w_k, w_n))[order])
+        return kappa.reshape(q.shape), w.reshape(q.shape)
+
+    def __reduce__(self) -> tuple[type[BoundMemo], tuple[()]]:
+        return (BoundMemo, ())
 
 
 def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:

@@ -161,6 +161,21 @@ class Path:
         idx = np.clip(np.searchsorted(self.offsets, q, side="right") - 1, 0, len(self.pieces) - 1)
         return q, idx
 
+    @property
+    def analytic(self) -> bool:
+        """Whether every piece is a line, arc or clothoid (closed-form curvature and heading).
+
+        Curvature and heading of such a path cost a few vector operations per query; a spline
+        or NURBS piece inverts its arc length at every query.
+
+        Examples
+        --------
+        >>> from speedplan import Path
+        >>> Path.from_waypoints([(0, 0), (4, 0), (4, 3)]).analytic
+        True
+        """
+        return self._clothoids is not None
+
     @cached_property
     def _clothoids(self) -> FloatArray | None:
         """Rows ``k0, k1 - k0, length, theta0`` of the pieces, if all are clothoid pieces.

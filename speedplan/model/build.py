@@ -26,7 +26,6 @@ from ..solve.nojerk import max_feasible_w
 from ..solve.problem import StencilRows
 from .boundary import check_reachable_states, fastest_w, jerk_motion_w, turnaround_speed
 from .grid import (
-    CRUISE_GRADING,
     MAX_DEFAULT_NODES,
     MIN_NODES,
     adaptive_grid,
@@ -34,7 +33,7 @@ from .grid import (
     rest_phase_length,
     uniform_grid,
 )
-from .refine import refined_grid
+from .refine import subdivided_grid
 from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
 
@@ -229,7 +228,7 @@ def build_model(request: PlanRequest) -> Model:
     path = request.path
     length = float(path.length)
     bound = SpeedBound(path, lim, None if request.zones is None else list(request.zones),
-                       request.v_limit, spans=request.spans)
+                       request.v_limit, spans=request.spans).memoised()
     _check_end_speeds(request, bound, length)
     rests = rest_points(request)
     cuts = [0.0, *(r.s for r in rests), length]
@@ -331,11 +330,13 @@ def _no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: fl
 
     Where the bound falls steeply (a corner's clothoid, a zone's edge) the node bound, the
     minimum over both adjacent cells, lies well below the bound at the node; where the no-jerk
-    optimum rides it, the cells are refined (:func:`~.refine.refined_grid`, steps / 4,
-    graded back by 10 % per node: the no-jerk law is linear in ``w`` per cell and needs no
-    smoothness). The O(n) pass makes each round cheap; on the serpentine of
-    ``benchmarks/bench_all.py`` one round takes the duration from 3.9 % to 1.0 % above the
-    exact optimum.
+    optimum rides it, those cells and their neighbours are cut in four
+    (:func:`~.refine.subdivided_grid`; the no-jerk law is linear in ``w`` per cell and needs
+    no smoothness of the steps). Every other cell is kept to the last bit, so the bound
+    already evaluated inside it is looked up, not evaluated again
+    (:meth:`~speedplan.geometry.SpeedBound.memoised`). The O(n) pass makes each round cheap;
+    on the serpentine of ``benchmarks/bench_all.py`` one round takes the duration from 3.9 %
+    to 1.0 % above the exact optimum.
     """
     lim = request.limits
     s = uniform_grid(length, n=NO_JERK_NODES)
@@ -357,8 +358,7 @@ def _no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: fl
         idx = np.flatnonzero(lossy)
         cells[np.clip(idx - 1, 0, m - 2)] = True
         cells[np.clip(idx, 0, m - 2)] = True
-        knots = np.sort(np.concatenate((s, 0.5 * (s[1:] + s[:-1]))))
-        s = refined_grid(s, knots, np.repeat(cells, 2), factor=0.25, grading=CRUISE_GRADING)
+        s = subdivided_grid(s, cells, parts=4)
     return s
 
 

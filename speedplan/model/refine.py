@@ -7,7 +7,7 @@ import numpy as np
 from ..core.checks import FloatArray, grid_size
 from .grid import GRADING, MIN_RELATIVE_STEP, graded_steps, nodes_from_steps
 
-__all__ = ["PAD_CELLS", "refined_grid"]
+__all__ = ["PAD_CELLS", "refined_grid", "subdivided_grid"]
 
 #: Cells added on each side of a flagged stretch before halving the steps there.
 PAD_CELLS = 4
@@ -49,5 +49,33 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
     target = graded_steps(s, target, np.full(s.size, grading))
     kept = None if anchors is None or not len(anchors) else np.intersect1d(anchors, s)
     grid = nodes_from_steps(s, target, kept)
+    grid_size("n", grid.size)
+    return grid
+
+
+def subdivided_grid(s: FloatArray, cells: np.ndarray, parts: int = 4) -> FloatArray:
+    """The grid ``s`` with the flagged ``cells`` and :data:`PAD_CELLS` on each side split.
+
+    Each such cell is cut into ``parts`` equal steps; every other node and cell of ``s`` is
+    kept to the last bit, so what was evaluated on them (the speed bound inside the cells)
+    still holds. For a law without jerk rows, which needs no smoothness of the steps.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.linspace(0.0, 10.0, 11)
+    >>> flag = np.zeros(10, dtype=bool); flag[5] = True
+    >>> g = subdivided_grid(s, flag, parts=2)
+    >>> g.size, bool(np.isin(s, g).all()), float(np.diff(g).min())
+    (20, True, 0.5)
+    """
+    m = s.size - 1
+    split = np.zeros(m, dtype=bool)
+    for k in np.flatnonzero(cells):
+        split[max(k - PAD_CELLS, 0):min(k + PAD_CELLS + 1, m)] = True
+    lo = s[:-1][split]
+    width = np.diff(s)[split]
+    inner = (lo[:, None] + width[:, None] * (np.arange(1, parts) / parts)[None, :]).ravel()
+    grid = np.sort(np.concatenate((s, inner)))
     grid_size("n", grid.size)
     return grid

@@ -222,10 +222,11 @@ def check_law(law: TimeLaw, offset: float, path: Path,
                                   + np.arange(local.size)))
     shape = where_at.shape
     spot_glob = offset + spots
-    kappa_spot = np.asarray(path.curvature(spot_glob), dtype=np.float64)
-    if isinstance(bound, SpeedBound) and bound.path is path:  # reuse the curvature
-        wb_spot = bound.given_curvature(spot_glob, kappa_spot)
+    if isinstance(bound, SpeedBound) and bound.path is path and bound.offset == 0.0:
+        # The curvature is the bound's own (remembered from the grid where it has a memo).
+        kappa_spot, wb_spot = bound.curvature_and_bound(spot_glob)
     else:
+        kappa_spot = np.asarray(path.curvature(spot_glob), dtype=np.float64)
         wb_spot = np.asarray(bound(spot_glob), dtype=np.float64)
     glob = spot_glob[sample_spot]
     kappa = kappa_spot[sample_spot]
