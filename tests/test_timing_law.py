@@ -216,3 +216,39 @@ def test_compiled_and_numpy_time_laws_agree():
         for a, b in zip(_law_kernel.kinematics(p, k, dx, width[k] - dx),
                         _law_numpy.kinematics(p, k, dx, width[k] - dx), strict=True):
             assert np.max(np.abs(a - b)) <= 1e-13 * max(np.max(np.abs(b)), 1e-300)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_compiled_inversion_meets_its_time_tolerance(seed):
+    # The compiled inversion skips the integral that would confirm a Newton step when the
+    # step's predicted error is far inside the tolerance: the times the offsets reach (the
+    # same 16-point integral from the piece's start, or its standstill end) must still be
+    # the requested ones to 1e-15 of the piece's time, up to rounding.
+    from speedplan.core import _law_kernel
+
+    rng = np.random.default_rng(seed)
+    s = np.cumsum(rng.uniform(0.05, 0.15, 300) * 10 ** rng.uniform(-3, 3))
+    s -= s[0]
+    j_max = 10 ** rng.uniform(-2, 2)
+    cap = 10 ** rng.uniform(-1, 1)
+    laws = [
+        TimeLaw(s, np.minimum(np.minimum(max_jerk_envelope(s, j_max),
+                                         max_jerk_envelope(s[-1] - s, j_max)), cap),
+                j_max=j_max),
+        TimeLaw(s, cap * (1.0 + np.sin(s / s[-1] * 7.0) ** 2), accel_start=0.0,
+                accel_end=0.0),
+    ]
+    for law in laws:
+        p = law._pieces
+        T = law.knot_times
+        t = np.concatenate((np.arange(0.0, law.duration, law.duration / 5000),
+                            rng.uniform(0.0, law.duration, 5000)))
+        k = np.clip(np.searchsorted(T, t, side="right") - 1, 0, p.c.size - 1)
+        dx, dr = _law_kernel.invert(p, T, k, t)
+        right = (p.y_right[k] <= 0.0) & (p.y[k] > 0.0)
+        off = np.where(right, dr, dx)
+        reached = _law_kernel.integrals(p, k, np.zeros(k.size), off, right)
+        tau = np.where(right, T[k + 1] - t, t - T[k])
+        span = T[k + 1] - T[k]
+        slack = 4e-15 * span + 8 * np.spacing(np.maximum(T[k + 1], 1e-300))
+        assert np.all(np.abs(reached - tau) <= slack)
