@@ -62,10 +62,14 @@ def _speed(pieces: Pieces, j: int, dx: float, dr: float) -> float:
     return math.sqrt(val)
 
 
-@njit(f"UniTuple(f8, 3)({_PIECES}, i8, f8, f8)", cache=True, error_model="numpy")
-def _speed_accel_jerk(pieces: Pieces, j: int, dx: float, dr: float
-                      ) -> tuple[float, float, float]:
-    """``v, a, jerk`` at offsets ``(dx, dr)`` of piece ``j`` (``_kinematics_into``'s formulas)."""
+@njit(f"UniTuple(f8, 4)({_PIECES}, i8, f8, f8)", cache=True, error_model="numpy")
+def _state(pieces: Pieces, j: int, dx: float, dr: float) -> tuple[float, float, float, float]:
+    """``w, v, a, jerk`` at offsets ``(dx, dr)`` of piece ``j``.
+
+    ``y, y', y''`` from the nearer knot (accurate relative to its own size next to a
+    standstill), then ``w = y`` or ``u^{4/3}``, ``v = sqrt(w)``, ``a = y'/2`` or
+    ``(2/3) u^{1/3} u'``, jerk ``y'' v / 2`` or ``(2/9) u'² + (2/3) u u''``.
+    """
     _x, y, g, c, is_u, y_right, g_right = pieces
     cj = c[j]
     if dx > dr:
@@ -77,10 +81,11 @@ def _speed_accel_jerk(pieces: Pieces, j: int, dx: float, dr: float
     val = max(val, 0.0)
     if is_u[j]:
         cube = np.cbrt(val)
-        v = math.sqrt(val * cube)
-        return v, (2.0 / 3.0) * cube * dy, (2.0 / 9.0) * dy * dy + (2.0 / 3.0) * val * cj
+        w = val * cube
+        v = math.sqrt(w)
+        return w, v, (2.0 / 3.0) * cube * dy, (2.0 / 9.0) * dy * dy + (2.0 / 3.0) * val * cj
     v = math.sqrt(val)
-    return v, 0.5 * dy, 0.5 * cj * v
+    return val, v, 0.5 * dy, 0.5 * cj * v
 
 
 @njit(f"f8({_PIECES}, i8, f8, f8, b1, f8[:, ::1])", cache=True, error_model="numpy")
@@ -205,9 +210,9 @@ def _invert_into(pieces: Pieces, T: FloatArray, j: IntArray, t: FloatArray, rule
                 if f >= 0:
                     hi = off
                 if rest_right:
-                    v, acc, jerk = _speed_accel_jerk(pieces, jk, width - off, off)
+                    _w, v, acc, jerk = _state(pieces, jk, width - off, off)
                 else:
-                    v, acc, jerk = _speed_accel_jerk(pieces, jk, off, width - off)
+                    _w, v, acc, jerk = _state(pieces, jk, off, width - off)
                 step = f * v
                 newton = off - step
                 converged = abs(f) <= ttol
@@ -248,35 +253,9 @@ def invert(pieces: Any, T: np.ndarray, j: np.ndarray, t: np.ndarray
 def _kinematics_into(pieces: Pieces, j: IntArray, dx: FloatArray, dr: FloatArray,
                      w_out: FloatArray, v_out: FloatArray, a_out: FloatArray,
                      jerk_out: FloatArray) -> None:
-    """``w, v, a, jerk`` at offsets ``(dx, dr)`` of pieces ``j``.
-
-    ``y, y', y''`` from the nearer knot (accurate relative to its own size next to a
-    standstill), then ``w = y`` or ``u^{4/3}``, ``v = sqrt(w)``, ``a = y'/2`` or
-    ``(2/3) u^{1/3} u'``, jerk ``y'' v / 2`` or ``(2/9) u'² + (2/3) u u''``.
-    """
-    _x, y, g, c, is_u, y_right, g_right = pieces
+    """``w, v, a, jerk`` at offsets ``(dx, dr)`` of pieces ``j`` (:func:`_state`)."""
     for k in range(j.size):
-        jk, dxk, drk = j[k], dx[k], dr[k]
-        cj = c[jk]
-        if dxk > drk:
-            val = y_right[jk] - g_right[jk] * drk + 0.5 * cj * drk * drk
-            dy = g_right[jk] - cj * drk
-        else:
-            val = y[jk] + g[jk] * dxk + 0.5 * cj * dxk * dxk
-            dy = g[jk] + cj * dxk
-        val = max(val, 0.0)
-        if is_u[jk]:
-            cube = np.cbrt(val)
-            w = val * cube
-            v = math.sqrt(w)
-            a = (2.0 / 3.0) * cube * dy
-            jerk = (2.0 / 9.0) * dy * dy + (2.0 / 3.0) * val * cj
-        else:
-            w = val
-            v = math.sqrt(w)
-            a = 0.5 * dy
-            jerk = 0.5 * cj * v
-        w_out[k], v_out[k], a_out[k], jerk_out[k] = w, v, a, jerk
+        w_out[k], v_out[k], a_out[k], jerk_out[k] = _state(pieces, j[k], dx[k], dr[k])
 
 
 def kinematics(pieces: Any, j: np.ndarray, dx: np.ndarray, dr: np.ndarray
