@@ -276,7 +276,8 @@ class SpeedBound:
         >>> SpeedBound(p, lim).memoised().memo is None
         True
         """
-        if self.memo is not None or not (self.zones or not self.path.analytic):
+        costly = bool(self.zones) or not self.path.analytic
+        if self.memo is not None or not costly:
             return self
         return replace(self, memo=BoundMemo())
 

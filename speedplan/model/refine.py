@@ -76,6 +76,6 @@ def subdivided_grid(s: FloatArray, cells: np.ndarray, parts: int = 4) -> FloatAr
     lo = s[:-1][split]
     width = np.diff(s)[split]
     inner = (lo[:, None] + width[:, None] * (np.arange(1, parts) / parts)[None, :]).ravel()
-    grid = np.sort(np.concatenate((s, inner)))
+    grid = np.unique(np.concatenate((s, inner)))  # sorted; a cell of a few ulps adds none
     grid_size("n", grid.size)
     return grid
