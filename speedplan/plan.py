@@ -16,15 +16,15 @@ from .core.limits import Limits
 from .geometry import Path, SpanLimit, SpeedBound, SpeedZone
 from .model import ForcedLeg, Leg, Model, PlanRequest, build_model
 from .model.boundary import STATE_JERK_SLACK, state_jerk
-from .model.build import leg_on_grid
+from .model.build import coarser_leg, leg_on_grid
 from .model.refine import refined_grid
 from .model.request import STANDSTILL_MODES
 from .solve import DiscreteSolution
 from .timing import TOLERANCES, LegResult, SpeedProfile, Verification, law_for
 
 # SpeedBound is re-exported so that pickles made when it lived here still load.
-__all__ = ["MAX_REFINEMENTS", "REFINE_FACTORS", "STANDSTILL_MODES", "SpeedBound", "plan",
-           "plan_request", "refine_factor"]
+__all__ = ["COARSER_GRIDS", "MAX_REFINEMENTS", "REFINE_FACTORS", "STANDSTILL_MODES",
+           "SpeedBound", "plan", "plan_request", "refine_factor"]
 
 #: What the reachability checks of boundary states name when they refuse one.
 STATE_CONSTRAINTS = ("jerk", "v_max", "length", "speed_bound")
@@ -33,6 +33,9 @@ MAX_REFINEMENTS = 3
 #: Bounds on the factor a refinement round multiplies the flagged steps by (finer in one
 #: round grades the grid so steeply that the banded kernel loses accuracy, measured).
 REFINE_FACTORS = (1 / 4, 1 / 2)
+#: Fractions of its nodes a jerk-limited default grid is rebuilt with, in turn, when neither
+#: relaxation backend converges on it (:func:`~speedplan.model.build.coarser_leg`).
+COARSER_GRIDS = (1 / 2, 1 / 4)
 
 
 def plan(
@@ -68,7 +71,10 @@ def plan(
         :func:`~speedplan.model.grid.graded_ends`): the law would exceed the limits there and
         the grid be refined after a first solve. By default the
         grid is adaptive and smoothly graded: ~80 nodes per jerk transition, coarse in long
-        cruises.
+        cruises; where neither relaxation backend converges on it (seen on paths with slow
+        zones), the leg is planned on the same grid with half, then a quarter of its nodes
+        (:data:`COARSER_GRIDS`) before a :class:`~speedplan.SolverError` is raised. A grid
+        given with ``n`` or ``ds`` is never changed this way.
     v0, a0 : float
         Speed [m/s] and acceleration [m/s²] at the start (default: at rest).
     vf, af : float
@@ -114,6 +120,9 @@ def plan(
         limit and where, ``s`` in metres). Moving states that ``j_max`` misses by a hair but
         ``j_max (1 + STATE_JERK_SLACK)`` (2 %) reaches are planned with that jerk instead, with
         a :class:`~speedplan.SpeedplanWarning`.
+    SolverError
+        Neither relaxation backend converged on the leg's grid (nor, on a default grid, on
+        the coarser ones), and no feasible speed law could be produced.
 
     Examples
     --------
@@ -147,7 +156,7 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
             "path (Path.from_waypoints with the default kind='g2') to drive through",
             SpeedplanWarning, stacklevel=3,
         )
-    legs = [_solve(leg) for leg in model.legs]
+    legs = [_solve_default(modelled, leg) for leg in model.legs]
     profile = SpeedProfile(path=request.path, limits=request.limits, legs=tuple(legs),
                            speed_bound=model.bound, request=request)
     # Each leg is checked once per law it gets: the final verification merges these checks
@@ -249,6 +258,28 @@ def refine_factor(check: Verification) -> float:
               for name, ratio in check.ratios.items() if ratio > 1.0 + TOLERANCES[name]]
     lo, hi = REFINE_FACTORS
     return float(np.clip(min(wanted, default=hi), lo, hi))
+
+
+def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> LegResult:
+    """:func:`_solve`, on a coarser default grid if neither backend converges on the first.
+
+    Measured on slow-zone paths (``benchmarks/fuzz_zones.py``): both interior-point methods
+    can stall on a fine default grid and converge on one with half or a quarter of its
+    nodes; the law is then verified and refined locally like any other. A user grid is
+    never changed: its failure is raised.
+    """
+    try:
+        return _solve(leg)
+    except SolverError as exc:
+        failure = exc
+    if isinstance(leg, Leg):
+        for factor in COARSER_GRIDS:
+            coarser = coarser_leg(request, leg, factor)
+            if coarser is None:
+                break
+            with contextlib.suppress(SolverError):
+                return _solve(coarser)
+    raise failure
 
 
 def _solve(leg: Leg | ForcedLeg) -> LegResult:

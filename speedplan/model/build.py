@@ -38,7 +38,7 @@ from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
 
 __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
-           "build_model", "grid_anchors", "node_bounds", "rest_points"]
+           "build_model", "coarser_leg", "grid_anchors", "node_bounds", "rest_points"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
@@ -292,7 +292,6 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
     length = hi - lo
     leg_bound = bound if (lo == 0.0 and hi == float(request.path.length)) else _sub_bound(
         request, bound, lo, hi)
-    env = _Envelopes.of(request, v0, a0, vf, af, length)
     if request.n is not None or request.ds is not None:
         s = uniform_grid(length, n=request.n, ds=request.ds)
         if request.jerk_limited:
@@ -300,28 +299,69 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
                             _transient(request, vf, -af, lim.a_decel, length))
         _check_moving_ends_resolved(s, lo, v0, a0, vf, af)
     elif request.jerk_limited:
-        low = [v for v in (v0, vf) if v > 0] + [
-            turnaround_speed(v, a, lim.j_max) for v, a in ((v0, a0), (vf, -af))
-            if v > 0 and a < 0]
-
-        def graded(max_nodes: int = MAX_DEFAULT_NODES) -> FloatArray:
-            return adaptive_grid(length, lambda q: env.cap(q, leg_bound(q)), a_max=lim.a_max,
-                                 a_decel=lim.a_decel, v_max=lim.v_max, j_max=lim.j_max,
-                                 w_start=v0**2, w_end=vf**2,
-                                 v_low=min((v for v in low if v > 0), default=None),
-                                 anchors=grid_anchors(request, lo, hi), max_nodes=max_nodes)
-
-        s = graded()
+        s = _default_grid(request, leg_bound, lo, hi, v0, a0, vf, af)
         leg = leg_on_grid(request, leg_bound, s, lo, v0, a0, vf, af)
         steps = ramp_steps(leg.problem)
         if steps <= MAX_RAMP_STEPS:
             return leg
         # A default grid the relaxation cannot resolve (a millimetre move whose boundary
         # transients ask for micrometre steps): coarser everywhere, in proportion.
-        s = graded(max(int(s.size * 0.9 * MAX_RAMP_STEPS / steps), MIN_NODES))
+        s = _default_grid(request, leg_bound, lo, hi, v0, a0, vf, af,
+                          max(int(s.size * 0.9 * MAX_RAMP_STEPS / steps), MIN_NODES))
     else:
         s = _no_jerk_grid(request, leg_bound, length, v0, vf)
     return leg_on_grid(request, leg_bound, s, lo, v0, a0, vf, af)
+
+
+def coarser_leg(request: PlanRequest, leg: Leg, factor: float) -> Leg | None:
+    """``leg`` on its default grid with ``factor`` times its nodes, or ``None``.
+
+    Every step grows in proportion (the node cap of :func:`adaptive_grid`), so the grid
+    stays smoothly graded. :func:`speedplan.plan` plans a leg on such a grid when neither
+    relaxation backend converges on its default grid: on paths with slow zones both
+    interior-point methods can stall on a fine default grid (a front of nearly active jerk
+    rows next to a zone's edge moves one node per iteration) and converge on a coarser one.
+    ``None`` for a user grid (``n`` or ``ds``: the grid is the caller's), without a jerk
+    limit (no solver runs), or where the grid would not get coarser (:data:`MIN_NODES`).
+
+    Examples
+    --------
+    >>> from speedplan import Limits, Path
+    >>> from speedplan.model import PlanRequest, build_model
+    >>> path = Path.from_waypoints([[0, 0], [30, 0]], kind="polyline")
+    >>> model = build_model(PlanRequest.create(path, Limits(2, 1, 1, 0.5)))
+    >>> leg = model.legs[0]
+    >>> half = coarser_leg(model.request, leg, 0.5)
+    >>> bool(half.problem.n <= leg.problem.n // 2 + 1), bool(half.problem.s[-1] == 30.0)
+    (True, True)
+    """
+    if request.n is not None or request.ds is not None or not request.jerk_limited:
+        return None
+    nodes = max(int(leg.problem.n * factor), MIN_NODES)
+    if nodes >= leg.problem.n:
+        return None
+    lo, hi = leg.start, leg.start + leg.length
+    s = _default_grid(request, leg.bound, lo, hi, leg.v0, leg.a0, leg.vf, leg.af, nodes)
+    if s.size >= leg.problem.n:
+        return None
+    return leg_on_grid(request, leg.bound, s, lo, leg.v0, leg.a0, leg.vf, leg.af)
+
+
+def _default_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: float,
+                  v0: float, a0: float, vf: float, af: float,
+                  max_nodes: int = MAX_DEFAULT_NODES) -> FloatArray:
+    """The jerk-limited default grid of the leg ``[lo, hi]`` (:func:`adaptive_grid`)."""
+    lim = request.limits
+    length = hi - lo
+    env = _Envelopes.of(request, v0, a0, vf, af, length)
+    low = [v for v in (v0, vf) if v > 0] + [
+        turnaround_speed(v, a, lim.j_max) for v, a in ((v0, a0), (vf, -af))
+        if v > 0 and a < 0]
+    return adaptive_grid(length, lambda q: env.cap(q, leg_bound(q)), a_max=lim.a_max,
+                         a_decel=lim.a_decel, v_max=lim.v_max, j_max=lim.j_max,
+                         w_start=v0**2, w_end=vf**2,
+                         v_low=min((v for v in low if v > 0), default=None),
+                         anchors=grid_anchors(request, lo, hi), max_nodes=max_nodes)
 
 
 def _no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: float,

@@ -5,6 +5,9 @@ A jerk-limited change of speed at speed ``v`` takes ``min(t_j, sqrt(v / j))`` se
 from rest the first transition spans ``ℓ = j t_j³ / 6``. The default grid puts ``per_phase``
 nodes on each such length, with ``v(s)`` estimated by the exact no-jerk optimum under the
 boundary envelopes (so a decelerating start that dips to a low speed gets a fine grid there).
+Where ``λ(v)`` falls below ``ℓ`` on the stretches next to the ends (the speed rising from
+rest), the steps stay at ``ℓ / per_phase``; a slow stretch farther inside (a slow zone, a
+tight curve) is resolved at its own ``λ(v)``, however short.
 
 Two properties the time law relies on (:mod:`speedplan.timing.law`):
 
@@ -326,8 +329,13 @@ def adaptive_grid(
             w_start=w_start, w_end=w_end,
         )
         w_est = max_feasible_w(pre, pin_ends=False)
-        h = np.maximum(np.maximum(scale(np.sqrt(w_est)), floor) / per_phase,
-                       MIN_RELATIVE_STEP * length)
+        # The floor keeps the steps from vanishing where the speed falls to the ends' states:
+        # on the stretches next to each end where λ(v) is below it. A slow stretch farther
+        # inside (a zone, a tight curve) has transitions of its own, which may be shorter
+        # than the floor: they are resolved like any other.
+        lam = scale(np.sqrt(w_est))
+        h = np.maximum(np.maximum(lam, np.where(_end_runs(lam < floor), floor, 0.0))
+                       / per_phase, MIN_RELATIVE_STEP * length)
         # Long stretches where the no-jerk optimum is linear in w (a cruise, a constant
         # acceleration or braking) hold nothing to resolve: coarse, graded faster. The no-jerk
         # pass sums A h along the path, so it is linear (or meets a constant bound) only to
@@ -377,6 +385,24 @@ def adaptive_grid(
     grid = nodes_from_steps(sf, h, inner_anchors if inner_anchors.size else None)
     grid_size("n", grid.size)
     return grid
+
+
+def _end_runs(mask: np.ndarray) -> np.ndarray:
+    """``mask`` on its leading and trailing runs of True, False elsewhere.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> _end_runs(np.array([True, True, False, True, False, True])).tolist()
+    [True, True, False, False, False, True]
+    """
+    out = np.zeros(mask.shape, dtype=bool)
+    if mask.all():
+        out[:] = True
+        return out
+    out[: int(np.argmin(mask))] = True
+    out[mask.size - int(np.argmin(mask[::-1])):] = True
+    return out
 
 
 def _distance_to(mask: np.ndarray, s: FloatArray) -> FloatArray:
