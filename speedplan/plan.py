@@ -16,7 +16,7 @@ from .core.limits import Limits
 from .geometry import Path, SpanLimit, SpeedBound, SpeedZone
 from .model import ForcedLeg, Leg, Model, PlanRequest, build_model
 from .model.boundary import STATE_JERK_SLACK, state_jerk
-from .model.build import coarser_leg, leg_on_grid
+from .model.build import coarsenable, coarser_leg, leg_on_grid
 from .model.refine import refined_grid
 from .model.request import STANDSTILL_MODES
 from .solve import DiscreteSolution
@@ -33,9 +33,9 @@ MAX_REFINEMENTS = 3
 #: Bounds on the factor a refinement round multiplies the flagged steps by (finer in one
 #: round grades the grid so steeply that the banded kernel loses accuracy, measured).
 REFINE_FACTORS = (1 / 4, 1 / 2)
-#: Fractions of its nodes a jerk-limited default grid is rebuilt with, in turn, when neither
-#: relaxation backend converges on it (:func:`~speedplan.model.build.coarser_leg`).
-COARSER_GRIDS = (1 / 2, 1 / 4)
+#: Fractions of its nodes a jerk-limited default grid is rebuilt with, in turn, when the
+#: relaxation backend does not converge on it (:func:`~speedplan.model.build.coarser_leg`).
+COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
 
 
 def plan(
@@ -71,10 +71,11 @@ def plan(
         :func:`~speedplan.model.grid.graded_ends`): the law would exceed the limits there and
         the grid be refined after a first solve. By default the
         grid is adaptive and smoothly graded: ~80 nodes per jerk transition, coarse in long
-        cruises; where neither relaxation backend converges on it (seen on paths with slow
-        zones), the leg is planned on the same grid with half, then a quarter of its nodes
-        (:data:`COARSER_GRIDS`) before a :class:`~speedplan.SolverError` is raised. A grid
-        given with ``n`` or ``ds`` is never changed this way.
+        cruises; where the relaxation backend does not converge on it (seen on paths with
+        slow zones), the leg is planned on the same grid with a half, a quarter, an eighth
+        of its nodes (:data:`COARSER_GRIDS`), then on these grids with the other backend
+        too, before a :class:`~speedplan.SolverError` is raised. A grid given with ``n`` or
+        ``ds`` is never changed this way.
     v0, a0 : float
         Speed [m/s] and acceleration [m/s²] at the start (default: at rest).
     vf, af : float
@@ -261,29 +262,36 @@ def refine_factor(check: Verification) -> float:
 
 
 def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> LegResult:
-    """:func:`_solve`, on a coarser default grid if neither backend converges on the first.
+    """:func:`_solve`, on coarser default grids if the backend does not converge.
 
     Measured on slow-zone paths (``benchmarks/fuzz_zones.py``): both interior-point methods
-    can stall on a fine default grid and converge on one with half or a quarter of its
-    nodes; the law is then verified and refined locally like any other. A user grid is
-    never changed: its failure is raised.
+    can stall on a fine default grid and converge on one with a half to an eighth of its
+    nodes, in well under a second, where the other backend takes 10 s to 7 min on the fine
+    grid to fail or to return a relaxation that needs IPOPT. So the backend alone is tried
+    on the default grid and on the coarser ones (:data:`COARSER_GRIDS`), and only then the
+    same grids with the other backend as well; the law is verified and refined locally like
+    any other. A user grid is never changed.
     """
-    try:
+    if not (isinstance(leg, Leg) and coarsenable(request, leg)):
         return _solve(leg)
-    except SolverError as exc:
-        failure = exc
-    if isinstance(leg, Leg):
-        for factor in COARSER_GRIDS:
-            coarser = coarser_leg(request, leg, factor)
-            if coarser is None:
-                break
-            with contextlib.suppress(SolverError):
-                return _solve(coarser)
+    grids: list[Leg] = [leg]
+    for factor in COARSER_GRIDS:
+        coarser = coarser_leg(request, leg, factor)
+        if coarser is None or coarser.problem.n >= grids[-1].problem.n:
+            break
+        grids.append(coarser)
+    for fallback in (False, True):
+        for grid in grids:
+            try:
+                return _solve(grid, fallback=fallback)
+            except SolverError as exc:
+                if fallback and grid is leg:
+                    failure = exc
     raise failure
 
 
-def _solve(leg: Leg | ForcedLeg) -> LegResult:
-    """Solve one leg and build its law."""
+def _solve(leg: Leg | ForcedLeg, *, fallback: bool = True) -> LegResult:
+    """Solve one leg and build its law (``fallback``: see :meth:`Leg.solve`)."""
     if isinstance(leg, ForcedLeg):
         t0 = time.perf_counter()
         law = law_for(leg.s, leg.w, leg.time_law)
@@ -294,7 +302,7 @@ def _solve(leg: Leg | ForcedLeg) -> LegResult:
             solve_time=time.perf_counter() - t0, backend="forced",
         )
         return LegResult(start=leg.start, s=leg.s, solution=solution, law=law)
-    solution = leg.solve()
+    solution = leg.solve(fallback=fallback)
     law = law_for(leg.problem.s, solution.w, leg.time_law)
     if not np.isfinite(law.duration):  # never hand out a trajectory that does not arrive
         raise SolverError(

@@ -38,7 +38,8 @@ from .request import PlanRequest
 from .standstill import calibrate_standstill_rows
 
 __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
-           "build_model", "coarser_leg", "grid_anchors", "node_bounds", "rest_points"]
+           "build_model", "coarsenable", "coarser_leg", "grid_anchors", "node_bounds",
+           "rest_points"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
@@ -140,10 +141,15 @@ class Leg(_Ends):
     backend: str = "auto"
     anchors: FloatArray = field(default_factory=lambda: np.zeros(0))
 
-    def solve(self) -> DiscreteSolution:
-        """Solve the leg's discrete problem; an infeasibility is restated physically."""
+    def solve(self, *, fallback: bool = True) -> DiscreteSolution:
+        """Solve the leg's discrete problem; an infeasibility is restated physically.
+
+        ``fallback``: whether a failed relaxation backend is retried with the other one
+        (:func:`~speedplan.solve.solve_problem`).
+        """
         try:
-            return solve_problem(self.problem, refine=self.refine, backend=self.backend)
+            return solve_problem(self.problem, refine=self.refine, backend=self.backend,
+                                 fallback=fallback)
         except InfeasibleError as exc:
             raise _explain(exc, self) from exc
 
@@ -317,8 +323,8 @@ def coarser_leg(request: PlanRequest, leg: Leg, factor: float) -> Leg | None:
     """``leg`` on its default grid with ``factor`` times its nodes, or ``None``.
 
     Every step grows in proportion (the node cap of :func:`adaptive_grid`), so the grid
-    stays smoothly graded. :func:`speedplan.plan` plans a leg on such a grid when neither
-    relaxation backend converges on its default grid: on paths with slow zones both
+    stays smoothly graded. :func:`speedplan.plan` plans a leg on such a grid when its
+    relaxation backend does not converge on the default grid: on paths with slow zones both
     interior-point methods can stall on a fine default grid (a front of nearly active jerk
     rows next to a zone's edge moves one node per iteration) and converge on a coarser one.
     ``None`` for a user grid (``n`` or ``ds``: the grid is the caller's), without a jerk
@@ -335,7 +341,7 @@ def coarser_leg(request: PlanRequest, leg: Leg, factor: float) -> Leg | None:
     >>> bool(half.problem.n <= leg.problem.n // 2 + 1), bool(half.problem.s[-1] == 30.0)
     (True, True)
     """
-    if request.n is not None or request.ds is not None or not request.jerk_limited:
+    if not coarsenable(request, leg):
         return None
     nodes = max(int(leg.problem.n * factor), MIN_NODES)
     if nodes >= leg.problem.n:
@@ -345,6 +351,15 @@ def coarser_leg(request: PlanRequest, leg: Leg, factor: float) -> Leg | None:
     if s.size >= leg.problem.n:
         return None
     return leg_on_grid(request, leg.bound, s, lo, leg.v0, leg.a0, leg.vf, leg.af)
+
+
+def coarsenable(request: PlanRequest, leg: Leg) -> bool:
+    """Whether ``leg`` is on a jerk-limited default grid above :data:`MIN_NODES` nodes.
+
+    The legs :func:`coarser_leg` can rebuild coarser (without building the grid).
+    """
+    return (request.n is None and request.ds is None and request.jerk_limited
+            and leg.problem.n > MIN_NODES)
 
 
 def _default_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: float,

@@ -93,17 +93,19 @@ def _arriving(relax: RelaxationResult, unit: DiscreteProblem, backend: str) -> R
 
 
 def _relax_with_fallback(
-    unit: DiscreteProblem, backend: str
+    unit: DiscreteProblem, backend: str, fallback: bool = True
 ) -> tuple[RelaxationResult, str, str | None]:
     """Solve the relaxation; if the backend stalls, retry once with the other backend.
 
     Both are interior-point methods on the same SOCP, but they fail on different instances
     (Clarabel can stall at ``InsufficientProgress``, or stop ``AlmostSolved`` at a law that
-    does not arrive, on long, strongly graded grids).
+    does not arrive, on long, strongly graded grids). ``fallback=False``: no retry.
     """
     try:
         return _arriving(RELAXATION_BACKENDS[backend](unit), unit, backend), backend, None
     except SolverError as first:
+        if not fallback:
+            raise
         other = "banded" if backend == "clarabel" else "clarabel"
         try:
             return (_arriving(RELAXATION_BACKENDS[other](unit), unit, other), other,
@@ -116,9 +118,13 @@ def _relax_with_fallback(
 
 
 def solve_problem(
-    problem: DiscreteProblem, *, refine: str = "auto", backend: str = "clarabel"
+    problem: DiscreteProblem, *, refine: str = "auto", backend: str = "clarabel",
+    fallback: bool = True,
 ) -> DiscreteSolution:
     """Solve a validated :class:`DiscreteProblem` (any grid) and certify the result.
+
+    If the relaxation backend fails, the other one is tried, unless ``fallback`` is False
+    (:func:`speedplan.plan` first tries a coarser default grid with the same backend).
 
     Raises
     ------
@@ -150,7 +156,7 @@ def solve_problem(
     s_scale, w_scale = unit_scales(problem)
     time_scale = s_scale / np.sqrt(w_scale)
     unit = problem.scaled(s_scale, w_scale)
-    relax, backend, fallback_reason = _relax_with_fallback(unit, backend)
+    relax, backend, fallback_reason = _relax_with_fallback(unit, backend, fallback)
     w_relaxed = np.clip(relax.w * w_scale, 0.0, problem.w_max)
     w_relaxed[0], w_relaxed[-1] = problem.w_start, problem.w_end
     lower = min(relax.dual_objective, relax.primal_objective) * time_scale
@@ -185,8 +191,8 @@ def solve_problem(
             if ref_ok:
                 w, status = w_ref, "refined"
             else:
-                fallback = _scale_into_jerk_bounds(problem, w_relaxed)
-                if fallback is None:
+                scaled = _scale_into_jerk_bounds(problem, w_relaxed)
+                if scaled is None:
                     raise SolverError(
                         f"the relaxation is not exact (jerk violation {relaxed_violation:.3g}) "
                         f"and the refinement did not return a feasible point ({ref.status})",
@@ -197,7 +203,7 @@ def solve_problem(
                     "solution scaled into the jerk bounds (status 'scaled')",
                     SpeedplanWarning, stacklevel=3,
                 )
-                w, status = fallback, "scaled"
+                w, status = scaled, "scaled"
     elif not exact:
         warnings.warn(
             f"refine='never' and the relaxation is not exact: w violates jerk rows by up to "
