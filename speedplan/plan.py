@@ -157,7 +157,8 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
             "path (Path.from_waypoints with the default kind='g2') to drive through",
             SpeedplanWarning, stacklevel=3,
         )
-    legs = [_solve_default(modelled, leg) for leg in model.legs]
+    first = [_solve_default(modelled, leg) for leg in model.legs]
+    legs = [result for result, _ in first]
     profile = SpeedProfile(path=request.path, limits=request.limits, legs=tuple(legs),
                            speed_bound=model.bound, request=request)
     # Each leg is checked once per law it gets: the final verification merges these checks
@@ -183,6 +184,16 @@ def plan_request(request: PlanRequest) -> SpeedProfile:
         profile = replace(profile, legs=tuple(legs))
         for i in changed:
             leg_checks[i] = profile.check_leg(i)
+    # A leg planned on a coarser grid (its backend had stalled on the default one) whose law
+    # still exceeds a limit: the default grid with the other backend as well, if that law
+    # passes (seen on a zone path whose eighth grid left six steps for the last rest phase).
+    for i, (leg, (_, coarsened)) in enumerate(zip(model.legs, first, strict=True)):
+        if coarsened and not leg_checks[i].verification.ok:
+            with contextlib.suppress(SolverError):
+                trial = replace(profile, legs=(*legs[:i], _solve(leg), *legs[i + 1:]))
+                trial_check = trial.check_leg(i)
+                if trial_check.verification.ok:
+                    profile, legs, leg_checks[i] = trial, list(trial.legs), trial_check
     check = Verification.merged([c.verification for c in leg_checks])
     if not check.ok:
         worst = ", ".join(f"{k} {r:.3f}× at s={check.where.get(k, float('nan')):.4g} m"
@@ -261,7 +272,7 @@ def refine_factor(check: Verification) -> float:
     return float(np.clip(min(wanted, default=hi), lo, hi))
 
 
-def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> LegResult:
+def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> tuple[LegResult, bool]:
     """:func:`_solve`, on coarser default grids if the backend does not converge.
 
     Measured on slow-zone paths (``benchmarks/fuzz_zones.py``): both interior-point methods
@@ -270,10 +281,11 @@ def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> LegResult:
     grid to fail or to return a relaxation that needs IPOPT. So the backend alone is tried
     on the default grid and on the coarser ones (:data:`COARSER_GRIDS`), and only then the
     same grids with the other backend as well; the law is verified and refined locally like
-    any other. A user grid is never changed.
+    any other. A user grid is never changed. Returns the result and whether it came from a
+    coarser grid before the other backend was tried on the default one.
     """
     if not (isinstance(leg, Leg) and coarsenable(request, leg)):
-        return _solve(leg)
+        return _solve(leg), False
     grids: list[Leg] = [leg]
     for factor in COARSER_GRIDS:
         coarser = coarser_leg(request, leg, factor)
@@ -283,7 +295,7 @@ def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> LegResult:
     for fallback in (False, True):
         for grid in grids:
             try:
-                return _solve(grid, fallback=fallback)
+                return _solve(grid, fallback=fallback), not fallback and grid is not leg
             except SolverError as exc:
                 if fallback and grid is leg:
                     failure = exc
