@@ -286,16 +286,18 @@ def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> tuple[LegResul
     """
     if not (isinstance(leg, Leg) and coarsenable(request, leg)):
         return _solve(leg), False
-    grids: list[Leg] = [leg]
+    with contextlib.suppress(SolverError):
+        return _solve(leg, fallback=False), False
+    grids: list[Leg] = [leg]  # built only now: most default grids solve at once
     for factor in COARSER_GRIDS:
         coarser = coarser_leg(request, leg, factor)
         if coarser is None or coarser.problem.n >= grids[-1].problem.n:
             break
         grids.append(coarser)
     for fallback in (False, True):
-        for grid in grids:
+        for grid in grids if fallback else grids[1:]:
             try:
-                return _solve(grid, fallback=fallback), not fallback and grid is not leg
+                return _solve(grid, fallback=fallback), not fallback
             except SolverError as exc:
                 if fallback and grid is leg:
                     failure = exc
