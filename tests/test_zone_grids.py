@@ -33,29 +33,38 @@ def _straight_with_zone() -> tuple[Path, SpeedZone]:
     return path, zone
 
 
-@pytest.mark.slow
-def test_slow_zone_on_the_default_grid_plans_within_physics() -> None:
-    path, zone = _straight_with_zone()
-    prof = plan(path, LIM, zones=[zone])
+def _assert_physical(lim: Limits, length: float, entry: float, exit_: float,
+                     v_zone: float) -> None:
+    """Plan a straight with one zone on the default grid and judge it by physics.
+
+    Finite differences of the sampled trajectory, the speed inside the zone on the sampled
+    positions themselves (not through the speed bound), and two independent references: no
+    motion beats the exact no-jerk optimum, and a jerk-limited motion exists that takes
+    ruckig's fastest move to the zone at its speed, crosses it at that speed and leaves it
+    with ruckig's fastest stop (the optimum may enter braking and leave accelerating,
+    dipping below the zone's speed: a little faster).
+    """
+    path = Path.from_waypoints([[0.0, 0.0], [length, 0.0]], kind="polyline")
+    zone = SpeedZone([(entry, -1.0), (exit_, -1.0), (exit_, 1.0), (entry, 1.0)], v_max=v_zone)
+    prof = plan(path, lim, zones=[zone])
     assert prof.status in ("optimal", "refined")
     m = measure(prof)
     assert within_promise(m), m
-    # The zone, judged on the sampled positions themselves (not through the speed bound).
-    t = np.linspace(0.0, prof.duration, 200_001)
-    traj = prof.at(t)
-    inside = (traj.x >= ENTRY) & (traj.x <= EXIT)
-    assert traj.v[inside].max() <= V_ZONE * (1 + 1e-3)
-    # Between two independent references: no motion beats the exact no-jerk optimum, and a
-    # jerk-limited motion exists that takes ruckig's fastest move to the zone at its speed,
-    # crosses it at that speed and leaves it with ruckig's fastest stop (the optimum may
-    # enter braking and leave accelerating, dipping below the zone's speed: a little faster).
-    lower, _, _ = no_jerk_lower_bound(SpeedBound(path, LIM, [zone]), 1.0, LIM.a_max,
-                                      LIM.a_decel)
-    to_zone = ruckig_move(ENTRY, LIM, vf=V_ZONE).duration
-    from_zone = ruckig_move(1.0 - EXIT, LIM, v0=V_ZONE).duration
+    traj = prof.at(np.linspace(0.0, prof.duration, 200_001))
+    inside = (traj.x >= entry) & (traj.x <= exit_)
+    assert traj.v[inside].max() <= v_zone * (1 + 1e-3)
+    lower, _, _ = no_jerk_lower_bound(SpeedBound(path, lim, [zone]), length, lim.a_max,
+                                      lim.a_decel)
+    to_zone = ruckig_move(entry, lim, vf=v_zone).duration
+    from_zone = ruckig_move(length - exit_, lim, v0=v_zone).duration
     assert to_zone is not None and from_zone is not None
-    feasible = to_zone + (EXIT - ENTRY) / V_ZONE + from_zone
+    feasible = to_zone + (exit_ - entry) / v_zone + from_zone
     assert lower * (1 - 1e-9) <= prof.duration <= feasible * (1 + 1e-6)
+
+
+@pytest.mark.slow
+def test_slow_zone_on_the_default_grid_plans_within_physics() -> None:
+    _assert_physical(LIM, 1.0, ENTRY, EXIT, V_ZONE)
 
 
 def test_coarser_leg_has_half_the_nodes_and_keeps_the_grading() -> None:
@@ -96,19 +105,4 @@ def test_a_zone_slower_than_the_rest_phase_is_resolved() -> None:
     now applies only on the stretches next to the ends.
     """
     lim = Limits(v_max=14.6, a_max=4.42, a_lat_max=2.2, j_max=0.886)
-    length, entry, exit_, v_zone = 60.0, 38.0, 48.0, 0.0345
-    path = Path.from_waypoints([[0.0, 0.0], [length, 0.0]], kind="polyline")
-    zone = SpeedZone([(entry, -1.0), (exit_, -1.0), (exit_, 1.0), (entry, 1.0)], v_max=v_zone)
-    prof = plan(path, lim, zones=[zone])
-    assert prof.status in ("optimal", "refined")
-    assert within_promise(measure(prof))
-    traj = prof.at(np.linspace(0.0, prof.duration, 200_001))
-    inside = (traj.x >= entry) & (traj.x <= exit_)
-    assert traj.v[inside].max() <= v_zone * (1 + 1e-3)
-    lower, _, _ = no_jerk_lower_bound(SpeedBound(path, lim, [zone]), length, lim.a_max,
-                                      lim.a_decel)
-    to_zone = ruckig_move(entry, lim, vf=v_zone).duration
-    from_zone = ruckig_move(length - exit_, lim, v0=v_zone).duration
-    assert to_zone is not None and from_zone is not None
-    feasible = to_zone + (exit_ - entry) / v_zone + from_zone
-    assert lower * (1 - 1e-9) <= prof.duration <= feasible * (1 + 1e-6)
+    _assert_physical(lim, 60.0, 38.0, 48.0, 0.0345)
