@@ -267,3 +267,50 @@ def test_interpolated_inversion_equals_newton_to_rounding(weights):
     speed = np.linalg.norm(piece.curve(newton, 1), axis=1)
     err = np.abs(piece.parameter(s) - newton) * speed
     assert (err <= 4e-15 * p.length + 2 * speed * np.spacing(newton)).all()
+
+
+def _curvature_from_derivatives(piece, s):
+    """κ from ``r'`` and ``r''`` (independent de Boor) at the parameter Newton inverts."""
+    flat, j = piece._cell(s)
+    tau = piece._parameter(flat, j, rel_tol=0.0)
+    curve = piece.curve
+    k, t, w = curve.degree, curve.knots, curve.weights
+    homog = np.column_stack((curve.control_points * w[:, None], w))
+    # The derivative splines' control points (degrees k-1 and k-2) give r' and r'' without
+    # differencing; then the quotient rule.
+    d1c = k * (homog[1:] - homog[:-1]) / np.maximum(t[k + 1:-1] - t[1:-k - 1], 1e-300)[:, None]
+    d2c = (k - 1) * (d1c[1:] - d1c[:-1]) / np.maximum(t[k + 1:-2] - t[2:-k - 1], 1e-300)[:, None]
+    out = np.empty(tau.size)
+    for i, x in enumerate(tau):
+        p0, p1 = de_boor(k, t, homog, x), de_boor(k - 1, t[1:-1], d1c, x)
+        p2 = de_boor(k - 2, t[2:-2], d2c, x)
+        r = p0[:2] / p0[2]
+        r1 = (p1[:2] - r * p1[2]) / p0[2]
+        r2 = (p2[:2] - 2 * r1 * p1[2] - r * p2[2]) / p0[2]
+        out[i] = (r1[0] * r2[1] - r1[1] * r2[0]) / np.hypot(*r1) ** 3
+    return out
+
+
+@pytest.mark.parametrize("weights", [[1, 1, 1.2, 0.7, 1, 1.0], [1, 1e3, 1e-3, 1e3, 1e-3, 1]])
+def test_interpolated_curvature_equals_the_curvature_of_the_derivatives(weights):
+    # κ(u) is read from Chebyshev interpolants per cell; the oracle is the quotient rule on
+    # an independent de Boor evaluation of the derivative splines at Newton's parameter.
+    p = Path.from_nurbs(K, KNOTS, CTRL, np.asarray(weights, dtype=float))
+    piece = p.pieces[0]
+    s = np.concatenate(([0.0, p.length], np.random.default_rng(3).uniform(0, p.length, 400)))
+    oracle = _curvature_from_derivatives(piece, s)
+    scale = np.abs(oracle).max() + 1.0 / p.length
+    np.testing.assert_allclose(p.curvature(s), oracle, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_array_equal(p.evaluate(s)[2], p.curvature(s))
+
+
+def test_cells_whose_curvature_interpolant_fails_evaluate_the_curve(monkeypatch):
+    # A cell whose interpolant missed its check answers from the derivatives at each query.
+    p = Path.from_nurbs(K, KNOTS, CTRL, W)
+    piece = p.pieces[0]
+    s = np.random.default_rng(4).uniform(0, p.length, 300)
+    direct = piece._direct_curvature(s)
+    wrong = piece._kappa_coef + 1.0  # an interpolant that would be off everywhere
+    object.__setattr__(piece, "_kappa_coef", wrong)
+    object.__setattr__(piece, "_kappa_ok", np.zeros_like(piece._kappa_ok))
+    np.testing.assert_array_equal(p.curvature(s), direct)

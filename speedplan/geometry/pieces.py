@@ -52,6 +52,11 @@ _CHEB_HALVINGS = 8
 #: Accepted error of the interpolant, as an arc length ``|r'| |Δτ|``, in units of the
 #: curve's length (of 1 m if shorter): a few ulps (the inversion stops at ``1e-14``).
 _CHEB_TOLERANCE = 2e-15
+#: Accepted error of the curvature's interpolant on a cell, in units of the largest |κ| at
+#: its nodes plus 1 / length: a hundred times the rounding of the curvature computed from
+#: the derivatives (measured ~2e-15 on the sample NURBS); a cell above it evaluates the
+#: curve at every query.
+_KAPPA_TOLERANCE = 1e-13
 #: At most this many Newton steps on the Chebyshev interpolant of σ(τ) for the nodes of
 #: τ(u) (quadratic convergence from the linear guess: 4-5 reach rounding).
 _POLY_NEWTON_STEPS = 10
@@ -185,7 +190,9 @@ class CurvePiece(Piece):
     bracketing table cell, so ``point(u)`` moves at unit speed. Queries use a degree-16
     Chebyshev interpolant of ``τ(u)`` per cell instead, built at construction and checked
     against the 16-point rule between its nodes (cells halved until it agrees to a few ulps,
-    see :meth:`_interpolate`): one Clenshaw sum and one curve evaluation per query.
+    see :meth:`_interpolate`): one Clenshaw sum and one curve evaluation per query. The
+    curvature has its own interpolants on the same cells (:meth:`_interpolate_curvature`):
+    a curvature query is one Clenshaw sum.
     """
 
     curve: ParametricCurve
@@ -203,6 +210,10 @@ class CurvePiece(Piece):
     _cheb_tau: FloatArray = field(init=False, repr=False)
     _cheb_coef: FloatArray = field(init=False, repr=False)
     _cheb_ok: npt.NDArray[np.bool_] = field(init=False, repr=False)
+    # Chebyshev interpolants of κ(u) on the same cells (one row per degree, one column per
+    # cell) and whether each is accurate (else the curve is evaluated per query).
+    _kappa_coef: FloatArray = field(init=False, repr=False)
+    _kappa_ok: npt.NDArray[np.bool_] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "direction", as_direction("direction", self.direction))
@@ -269,6 +280,34 @@ class CurvePiece(Piece):
         set_(self, "_cheb_tau", np.column_stack((lo[order], hi[order])))
         set_(self, "_cheb_coef", np.ascontiguousarray(coef[order].T))
         set_(self, "_cheb_ok", ok[order])
+        self._interpolate_curvature()
+
+    def _interpolate_curvature(self) -> None:
+        """Chebyshev interpolants of ``κ(u)`` on the cells of ``τ(u)``'s interpolants.
+
+        A curvature query on a spline or NURBS path then costs one Clenshaw sum instead of an
+        inversion and three derivative evaluations; ``plan()`` evaluates the curvature at
+        eight points per grid interval. Each interpolant is checked halfway between its nodes
+        against the curvature from the derivatives and kept within ``_KAPPA_TOLERANCE``.
+        """
+        u0, u1 = self._cheb_u[:-1], self._cheb_u[1:]
+        half = 0.5 * (u1 - u0)
+        m = _CHEB_CHECKS.size
+        # A curve of zero length (refused by its constructor after this) or with |r'| = 0
+        # gives NaN here: such a cell fails its check and keeps the direct evaluation.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            kappa = self._direct_curvature(
+                (u0[:, None] + half[:, None] * (_CHEB_POINTS[None, :] + 1.0)).ravel()
+            ).reshape(u0.size, -1)
+            coef = kappa @ _CHEB_MATRIX.T
+            checks = self._direct_curvature(
+                (u0[:, None] + half[:, None] * (_CHEB_CHECKS[None, :] + 1.0)).ravel())
+            got = _clenshaw(np.repeat(coef, m, axis=0), np.tile(_CHEB_CHECKS, u0.size))
+            scale = np.abs(kappa).max(axis=1) + 1.0 / max(self.length, 1e-300)
+            err = np.abs(got - checks).reshape(-1, m).max(axis=1)
+        set_ = object.__setattr__
+        set_(self, "_kappa_coef", np.ascontiguousarray(coef.T))
+        set_(self, "_kappa_ok", err <= _KAPPA_TOLERANCE * scale)
 
     def _fit_cells(self, u_lo: FloatArray, u_hi: FloatArray, t_lo: FloatArray,
                    t_hi: FloatArray, tol: float) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
@@ -452,13 +491,13 @@ class CurvePiece(Piece):
         shape = np.shape(u)
         flat, j = self._cell(u)
         tau = self._interpolated(flat, j)
-        r, d1, d2 = self._derivatives(tau)
+        r, d1, _ = self._derivatives(tau)
         raw = np.arctan2(d1[:, 1], d1[:, 0]) + (np.pi if self.direction < 0 else 0.0)
         # Nearest 2π-branch to the heading interpolated in the table cell.
         w = (flat - self._arc[j]) / np.maximum(self._arc[j + 1] - self._arc[j], 1e-300)
         ref = (1.0 - w) * self._theta[j] + w * self._theta[j + 1]
         theta = raw + 2.0 * np.pi * np.round((ref - raw) / (2.0 * np.pi))
-        kappa = _signed_curvature(d1, d2)
+        kappa = self.curvature(flat)  # the interpolant: the same numbers as curvature()
         return r.reshape(*shape, 2), theta.reshape(shape), kappa.reshape(shape)
 
     def _derivatives(self, tau: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -478,10 +517,23 @@ class CurvePiece(Piece):
         return self.evaluate(u)[1]
 
     def curvature(self, u: FloatArray) -> FloatArray:
-        """``(x'y'' - y'x'') / |r'|³`` [1/m] (without the headings of :meth:`evaluate`)."""
-        tau = self._interpolated(*self._cell(u))
+        """``(x'y'' - y'x'') / |r'|³`` [1/m], from the cells' interpolants of ``κ(u)``."""
+        flat = np.clip(np.asarray(u, dtype=np.float64).ravel(), 0.0, self.length)
+        c = np.clip(np.searchsorted(self._cheb_u, flat, side="right") - 1, 0,
+                    self._cheb_u.size - 2)
+        u0, u1 = self._cheb_u[c], self._cheb_u[c + 1]
+        x = np.clip(2.0 * (flat - u0) / np.maximum(u1 - u0, 1e-300) - 1.0, -1.0, 1.0)
+        kappa = _clenshaw_t(self._kappa_coef[:, c], x)
+        direct = ~self._kappa_ok[c]
+        if direct.any():
+            kappa[direct] = self._direct_curvature(flat[direct])
+        return kappa.reshape(np.shape(u))
+
+    def _direct_curvature(self, flat: FloatArray) -> FloatArray:
+        """The curvature from ``r'`` and ``r''`` at the inverted parameters of ``flat``."""
+        tau = self._interpolated(*self._cell(flat))
         _, d1, d2 = self._derivatives(tau)
-        return _signed_curvature(d1, d2).reshape(np.shape(u))
+        return _signed_curvature(d1, d2)
 
     def curvature_rate(self, u: FloatArray) -> FloatArray:
         """The central difference of :meth:`Piece.curvature_rate`, both sides in one query."""
