@@ -15,12 +15,20 @@ Modules, one job each:
   spline, rounded polyline) and their options;
 * :mod:`~speedplan.geometry.nurbs` — NURBS (VDA 5050 ``trajectory``);
 * :mod:`~speedplan.geometry.bounds` — :func:`speed_bounds` ``mu+(s)``, :class:`SpeedBound`,
-  :class:`SpeedZone`, :class:`SpanLimit`, :func:`zone_intervals`.
+  :class:`SpeedZone`, :class:`SpanLimit`, :func:`zone_intervals`,
+  :func:`bound_breakpoints`.
 
 This layer imports only ``errors``, ``_checks`` and ``limits``.
 """
 
-from .bounds import SpanLimit, SpeedBound, SpeedZone, speed_bounds, zone_intervals
+from .bounds import (
+    SpanLimit,
+    SpeedBound,
+    SpeedZone,
+    bound_breakpoints,
+    speed_bounds,
+    zone_intervals,
+)
 from .path import Arc, Clothoid, Line, Path, PathSamples
 
 __all__ = [
@@ -32,6 +40,7 @@ __all__ = [
     "SpanLimit",
     "SpeedBound",
     "SpeedZone",
+    "bound_breakpoints",
     "speed_bounds",
     "zone_intervals",
 ]

@@ -15,8 +15,8 @@ from ..core.errors import InvalidInputError
 from ..core.limits import Limits
 from .path import Path
 
-__all__ = ["SpanLimit", "SpeedBound", "SpeedZone", "check_spans", "check_zones", "speed_bounds",
-           "zone_intervals"]
+__all__ = ["ZONE_RESCAN", "SpanLimit", "SpeedBound", "SpeedZone", "bound_breakpoints",
+           "check_spans", "check_zones", "speed_bounds", "zone_intervals"]
 
 
 @dataclass(frozen=True)
@@ -382,6 +382,9 @@ def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:
     return sk, vk
 
 
+#: Points per scan step of :func:`zone_intervals` where the path, outside a zone at both
+#: ends of the step, comes within one step of it.
+ZONE_RESCAN = 64
 #: Bisection steps of :func:`zone_intervals` per path query (2**depth - 1 points a bracket).
 _BISECT_DEPTH = 5
 
@@ -392,8 +395,11 @@ def zone_intervals(
     """Where the path is inside each zone: ``[(s_enter, s_exit, v_max), ...]`` sorted by entry.
 
     A point on the polygon boundary counts as inside. Membership is scanned on a grid of
-    spacing ``max(0.01 m, length / 200000)``; every change is then located by bisection to
-    ``tol`` metres (excursions shorter than the grid spacing may be missed). A path starting
+    spacing ``max(0.01 m, length / 200000)``; the steps between two points outside that
+    come within one step of the polygon are scanned again, :data:`ZONE_RESCAN` times finer
+    (a zone corner or a narrow zone crossed between two points); every change is then
+    located by bisection to ``tol`` metres (an excursion shorter than the finer spacing may
+    still be missed). A path starting
     (ending) inside a zone enters at 0 (leaves at ``length``). The result is remembered per
     path and zones (both immutable): every plan with zones checks its law at these points.
 
@@ -454,6 +460,11 @@ def _zone_intervals(path: Path, zone_list: list[SpeedZone], tol: float
         # Bisect every bracket at once; invariant: flags at a differ from flags at b.
         a, b = s[change], s[change + 1]
         entering = flags[change + 1]
+        ra, rb, rent = _rescanned(path, zone, s, xy, flags)
+        if ra.size:
+            a, b, entering = (np.concatenate(x) for x in ((a, ra), (b, rb), (entering, rent)))
+            order = np.argsort(a, kind="stable")
+            a, b, entering = a[order], b[order], entering[order]
         steps = int(np.ceil(np.log2(max(s[1], tol) / tol))) + 1
         while steps > 0 and a.size:
             # Several bisection steps per path query: every midpoint the next `depth` steps
@@ -486,6 +497,66 @@ def _zone_intervals(path: Path, zone_list: list[SpeedZone], tol: float
         exits = list(a[~entering]) + ([L] if flags[-1] else [])
         out.extend((float(e), float(x), zone.v_max) for e, x in zip(enters, exits, strict=True))
     return sorted(out)
+
+
+def _rescanned(path: Path, zone: SpeedZone, s: FloatArray, xy: FloatArray,
+               flags: np.ndarray) -> tuple[FloatArray, FloatArray, np.ndarray]:
+    """Brackets ``(a, b, entering)`` of crossings between two scan points outside ``zone``.
+
+    Only steps with both ends outside and an end within one step of the polygon (a bounding
+    box test first, then the distance) are scanned again, :data:`ZONE_RESCAN` points each.
+    """
+    step = float(s[1] - s[0])
+    x0, y0, x1, y1 = zone.polygon.bounds
+    near = (~flags & (xy[:, 0] >= x0 - step) & (xy[:, 0] <= x1 + step)
+            & (xy[:, 1] >= y0 - step) & (xy[:, 1] <= y1 + step))
+    idx = np.flatnonzero(near)
+    if idx.size:
+        idx = idx[shapely.dwithin(zone.polygon, shapely.points(xy[idx]), step)]
+    cells = np.union1d(idx[idx < s.size - 1], idx[idx > 0] - 1)
+    cells = cells[~flags[cells] & ~flags[cells + 1]]
+    empty = np.zeros(0)
+    if cells.size == 0:
+        return empty, empty, np.zeros(0, dtype=bool)
+    fine = s[cells, None] + step * np.linspace(0.0, 1.0, ZONE_RESCAN + 1)[None, :]
+    p = path.point(fine.ravel())
+    inside = shapely.intersects_xy(zone.polygon, p[:, 0], p[:, 1]).reshape(fine.shape)
+    row, col = np.nonzero(inside[:, 1:] != inside[:, :-1])
+    return fine[row, col], fine[row, col + 1], inside[row, col + 1]
+
+
+def bound_breakpoints(path: Path, bound: Any) -> FloatArray:
+    """Arc lengths [m] where the speed bound ``bound`` may have a kink, a step or a dip.
+
+    The joins of the path's pieces (where the curvature may jump or change its law: the
+    extremes of a clothoid chain's curvature lie there) and, for a :class:`SpeedBound`, the
+    knots of its ``v_limit`` (piecewise linear: its minimum over any stretch is at a knot or
+    an end), the ends of its spans and the entries and exits of its zones
+    (:func:`zone_intervals`, located to 1e-9 m on the inside). In the bound's own arc length
+    (the path's minus :attr:`SpeedBound.offset`), sorted, within the path.
+
+    Examples
+    --------
+    >>> from speedplan import Limits
+    >>> from speedplan.geometry import Arc, Line, Path, SpeedBound, bound_breakpoints
+    >>> p = Path.from_segments([Line(5.0), Arc(radius=2.0, angle=1.0)])
+    >>> lim = Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
+    >>> bound_breakpoints(p, SpeedBound(p, lim, v_limit=([1.0, 2.0], [2.0, 1.0]))).tolist()
+    [1.0, 2.0, 5.0]
+    """
+    parts = [np.asarray(path.offsets[1:-1], dtype=np.float64)]
+    shift = 0.0
+    if isinstance(bound, SpeedBound):
+        shift = bound.offset  # the bound reads the path at s + offset
+        if bound.v_limit is not None:
+            parts.append(_check_v_limit(bound.v_limit)[0])
+        parts += [np.array([span.start, span.end]) for span in bound.spans]
+        if bound.zones:
+            cuts = zone_intervals(bound.path, bound.zones)
+            parts.append(np.array([x for a, b, _ in cuts for x in (a, b)]))
+    out = np.unique(np.concatenate(parts))
+    out = out[(out >= shift) & (out <= path.length)] - shift
+    return out
 
 
 def check_zones(zones: Any) -> list[SpeedZone]:

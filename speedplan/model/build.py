@@ -19,7 +19,7 @@ import numpy as np
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
 from ..core.limits import Limits
-from ..geometry import Path, SpeedBound
+from ..geometry import Path, SpeedBound, bound_breakpoints
 from ..solve import DiscreteProblem, DiscreteSolution, solve_problem
 from ..solve.banded import MAX_RAMP_STEPS, ramp_steps
 from ..solve.nojerk import max_feasible_w
@@ -376,7 +376,8 @@ def _default_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: fl
                          a_decel=lim.a_decel, v_max=lim.v_max, j_max=lim.j_max,
                          w_start=v0**2, w_end=vf**2,
                          v_low=min((v for v in low if v > 0), default=None),
-                         anchors=grid_anchors(request, lo, hi), max_nodes=max_nodes)
+                         anchors=grid_anchors(request, lo, hi), max_nodes=max_nodes,
+                         breakpoints=bound_breakpoints(request.path, leg_bound))
 
 
 def _no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: float,

@@ -21,8 +21,8 @@ import numpy as np
 from ..core.checks import FloatArray
 from ..core.forward import Forwarded
 from ..core.limits import Limits
-from ..geometry import Path, SpeedBound, zone_intervals
-from ..geometry.bounds import _check_v_limit
+from ..geometry import Path, SpeedBound
+from ..geometry.bounds import bound_breakpoints
 from .law import TimeLaw
 
 __all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "Verification",
@@ -143,37 +143,6 @@ def curvature_rate(path: Path, s: FloatArray) -> FloatArray:
     out: FloatArray = (both[:hi.size].reshape(hi.shape) - both[hi.size:].reshape(lo.shape)) / (
         hi - lo)
     return out
-
-
-def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> FloatArray:
-    """Arc lengths [m] of ``path`` where the speed bound may have a kink, a step or a dip.
-
-    The joins of the path's pieces (where the curvature may jump or change its law) and, for
-    a :class:`~speedplan.geometry.SpeedBound`, the knots of its ``v_limit`` (piecewise
-    linear: its minimum over any stretch is at a knot or an end), the ends of its spans and
-    the entries and exits of its zones (:func:`~speedplan.geometry.zone_intervals`, located
-    to 1e-9 m on the inside). Sorted, within ``[0, path.length]``.
-
-    Examples
-    --------
-    >>> from speedplan import Limits
-    >>> from speedplan.geometry import Arc, Line, Path, SpeedBound
-    >>> p = Path.from_segments([Line(5.0), Arc(radius=2.0, angle=1.0)])
-    >>> lim = Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
-    >>> bound_breakpoints(p, SpeedBound(p, lim, v_limit=([1.0, 2.0], [2.0, 1.0]))).tolist()
-    [1.0, 2.0, 5.0]
-    """
-    parts = [np.asarray(path.offsets[1:-1], dtype=np.float64)]
-    if isinstance(bound, SpeedBound):
-        shift = bound.offset  # the bound reads the path at s + offset
-        if bound.v_limit is not None:
-            parts.append(_check_v_limit(bound.v_limit)[0] - shift)
-        parts += [np.array([span.start, span.end]) - shift for span in bound.spans]
-        if bound.zones:
-            cuts = zone_intervals(bound.path, bound.zones)
-            parts.append(np.array([x for a, b, _ in cuts for x in (a, b)]) - shift)
-    out = np.unique(np.concatenate(parts))
-    return out[(out >= 0.0) & (out <= path.length)]
 
 
 def check_law(law: TimeLaw, offset: float, path: Path,
