@@ -85,3 +85,50 @@ def test_a_zone_narrower_than_the_membership_scan_is_respected() -> None:
     assert to_zone is not None and from_zone is not None
     feasible = to_zone + width / v_zone + from_zone
     assert lower * (1 - 1e-9) <= prof.duration <= feasible * (1 + 1e-6)
+
+
+def _no_jerk_optimum_line_arc_line(before: float, arc: float, after: float, w_arc: float,
+                                   lim: Limits) -> float:
+    """Exact minimum time without a jerk limit, rest to rest, over line - arc - line.
+
+    The fastest ``w`` is the minimum of ``v_max²``, the acceleration cones from both rests
+    and from the arc, and ``w_arc`` on the arc: piecewise linear in ``s``, so on a grid that
+    holds every kink ``2 h / (v_0 + v_1)`` per step is exact.
+    """
+    total = before + arc + after
+    a, d, top = 2 * lim.a_max, 2 * lim.a_decel, lim.v_max**2
+    end = before + arc
+
+    def w(s: np.ndarray) -> np.ndarray:
+        on = (s >= before) & (s <= end)
+        cone = np.where(s < before, w_arc + d * (before - s), w_arc + a * (s - end))
+        return np.where(on, w_arc, np.minimum.reduce([np.full(s.shape, top), a * s,
+                                                      d * (total - s), cone]))
+
+    kinks = [top / a, before - (top - w_arc) / d, end + (top - w_arc) / a, total - top / d,
+             (w_arc + d * before) / (a + d), (d * total + a * end - w_arc) / (a + d)]
+    s = np.union1d(np.linspace(0.0, total, 200_001), [before, end, *kinks])
+    s = s[(s >= 0) & (s <= total)]
+    v = np.sqrt(w(s))
+    return float(np.sum(2 * np.diff(s) / (v[1:] + v[:-1])))
+
+
+def test_a_hairpin_narrower_than_a_no_jerk_grid_step_is_cut_out() -> None:
+    # A 0.55 mm arc 1.7 km along a 1.9 km path, no jerk limit (found by a hairpin fuzz:
+    # limits_exceeded, 18x the speed on the arc, after the grid's refinements).
+    before, radius, angle, total = 1711.0, 0.00117, 0.47, 1912.0
+    lim = Limits(v_max=0.7955, a_max=0.1442, a_lat_max=1.657, j_max=np.inf)
+    path = Path.from_segments([Line(before), Arc(radius=radius, angle=angle),
+                               Line(total - before - radius * angle)])
+    prof = plan(path, lim)
+    assert prof.status == "optimal", prof.verification
+    w_arc = min(lim.a_lat_max * radius, lim.v_max**2)
+    exact = _no_jerk_optimum_line_arc_line(before, radius * angle,
+                                           total - before - radius * angle, w_arc, lim)
+    assert exact * (1 - 1e-9) <= prof.duration <= exact * (1 + 1e-3)
+    coarse = prof.at(np.linspace(0.0, prof.duration, 100_001))
+    t_arc = float(np.interp(before, coarse.s, coarse.t))
+    near = prof.at(np.linspace(t_arc - 0.5, t_arc + 0.5, 100_001))
+    on_arc = (near.s >= before) & (near.s <= before + radius * angle)
+    assert on_arc.sum() > 10
+    assert near.v[on_arc].max() <= np.sqrt(w_arc) * (1 + 1e-3)

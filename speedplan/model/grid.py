@@ -42,6 +42,7 @@ __all__ = [
     "DEFAULT_PER_PHASE",
     "END_PER_PHASE",
     "GRADING",
+    "HIDDEN_DIP",
     "MAX_DEFAULT_NODES",
     "MIN_ANCHOR_NODES",
     "MIN_NODES",
@@ -49,6 +50,7 @@ __all__ = [
     "adaptive_grid",
     "graded_ends",
     "graded_steps",
+    "hidden_dips",
     "nodes_from_steps",
     "rest_phase_length",
     "uniform_grid",
@@ -367,7 +369,7 @@ def adaptive_grid(
                                    inner_anchors)))
     sf = sf[(sf >= 0.0) & (sf <= length)]
     if breakpoints is not None:
-        sf = np.union1d(sf, _hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
+        sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
     h = steps(sf)
     for _ in range(3):
         cell = np.diff(sf)
@@ -400,14 +402,16 @@ def adaptive_grid(
 HIDDEN_DIP = 1.0 - 1e-3
 
 
-def _hidden_dips(sf: FloatArray, breaks: FloatArray,
-                 w_bound: Callable[[FloatArray], FloatArray]) -> FloatArray:
+def hidden_dips(sf: FloatArray, breaks: FloatArray,
+                w_bound: Callable[[FloatArray], FloatArray], cells: bool = False) -> FloatArray:
     """The ``breaks`` inside ``(sf[0], sf[-1])`` where the bound dips between scan points.
 
     Measured (zone fuzz seed 3, case 51): a 9 cm hairpin on a 4.5 km path, a bound of
     0.29 m/s for 0.3 m between scan points 0.97 m apart, got 45 m steps; its law exceeded
     ``j_max`` 1.76x after three refinements. Only such dips are added: on the sample paths a
     scan point at every join of the pieces made the default grids no finer, and changed them.
+    With ``cells=True``, every breakpoint in a scan step that holds such a dip (the dip's
+    other edge: the end of a hairpin's arc, a narrow zone's exit).
     """
     breaks = breaks[(breaks > sf[0]) & (breaks < sf[-1])]
     if breaks.size == 0:
@@ -415,7 +419,10 @@ def _hidden_dips(sf: FloatArray, breaks: FloatArray,
     k = np.clip(np.searchsorted(sf, breaks), 1, sf.size - 1)
     wb = w_bound(np.concatenate((breaks, sf[k - 1], sf[k])))
     at, left, right = np.split(wb, 3)
-    out: FloatArray = breaks[at < HIDDEN_DIP * np.minimum(left, right)]
+    dip = at < HIDDEN_DIP * np.minimum(left, right)
+    if cells:
+        dip = np.isin(k, k[dip])
+    out: FloatArray = breaks[dip]
     return out
 
 
