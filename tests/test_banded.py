@@ -201,35 +201,35 @@ def _newton_state(seed: int):
     d, _ = _prepare(unit, _positive_feasible(unit)[1:-1])
     lay = d.lay
     rng = np.random.default_rng(seed)
-
-    def cone_interior():
-        u = rng.normal(size=(3, lay.nc))
-        u[0] = np.hypot(u[1], u[2]) * (1.0 + 10.0 ** rng.uniform(-2, 0, lay.nc))
-        return u
-
     pt = ipm.empty(ipm.Point, lay)
     pt.sl[:], pt.yl[:] = 10.0 ** rng.uniform(-2, 2, (2, lay.n_lin))
-    pt.ss[:], pt.ys[:] = cone_interior(), cone_interior()
+    # Both cones of every node strictly interior: z² < w and t z > 1.
+    pt.w[:] = 10.0 ** rng.uniform(-1, 1, lay.m)
+    pt.z[:] = np.sqrt(pt.w) * rng.uniform(0.05, 0.95, lay.m)
+    pt.t[:] = (1.0 + 10.0 ** rng.uniform(-2, 0, lay.m)) / pt.z
+    pt.ys[:] = rng.normal(size=(3, lay.nc))
+    pt.ys[0] = np.hypot(pt.ys[1], pt.ys[2]) * (1.0 + 10.0 ** rng.uniform(-2, 0, lay.nc))
     sc = ipm.Scaling.identity(lay)
-    ipm.scaling_into(pt.ss, pt.ys, sc)
+    ipm.scaling_into(pt, sc)
     fac = ipm.empty(ipm.Factor, lay)
     assert ipm.factor_into(d, sc, pt.yl, pt.sl, fac)
-    res, rhs = ipm.empty(ipm.Residual, lay), ipm.empty(ipm.Rhs, lay)
-    for arr in (*res, *rhs):
+    res = ipm.empty(ipm.Residual, lay)
+    for arr in res:
         arr[:] = rng.normal(size=arr.shape)
-    return ipm, d, sc, fac, pt, res, rhs
+    return ipm, d, sc, fac, pt, res, float(rng.normal())
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_newton_refines_only_above_its_residual_threshold(seed):
     # One round of iterative refinement runs iff the residual of G'Δy = bx exceeds
     # refine_above; below the threshold the unrefined direction is returned as it is.
-    ipm, d, sc, fac, pt, res, rhs = _newton_state(seed)
+    ipm, d, sc, fac, pt, res, rp = _newton_state(seed)
     lay = d.lay
 
     def direction(refine_above):
         dn = ipm.empty(ipm.Direction, lay)
-        ipm.newton_into(d, sc, fac, ipm.empty(ipm.Work, lay), pt, res, rhs, refine_above, dn)
+        ipm.newton_into(d, sc, fac, ipm.empty(ipm.Work, lay), pt, res, rp, False, 0.0,
+                        refine_above, dn)
         gx = (np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m))
         ipm.g_adjoint_into(d, dn.dyl, dn.dys, *gx)
         residual = np.sqrt(sum(float(np.sum((b - g) ** 2))

@@ -165,7 +165,8 @@ def test_nesterov_todd_scaling_identities(seed):
     s, y = _interior_cones(rng, nc), _interior_cones(rng, nc)
     lay = ipm.layout(nc // 2, 0, 0)
     sc = ipm.Scaling.identity(lay)
-    ipm.scaling_into(s, y, sc)
+    for c in range(nc):
+        ipm.cone_scaling_into(sc, c, *s[:, c], *y[:, c])
     for c in range(nc):
         w = _w_matrix(sc, c)
         lam = np.array(ipm._lambda(sc, y, c))
@@ -181,16 +182,32 @@ def test_nesterov_todd_scaling_identities(seed):
                                        rtol=1e-9, atol=1e-12 * np.abs(h).max())
 
 
+def _interior_x(rng: np.random.Generator, m: int) -> tuple[np.ndarray, ...]:
+    """``(w, t, z)`` with both cones of every node strictly interior: ``z² < w``, ``t z > 1``."""
+    w = 10.0 ** rng.uniform(-1, 1, m)
+    z = np.sqrt(w) * rng.uniform(0.05, 0.95, m)
+    t = (1.0 + 10.0 ** rng.uniform(-3, 0, m)) / z
+    return w, t, z
+
+
+def _b_soc(m: int) -> np.ndarray:
+    """Constant part of the cone rows: ``(1, 0, -1)`` per node cone, ``(0, 0, 2)`` per t-z cone."""
+    b = np.zeros((3, 2 * m))
+    b[0, :m], b[2, :m], b[2, m:] = 1.0, -1.0, 2.0
+    return b
+
+
 def _random_state(seed: int):
     """A factored Newton system at a random interior point of the seed's problem."""
     unit, d = _setup(seed)
     lay = d.lay
     rng = np.random.default_rng(100 + seed)
     pt = ipm.empty(ipm.Point, lay)
+    pt.w[:], pt.t[:], pt.z[:] = _interior_x(rng, lay.m)
     pt.sl[:], pt.yl[:] = 10.0 ** rng.uniform(-1, 1, (2, lay.n_lin))
-    pt.ss[:], pt.ys[:] = _interior_cones(rng, lay.nc), _interior_cones(rng, lay.nc)
+    pt.ys[:] = _interior_cones(rng, lay.nc)
     sc = ipm.Scaling.identity(lay)
-    ipm.scaling_into(pt.ss, pt.ys, sc)
+    ipm.scaling_into(pt, sc)
     fac = ipm.empty(ipm.Factor, lay)
     assert ipm.factor_into(d, sc, pt.yl, pt.sl, fac)
     g_lin, g_soc = _dense_g(unit, d)
@@ -200,6 +217,25 @@ def _random_state(seed: int):
                                         for c in range(lay.nc)))
     k_mat = g_lin.T @ np.diag(pt.yl / pt.sl) @ g_lin + g_cones.T @ h_cones @ g_cones
     return d, pt, sc, fac, g_lin, g_soc, k_mat, rng
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_cone_slacks_are_b_minus_g_x(seed):
+    # The kernel keeps no cone slacks: s = b - G x and Δs = -G Δx, against the dense G.
+    d, pt, sc, _, _, g_soc, _, rng = _random_state(seed)
+    lay = d.lay
+    x = np.concatenate((pt.w, pt.t, pt.z))
+    dx = rng.normal(size=3 * lay.m)
+    s_ref, ds_ref = _b_soc(lay.m) - g_soc @ x, -(g_soc @ dx)
+    dw, dt, dz = np.split(dx, 3)
+    for c in range(lay.nc):
+        np.testing.assert_allclose(ipm._cone_s(pt.w, pt.t, pt.z, c), s_ref[:, c], rtol=1e-14)
+        np.testing.assert_allclose(ipm._cone_ds(dw, dt, dz, c), ds_ref[:, c], rtol=1e-14)
+    # The scaling is the one of those slacks: W⁻¹ s = W y.
+    for c in range(lay.nc):
+        w = _w_matrix(sc, c)
+        np.testing.assert_allclose(np.linalg.solve(w, s_ref[:, c]), w @ pt.ys[:, c],
+                                   rtol=1e-9, atol=1e-12)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -234,18 +270,31 @@ def test_normal_equations_solve_matches_a_dense_solve(seed):
                                atol=1e-10 * np.abs(x).max())
 
 
+def _jordan(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The Jordan product ``u ∘ v`` of one second-order cone."""
+    return np.array([u @ v, u[0] * v[1] + v[0] * u[1], u[0] * v[2] + v[0] * u[2]])
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 @pytest.mark.parametrize("refine_above", [np.inf, 0.0])
-def test_newton_direction_solves_the_full_kkt_system(seed, refine_above):
-    # G'Δy = bx, GΔx + Δs = by, λ ∘ (WΔy + W⁻¹Δs) = bs, solved densely.
+@pytest.mark.parametrize("corrector", [False, True])
+def test_newton_direction_solves_the_full_kkt_system(seed, refine_above, corrector):
+    # G'Δy = bx, GΔx + Δs = by, λ ∘ (WΔy + W⁻¹Δs) = bs, solved densely. by is the scalar rp
+    # on the linear rows and 0 on the cones; bs is -λ∘λ (predictor) or Mehrotra's
+    # -λ∘λ - (W⁻¹Δs_a) ∘ (WΔy_a) + σμ e for a given predictor direction (corrector).
     d, pt, sc, fac, g_lin, g_soc, _, rng = _random_state(seed)
     lay = d.lay
     m, nl, nc = lay.m, lay.n_lin, lay.nc
-    res, rhs = ipm.empty(ipm.Residual, lay), ipm.empty(ipm.Rhs, lay)
-    for arr in (*res, *rhs):
+    res = ipm.empty(ipm.Residual, lay)
+    for arr in res:
         arr[:] = rng.normal(size=arr.shape)
+    rp, sigma_mu = float(rng.normal()), float(10.0 ** rng.uniform(-2, 0))
     dn = ipm.empty(ipm.Direction, lay)
-    ipm.newton_into(d, sc, fac, ipm.empty(ipm.Work, lay), pt, res, rhs, refine_above, dn)
+    for arr in dn:  # the predictor's direction, read by the corrector
+        arr[:] = rng.normal(size=arr.shape)
+    pred = [np.copy(a) for a in dn]
+    ipm.newton_into(d, sc, fac, ipm.empty(ipm.Work, lay), pt, res, rp, corrector, sigma_mu,
+                    refine_above, dn)
     # Unknowns: Δx (3m), Δs_lin (nl), Δs_soc (3 nc, cone-major), Δy_lin, Δy_soc.
     g_cones = np.concatenate([g_soc[:, c, :] for c in range(nc)])
     nx, ns = 3 * m, nl + 3 * nc
@@ -256,20 +305,66 @@ def test_newton_direction_solves_the_full_kkt_system(seed, refine_above):
     rhs_vec[:nx] = np.concatenate((res.gw, res.gt, res.gz))
     kkt[nx : nx + ns, :nx] = g
     kkt[nx : nx + ns, nx : nx + ns] = np.eye(ns)
-    rhs_vec[nx : nx + ns] = np.concatenate((res.ryl, res.rys.T.ravel()))
+    rhs_vec[nx : nx + nl] = rp
     row = nx + ns
     # Linear rows: λ = sqrt(s y), W = sqrt(s / y): λ (W Δy + Δs / W) = y Δs + s Δy.
     kkt[row : row + nl, nx : nx + nl] = np.diag(pt.yl)
     kkt[row : row + nl, nx + ns : nx + ns + nl] = np.diag(pt.sl)
-    rhs_vec[row : row + nl] = rhs.bsl
+    rhs_vec[row : row + nl] = -pt.sl * pt.yl
+    if corrector:
+        rhs_vec[row : row + nl] += sigma_mu - pred[3] * pred[4]
+    ds_pred = -(g_soc @ np.concatenate(pred[:3]))
     for c in range(nc):
         w = _w_matrix(sc, c)
         lam = w @ pt.ys[:, c]
         r0 = row + nl + 3 * c
         kkt[r0 : r0 + 3, nx + nl + 3 * c : nx + nl + 3 * c + 3] = _arrow(lam) @ np.linalg.inv(w)
         kkt[r0 : r0 + 3, nx + ns + nl + 3 * c : nx + ns + nl + 3 * c + 3] = _arrow(lam) @ w
-        rhs_vec[r0 : r0 + 3] = rhs.bss[:, c]
+        rhs_vec[r0 : r0 + 3] = -_jordan(lam, lam)
+        if corrector:
+            rhs_vec[r0 : r0 + 3] += sigma_mu * np.array([1.0, 0.0, 0.0]) - _jordan(
+                np.linalg.solve(w, ds_pred[:, c]), w @ pred[5][:, c])
     sol = np.linalg.solve(kkt, rhs_vec)
-    got = np.concatenate((dn.dw, dn.dt, dn.dz, dn.dsl, dn.dss.T.ravel(), dn.dyl,
-                          dn.dys.T.ravel()))
+    dx = np.concatenate((dn.dw, dn.dt, dn.dz))
+    ds_soc = -(g_soc @ dx)  # the kernel's implied Δs of the cones
+    got = np.concatenate((dx, dn.dsl, ds_soc.T.ravel(), dn.dyl, dn.dys.T.ravel()))
     np.testing.assert_allclose(got, sol, rtol=1e-7, atol=1e-9 * np.abs(sol).max())
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+@pytest.mark.parametrize("iterations", [1, 3])
+def test_linear_rows_primal_residual_stays_one_number(seed, iterations):
+    # The kernel carries the linear rows' primal residual b - G x - s as one scalar: the
+    # start's shift is the same on every row and each step removes the same fraction of it.
+    # Forced here by a start above a speed bound; checked against the dense G.
+    from speedplan.solve.banded import _kernel_args
+
+    unit, d = _setup(seed)
+    lay = d.lay
+    args = _kernel_args(unit, d)
+    pt = args[1]
+    pt.w[3] = 3.0 * unit.w_max[4] / d.cw[3]  # z² < w and t z > 1 still hold
+    log = np.full((iterations + 1, len(ipm.LOG_COLUMNS)), np.nan)
+    ipm.iterate(*args, log, 1e-8, iterations)
+    g_lin, _ = _dense_g(unit, d)
+    r = d.b_lin - g_lin @ np.concatenate((pt.w, pt.t, pt.z)) - pt.sl
+    assert np.abs(r).max() > 1e-6  # the shift is not yet gone
+    assert np.ptp(r) <= 1e-12 * max(1.0, float(np.abs(d.b_lin).max()))
+    # The logged primal residual of the last iteration is that of the iterate.
+    _, _, _, ry2, _ = ipm.residuals_into(d, pt, ipm.empty(ipm.Residual, lay), np.zeros(lay.n_lin))
+    assert ry2 == pytest.approx(float(r @ r), rel=1e-9)
+
+
+def test_kernel_keeps_sixty_doubles_per_node():
+    # The kernel's arrays on a plain jerk-limited problem (one stencil row per node, no
+    # floors): 60 doubles per node (docs/banded-ipm.md lists them), 480 bytes.
+    from speedplan.solve.banded import _kernel_args
+
+    inst = paper_instance("rnd", "cnst", "cnst", n=2000, seed=0)
+    p = DiscreteProblem(s=np.arange(inst.w_max.size, dtype=float), w_max=inst.w_max,
+                        accel=inst.A, decel=inst.A, jerk=inst.J)
+    unit = p.scaled(*unit_scales(p))
+    d, _ = _prepare(unit, _positive_feasible(unit)[1:-1])
+    kernel = _kernel_args(unit, d)[1:]
+    doubles = sum(a.size for part in kernel for a in part) / d.lay.m
+    assert 59.9 < doubles <= 60.01

@@ -150,47 +150,45 @@ class Data(NamedTuple):
 
 
 class Point(NamedTuple):
-    """Primal–dual iterate: ``x = (w, t, z)``, slacks ``s`` and multipliers ``y``."""
+    """Primal–dual iterate: ``x = (w, t, z)``, linear slacks ``sl`` and multipliers ``y``.
+
+    The cones' slacks are not stored: they are kept equal to ``b - G x`` (:func:`_cone_s`),
+    which the start makes strictly interior, so the cone rows' primal residual is zero
+    throughout and their ``Δs = -G Δx`` (:func:`_cone_ds`).
+    """
 
     w: FloatArray
     t: FloatArray
     z: FloatArray
     sl: FloatArray  # linear rows
     yl: FloatArray
-    ss: FloatArray  # cones (3, nc)
-    ys: FloatArray
+    ys: FloatArray  # cones (3, nc)
 
 
 
 class Residual(NamedTuple):
-    """Residuals, negated: the right-hand sides ``-(G'y + c)`` and ``-(Gx + s - b)``."""
+    """The dual residual, negated: ``-(G'y + c)``.
+
+    The primal residual of the linear rows is the same number on every row (the start's
+    shift, scaled by ``1 - α`` at each step), carried as a scalar ``rp``; the cone rows
+    have none (see :class:`Point`).
+    """
 
     gw: FloatArray
     gt: FloatArray
     gz: FloatArray
-    ryl: FloatArray
-    rys: FloatArray
 
 
 
 class Direction(NamedTuple):
-    """A Newton direction ``(Δx, Δs, Δy)``."""
+    """A Newton direction ``(Δx, Δs, Δy)``; the cones' ``Δs = -G Δx`` is not stored."""
 
     dw: FloatArray
     dt: FloatArray
     dz: FloatArray
     dsl: FloatArray
     dyl: FloatArray
-    dss: FloatArray
     dys: FloatArray
-
-
-
-class Rhs(NamedTuple):
-    """Right-hand side of the complementarity equation ``λ ∘ (WΔy + W⁻¹Δs) = bs``."""
-
-    bsl: FloatArray
-    bss: FloatArray
 
 
 
@@ -215,12 +213,14 @@ class Scaling(NamedTuple):
 
 
 class Factor(NamedTuple):
-    """``L D L'`` factor of the reduced matrix and the per-node elimination of ``(t, z)``."""
+    """``L D L'`` factor of the reduced matrix and the per-node elimination of ``(t, z)``.
+
+    The linear rows' weights ``H = y / s`` are not stored: each use divides.
+    """
 
     l1: FloatArray  # L[i, i-1]
     l2: FloatArray  # L[i, i-2]
     dd: FloatArray  # D
-    hl: FloatArray  # linear rows' weights y / s, shape (n_lin,)
     alpha: FloatArray  # per stencil row: coupling of t_i to (jc_r · ŵ) in G'HG
     bwz: FloatArray  # coupling of z_i to w_i
     p: FloatArray  # inverse of the (t, z) block: [[p, q], [q, r]]
@@ -241,21 +241,23 @@ class Work(NamedTuple):
 _KINDS: dict[type, dict[str, str]] = {
     Data: {"jk": "jerk", "jstart": "start", "jc": "stencil", "cj": "jerk", "lk": "low",
            "ct": "node", "cw": "node", "b_lin": "lin"},
-    Point: {"w": "node", "t": "node", "z": "node", "sl": "lin", "yl": "lin", "ss": "cone",
-            "ys": "cone"},
-    Residual: {"gw": "node", "gt": "node", "gz": "node", "ryl": "lin", "rys": "cone"},
+    Point: {"w": "node", "t": "node", "z": "node", "sl": "lin", "yl": "lin", "ys": "cone"},
+    Residual: dict.fromkeys(Residual._fields, "node"),
     Direction: {"dw": "node", "dt": "node", "dz": "node", "dsl": "lin", "dyl": "lin",
-                "dss": "cone", "dys": "cone"},
-    Rhs: {"bsl": "lin", "bss": "cone"},
+                "dys": "cone"},
     Scaling: {"beta": "cones", "v": "cone"},
-    Factor: {**dict.fromkeys(Factor._fields, "node"), "hl": "lin", "alpha": "jerk"},
+    Factor: {**dict.fromkeys(Factor._fields, "node"), "alpha": "jerk"},
     Work: dict.fromkeys(Work._fields, "node"),
 }
 
 
 def check_sizes(d: Data, *parts: tuple[Any, ...]) -> None:
-    """Check ``d`` and every array tuple against ``d.lay`` (once, before the kernel runs)."""
-    d.check()
+    """Check the shapes of ``d`` and of every array tuple against ``d.lay``.
+
+    Call :meth:`Data.check` (shapes and row order) once before allocating the kernel's
+    arrays: its temporaries would otherwise add to the solve's peak memory.
+    """
+    _check(d, d.lay)
     for part in parts:
         _check(part, d.lay)
 
@@ -360,6 +362,28 @@ def _b_soc(r: int, c: int, m: int) -> float:
     return 0.0 if r == 0 else 2.0
 
 
+@njit(cache=True, error_model="numpy")
+def _cone_s(w: FloatArray, t: FloatArray, z: FloatArray, c: int) -> tuple[float, float, float]:
+    """Cone ``c``'s slack ``b - G x``: ``(1 + w, 2 z, w - 1)`` (node) or ``(t + z, t - z, 2)``."""
+    m = w.size
+    if c < m:
+        return 1.0 + w[c], 2.0 * z[c], w[c] - 1.0
+    i = c - m
+    return t[i] + z[i], t[i] - z[i], 2.0
+
+
+@njit(cache=True, error_model="numpy")
+def _cone_ds(
+    dw: FloatArray, dt: FloatArray, dz: FloatArray, c: int
+) -> tuple[float, float, float]:
+    """Cone ``c``'s ``Δs = -G Δx``, the change of :func:`_cone_s` along ``Δx``."""
+    m = dw.size
+    if c < m:
+        return dw[c], 2.0 * dz[c], dw[c]
+    i = c - m
+    return dt[i] + dz[i], dt[i] - dz[i], 0.0
+
+
 # --- the constraint map G and its adjoint -------------------------------------------------
 
 
@@ -423,31 +447,50 @@ def g_adjoint_into(
 
 
 @njit(cache=True, error_model="numpy")
+def _cone_step(
+    u0: float, u1: float, u2: float, du0: float, du1: float, du2: float
+) -> float:
+    """Largest ``α`` with ``u + α du`` in the cone (``u`` interior); ``inf`` if unbounded."""
+    a = _jnorm2(du0, du1, du2)
+    b = u0 * du0 - u1 * du1 - u2 * du2
+    cc = _jnorm2(u0, u1, u2)
+    disc = b * b - a * cc
+    root = np.inf
+    if not (disc < 0.0 and a >= 0.0):
+        # Roots of a α² + 2 b α + cc = 0 without cancellation: q / a and cc / q.
+        sq = math.sqrt(max(disc, 0.0))
+        q = -(b + math.copysign(sq, b))
+        if a != 0.0:
+            r1 = q / a
+            if r1 > 0.0 and math.isfinite(r1):
+                root = min(root, r1)
+        if q != 0.0:
+            r2 = cc / q
+            if r2 > 0.0 and math.isfinite(r2):
+                root = min(root, r2)
+    # Also keep u_0 + α du_0 > 0 (the quadratic alone does not tell K from -K).
+    if du0 < 0.0:
+        root = min(root, -u0 / du0)
+    return root
+
+
+@njit(cache=True, error_model="numpy")
 def max_step_soc(u: FloatArray, du: FloatArray) -> float:
     """Largest ``α`` with ``u + α du`` in every cone (``u`` interior); ``inf`` if unbounded."""
     best = np.inf
     for c in range(u.shape[1]):
-        a = _jnorm2(du[0, c], du[1, c], du[2, c])
-        b = u[0, c] * du[0, c] - u[1, c] * du[1, c] - u[2, c] * du[2, c]
-        cc = _jnorm2(u[0, c], u[1, c], u[2, c])
-        disc = b * b - a * cc
-        root = np.inf
-        if not (disc < 0.0 and a >= 0.0):
-            # Roots of a α² + 2 b α + cc = 0 without cancellation: q / a and cc / q.
-            sq = math.sqrt(max(disc, 0.0))
-            q = -(b + math.copysign(sq, b))
-            if a != 0.0:
-                r1 = q / a
-                if r1 > 0.0 and math.isfinite(r1):
-                    root = min(root, r1)
-            if q != 0.0:
-                r2 = cc / q
-                if r2 > 0.0 and math.isfinite(r2):
-                    root = min(root, r2)
-        # Also keep u_0 + α du_0 > 0 (the quadratic alone does not tell K from -K).
-        if du[0, c] < 0.0:
-            root = min(root, -u[0, c] / du[0, c])
-        best = min(best, root)
+        best = min(best, _cone_step(u[0, c], u[1, c], u[2, c], du[0, c], du[1, c], du[2, c]))
+    return best
+
+
+@njit(cache=True, error_model="numpy")
+def max_step_slack_soc(pt: Point, dn: Direction) -> float:
+    """:func:`max_step_soc` for the cones' slacks ``s = b - G x`` along ``Δs = -G Δx``."""
+    best = np.inf
+    for c in range(pt.ys.shape[1]):
+        s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
+        d0, d1, d2 = _cone_ds(dn.dw, dn.dt, dn.dz, c)
+        best = min(best, _cone_step(s0, s1, s2, d0, d1, d2))
     return best
 
 
@@ -461,33 +504,51 @@ def max_step_lin(u: FloatArray, du: FloatArray) -> float:
 
 
 @njit(cache=True, error_model="numpy")
-def _interior_after_step(u: FloatArray, alpha: float, du: FloatArray) -> bool:
-    """Whether every cone of ``u + α du`` is strictly interior (nothing is written)."""
-    for c in range(u.shape[1]):
-        o0 = u[0, c] + alpha * du[0, c]
-        o1 = u[1, c] + alpha * du[1, c]
-        o2 = u[2, c] + alpha * du[2, c]
-        if not (o0 > 0.0 and _jnorm2(o0, o1, o2) > 0.0):
+def _interior(u0: float, u1: float, u2: float) -> bool:
+    """Whether ``u`` is strictly inside the cone."""
+    return u0 > 0.0 and _jnorm2(u0, u1, u2) > 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _interior_after_step(pt: Point, alpha: float, dn: Direction) -> bool:
+    """Whether every cone of ``s`` and of ``y`` is strictly interior after the step ``α``."""
+    for c in range(pt.ys.shape[1]):
+        s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
+        d0, d1, d2 = _cone_ds(dn.dw, dn.dt, dn.dz, c)
+        if not _interior(s0 + alpha * d0, s1 + alpha * d1, s2 + alpha * d2):
+            return False
+        if not _interior(pt.ys[0, c] + alpha * dn.dys[0, c], pt.ys[1, c] + alpha * dn.dys[1, c],
+                         pt.ys[2, c] + alpha * dn.dys[2, c]):
             return False
     return True
 
 
 @njit(cache=True, error_model="numpy")
-def scaling_into(ss: FloatArray, ys: FloatArray, sc: Scaling) -> None:
-    """Nesterov–Todd scaling of every cone (formulas of CVXOPT's ``misc.compute_scaling``)."""
-    for c in range(ss.shape[1]):
-        sn = math.sqrt(_jnorm2(ss[0, c], ss[1, c], ss[2, c]))
-        yn = math.sqrt(_jnorm2(ys[0, c], ys[1, c], ys[2, c]))
-        bt = math.sqrt(sn / yn)
-        s0, s1, s2 = ss[0, c] / sn, ss[1, c] / sn, ss[2, c] / sn
-        y0, y1, y2 = ys[0, c] / yn, ys[1, c] / yn, ys[2, c] / yn
-        gamma = math.sqrt(0.5 * (1.0 + s0 * y0 + s1 * y1 + s2 * y2))
-        wb0 = (s0 + y0) / (2.0 * gamma)
-        wb1 = (s1 - y1) / (2.0 * gamma)
-        wb2 = (s2 - y2) / (2.0 * gamma)
-        nv = math.sqrt(2.0 * (wb0 + 1.0))
-        sc.beta[c] = bt
-        sc.v[0, c], sc.v[1, c], sc.v[2, c] = (wb0 + 1.0) / nv, wb1 / nv, wb2 / nv
+def cone_scaling_into(
+    sc: Scaling, c: int, s0: float, s1: float, s2: float, y0: float, y1: float, y2: float
+) -> None:
+    """Nesterov–Todd scaling of cone ``c`` at ``(s, y)`` (CVXOPT's ``misc.compute_scaling``)."""
+    sn = math.sqrt(_jnorm2(s0, s1, s2))
+    yn = math.sqrt(_jnorm2(y0, y1, y2))
+    bt = math.sqrt(sn / yn)
+    s0, s1, s2 = s0 / sn, s1 / sn, s2 / sn
+    y0, y1, y2 = y0 / yn, y1 / yn, y2 / yn
+    gamma = math.sqrt(0.5 * (1.0 + s0 * y0 + s1 * y1 + s2 * y2))
+    wb0 = (s0 + y0) / (2.0 * gamma)
+    wb1 = (s1 - y1) / (2.0 * gamma)
+    wb2 = (s2 - y2) / (2.0 * gamma)
+    nv = math.sqrt(2.0 * (wb0 + 1.0))
+    sc.beta[c] = bt
+    sc.v[0, c], sc.v[1, c], sc.v[2, c] = (wb0 + 1.0) / nv, wb1 / nv, wb2 / nv
+
+
+@njit(cache=True, error_model="numpy")
+def scaling_into(pt: Point, sc: Scaling) -> None:
+    """Nesterov–Todd scaling of every cone at the iterate's ``(s, y)``."""
+    ys = pt.ys
+    for c in range(ys.shape[1]):
+        s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
+        cone_scaling_into(sc, c, s0, s1, s2, ys[0, c], ys[1, c], ys[2, c])
 
 
 @njit(cache=True, error_model="numpy")
@@ -501,13 +562,13 @@ def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
 
 @njit(cache=True, error_model="numpy")
 def _eliminate_tz(
-    d: Data, sc: Scaling, fac: Factor, i: int
+    d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor, i: int
 ) -> tuple[float, float, float, float, float, float, float]:
     """Eliminate ``(t_i, z_i)`` from node ``i``'s rows of ``G' H G``; returns ``M_i`` and more.
 
     Writes the inverse ``[[p, q], [q, r]]`` of the ``(t_i, z_i)`` block, the coupling
     ``b_wz`` of ``z_i`` to ``w_i`` and, per stencil row ``r`` of the node, the coupling
-    ``α_r = -c_r (H⁺_r - H⁻_r)`` of ``t_i`` to ``a_r · ŵ`` (``H = y / s`` in ``fac.hl``).
+    ``α_r = -c_r (H⁺_r - H⁻_r)`` of ``t_i`` to ``a_r · ŵ`` (``H = y / s``).
     Each stencil row ``±c_r (a_r · ŵ) - t̂_i`` adds ``σ_r c_r² a_r a_r'`` (``σ_r = H⁺_r + H⁻_r``)
     to the ``w`` block and ``σ_r`` to the diagonal of ``t_i``. Returns the six entries
     00, 01, 02, 11, 12, 22 of the block over ``w_{i-1:i+2}`` left by the elimination,
@@ -516,7 +577,7 @@ def _eliminate_tz(
     from its own bound and node cone (docs/banded-ipm.md).
     """
     lay = d.lay
-    m, hl = lay.m, fac.hl
+    m = lay.m
     h00, h01, h02, h11, h12, h22 = _h_entries(sc, i)
     g00, g01, _, g11, _, _ = _h_entries(sc, m + i)
     mtt = g00 + 2.0 * g01 + g11
@@ -524,11 +585,11 @@ def _eliminate_tz(
     mtz = g00 - g11
     bwz = 2.0 * (h01 + h12)
     fac.bwz[i] = bwz
-    dg = hl[lay.up + i] + (h00 + 2.0 * h02 + h22)
+    dg = yl[lay.up + i] / sl[lay.up + i] + (h00 + 2.0 * h02 + h22)
     r0, r1 = d.jstart[i], d.jstart[i + 1]
     hsum = 0.0
     for r in range(r0, r1):
-        hp, hm = hl[lay.jp + r], hl[lay.jm + r]
+        hp, hm = yl[lay.jp + r] / sl[lay.jp + r], yl[lay.jm + r] / sl[lay.jm + r]
         fac.alpha[r] = -d.cj[r] * (hp - hm)
         hsum += hp + hm
     # κ: the cones' own weight of t once z is eliminated; p = 1 / (κ + Σσ).
@@ -539,7 +600,7 @@ def _eliminate_tz(
     fac.p[i], fac.q[i], fac.r[i] = p, q, mtt / det
     m00 = m01 = m02 = m11 = m12 = m22 = 0.0
     for r in range(r0, r1):
-        hp, hm = hl[lay.jp + r], hl[lay.jm + r]
+        hp, hm = yl[lay.jp + r] / sl[lay.jp + r], yl[lay.jm + r] / sl[lay.jm + r]
         sig = hp + hm
         # E_rr = c² σ - p α², written without cancellation as
         # c² (σ (κ + Σσ - σ) + 4 H⁺H⁻) / (κ + Σσ).
@@ -577,25 +638,24 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
     """
     lay = d.lay
     m, dec = lay.m, lay.dec
-    hl, l1, l2, dd = fac.hl, fac.l1, fac.l2, fac.dd
-    for j in range(hl.size):
-        hl[j] = yl[j] / sl[j]
+    l1, l2, dd = fac.l1, fac.l2, fac.dd
     p02 = p12 = p22 = 0.0  # the entries of M_{i-1} that row i needs
-    _, c01, c02, c11, c12, c22, cdg = _eliminate_tz(d, sc, fac, 0)
+    _, c01, c02, c11, c12, c22, cdg = _eliminate_tz(d, sc, yl, sl, fac, 0)
     rl = 0
     while rl < lay.kl and d.lk[rl] == 0:
-        cdg += hl[lay.low + rl]
+        cdg += yl[lay.low + rl] / sl[lay.low + rl]
         rl += 1
     ok = True
+    gacc_n = yl[0] / sl[0] + yl[dec] / sl[dec]  # weights of the acceleration rows of node i
     for i in range(m):
         n00 = n01 = n02 = n11 = n12 = n22 = ndg = 0.0
         if i + 1 < m:
-            n00, n01, n02, n11, n12, n22, ndg = _eliminate_tz(d, sc, fac, i + 1)
+            n00, n01, n02, n11, n12, n22, ndg = _eliminate_tz(d, sc, yl, sl, fac, i + 1)
             while rl < lay.kl and d.lk[rl] == i + 1:
-                ndg += hl[lay.low + rl]
+                ndg += yl[lay.low + rl] / sl[lay.low + rl]
                 rl += 1
-        gacc_i = hl[i] + hl[dec + i]
-        gacc_n = hl[i + 1] + hl[dec + i + 1]
+        gacc_i = gacc_n
+        gacc_n = yl[i + 1] / sl[i + 1] + yl[dec + i + 1] / sl[dec + i + 1]
         # S[i, i] gathers M_i's middle, M_{i+1}'s first and M_{i-1}'s last entry.
         di = c11 + cdg - fac.r[i] * fac.bwz[i] ** 2 + d.cw[i] ** 2 * (gacc_i + gacc_n)
         off1 = 0.0
@@ -671,68 +731,92 @@ def solve_normal_inplace(
 
 @njit(cache=True, error_model="numpy")
 def _v_into(
-    sc: Scaling, fac: Factor, pt: Point, res: Residual, rhs: Rhs, vl: FloatArray,
-    vs: FloatArray,
+    sc: Scaling, pt: Point, rp: float, corrector: bool, sigma_mu: float, dn: Direction
 ) -> None:
-    """``v = H by - W⁻¹ u`` with ``λ ∘ u = bs`` (``H = y / s`` on the linear rows)."""
-    sl, hl = pt.sl, fac.hl
-    for j in range(vl.size):
-        vl[j] = hl[j] * res.ryl[j] - rhs.bsl[j] / sl[j]
-    bys, bss = res.rys, rhs.bss
-    for c in range(bys.shape[1]):
+    """``v = H by - W⁻¹ u`` with ``λ ∘ u = bs``, into ``(dn.dyl, dn.dys)``.
+
+    ``by`` is ``rp`` on the linear rows and zero on the cones; ``H = y / s`` on the linear
+    rows. ``bs = -λ ∘ λ`` (the predictor), or with ``corrector`` Mehrotra's
+    ``-λ ∘ λ - (W⁻¹Δs) ∘ (WΔy) + σ μ e`` for the predictor's direction, which ``dn`` holds on
+    entry and which is overwritten entry by entry as it is read.
+    """
+    sl, yl, dsl, dyl = pt.sl, pt.yl, dn.dsl, dn.dyl
+    for j in range(sl.size):
+        bsl = -sl[j] * yl[j]  # λ∘λ = s y on the linear rows
+        if corrector:
+            bsl += sigma_mu - dsl[j] * dyl[j]
+        dyl[j] = yl[j] / sl[j] * rp - bsl / sl[j]
+    dys = dn.dys
+    for c in range(dys.shape[1]):
         l0, l1, l2 = _lambda(sc, pt.ys, c)
-        u0, u1, u2 = _jordan_solve(l0, l1, l2, bss[0, c], bss[1, c], bss[2, c])
+        b0, b1, b2 = -(l0 ** 2 + l1 ** 2 + l2 ** 2), -2.0 * l0 * l1, -2.0 * l0 * l2
+        if corrector:
+            e0, e1, e2 = _cone_ds(dn.dw, dn.dt, dn.dz, c)
+            a0, a1, a2 = _apply_winv(sc, e0, e1, e2, c)
+            f0, f1, f2 = _apply_w(sc, dys[0, c], dys[1, c], dys[2, c], c)
+            b0 += -(a0 * f0 + a1 * f1 + a2 * f2) + sigma_mu
+            b1 += -(a0 * f1 + f0 * a1)
+            b2 += -(a0 * f2 + f0 * a2)
+        u0, u1, u2 = _jordan_solve(l0, l1, l2, b0, b1, b2)
         w0, w1, w2 = _apply_winv(sc, u0, u1, u2, c)
-        h0, h1, h2 = _apply_h(sc, bys[0, c], bys[1, c], bys[2, c], c)
-        vs[0, c], vs[1, c], vs[2, c] = h0 - w0, h1 - w1, h2 - w2
+        dys[0, c], dys[1, c], dys[2, c] = -w0, -w1, -w2
 
 
 @njit(cache=True, error_model="numpy")
-def _ds_dy_into(d: Data, sc: Scaling, fac: Factor, res: Residual, dn: Direction) -> None:
-    """``Δs = by - G Δx`` and ``Δy = H G Δx - v``, with ``v`` on entry in ``(dyl, dys)``."""
+def _recover_v_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
+    """Put back the ``v`` of :func:`_v_into` into ``(dyl, dys)`` from the direction ``dn``.
+
+    ``Δy = H G Δx - v`` with ``G Δx = by - Δs``: so ``v = H (by - Δs) - Δy`` on the linear
+    rows and ``v = H G Δx - Δy`` on the cones, without the right-hand side ``bs``.
+    """
+    sl, yl, dsl, dyl = pt.sl, pt.yl, dn.dsl, dn.dyl
+    for j in range(sl.size):
+        dyl[j] = yl[j] / sl[j] * (rp - dsl[j]) - dyl[j]
+    dys = dn.dys
+    for c in range(dys.shape[1]):
+        e0, e1, e2 = _cone_ds(dn.dw, dn.dt, dn.dz, c)
+        h0, h1, h2 = _apply_h(sc, -e0, -e1, -e2, c)
+        dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
+
+
+@njit(cache=True, error_model="numpy")
+def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
+    """``Δs = by - G Δx`` (linear rows) and ``Δy = H G Δx - v``, with ``v`` in ``(dyl, dys)``."""
     g_lin_into(d, dn.dw, dn.dt, dn.dsl)  # G Δx, linear rows, kept in dsl until replaced
-    hl = fac.hl
-    for j in range(hl.size):
-        g = dn.dsl[j]
-        dn.dyl[j] = hl[j] * g - dn.dyl[j]
-        dn.dsl[j] = res.ryl[j] - g
-    m = dn.dw.size
-    dw, dt, dz, dss, dys, bys = dn.dw, dn.dt, dn.dz, dn.dss, dn.dys, res.rys
-    for c in range(2 * m):
-        if c < m:
-            g0, g1, g2 = -dw[c], -2.0 * dz[c], -dw[c]
-        else:
-            i = c - m
-            g0, g1, g2 = -(dt[i] + dz[i]), -(dt[i] - dz[i]), 0.0
-        dss[0, c] = bys[0, c] - g0
-        dss[1, c] = bys[1, c] - g1
-        dss[2, c] = bys[2, c] - g2
-        h0, h1, h2 = _apply_h(sc, g0, g1, g2, c)
-        dys[0, c] = h0 - dys[0, c]
-        dys[1, c] = h1 - dys[1, c]
-        dys[2, c] = h2 - dys[2, c]
+    sl, yl, dsl, dyl = pt.sl, pt.yl, dn.dsl, dn.dyl
+    for j in range(sl.size):
+        g = dsl[j]
+        dyl[j] = yl[j] / sl[j] * g - dyl[j]
+        dsl[j] = rp - g
+    dys = dn.dys
+    for c in range(dys.shape[1]):
+        e0, e1, e2 = _cone_ds(dn.dw, dn.dt, dn.dz, c)
+        h0, h1, h2 = _apply_h(sc, -e0, -e1, -e2, c)
+        dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
 
 
 @njit(cache=True, error_model="numpy")
 def newton_into(
-    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rhs: Rhs,
-    refine_above: float, dn: Direction,
+    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rp: float,
+    corrector: bool, sigma_mu: float, refine_above: float, dn: Direction,
 ) -> None:
     """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs`` into ``dn``.
 
-    ``(bx, by)`` are the residuals ``res``, ``bs`` is ``rhs``. One round of iterative
-    refinement follows if the 2-norm of the residual ``bx - G'Δy`` exceeds ``refine_above``
-    (``inf``: no refinement, and the residual is not computed).
+    ``bx`` is the residual ``res``, ``by`` is ``rp`` on the linear rows and zero on the cones,
+    ``bs`` as :func:`_v_into` says (``corrector``, ``sigma_mu``; the corrector reads the
+    predictor's direction from ``dn``). One round of iterative refinement follows if the
+    2-norm of the residual ``bx - G'Δy`` exceeds ``refine_above`` (``inf``: no refinement,
+    and the residual is not computed).
     """
     # With v = H by - W⁻¹ u (λ ∘ u = bs): (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
-    _v_into(sc, fac, pt, res, rhs, dn.dyl, dn.dys)
+    _v_into(sc, pt, rp, corrector, sigma_mu, dn)
     g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz)
     for i in range(dn.dw.size):
         dn.dw[i] += res.gw[i]
         dn.dt[i] += res.gt[i]
         dn.dz[i] += res.gz[i]
     solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
-    _ds_dy_into(d, sc, fac, res, dn)
+    _ds_dy_into(d, sc, pt, rp, dn)
     # The last two equations hold by construction; only G'Δy = bx inherits the rounding of
     # the reduced solve, which grows as H becomes ill-conditioned near the optimum. A round
     # of iterative refinement with the same factor restores it.
@@ -748,12 +832,12 @@ def newton_into(
         if not math.sqrt(res2) > refine_above:
             return
         solve_normal_inplace(d, fac, rw, rt, rz)
+        _recover_v_into(sc, pt, rp, dn)  # the same v, from the unrefined direction
         for i in range(rw.size):
             dn.dw[i] += rw[i]
             dn.dt[i] += rt[i]
             dn.dz[i] += rz[i]
-        _v_into(sc, fac, pt, res, rhs, dn.dyl, dn.dys)  # the same v, recomputed
-        _ds_dy_into(d, sc, fac, res, dn)
+        _ds_dy_into(d, sc, pt, rp, dn)
 
 
 # --- the iteration, step by step ------------------------------------------------------------
@@ -778,40 +862,57 @@ def _axpy(alpha: float, x: FloatArray, y: FloatArray) -> None:
 
 
 @njit(cache=True, error_model="numpy")
+def _shift(worst: float, nrm: float) -> float:
+    """CVXOPT's initial-point rule: the shift ``1 + t`` along ``e`` when ``u`` is not interior
+    by margin (``t = -worst``, the most negative entry), else 0."""
+    ts = -worst
+    return 1.0 + ts if ts >= -1e-8 * max(nrm, 1.0) else 0.0
+
+
+@njit(cache=True, error_model="numpy")
 def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
-    """CVXOPT's initial-point rule: add ``(1 + t) e`` when ``u`` is not interior by margin."""
+    """Add :func:`_shift` of ``(ul, us)`` to every linear entry and every cone's axis."""
     worst = np.inf
     for i in range(ul.size):
         worst = min(worst, ul[i])
     for c in range(us.shape[1]):
         worst = min(worst, us[0, c] - math.hypot(us[1, c], us[2, c]))
-    ts = -worst
-    nrm = math.sqrt(_dot(ul, ul) + _dot(us, us))
-    if ts >= -1e-8 * max(nrm, 1.0):
-        for i in range(ul.size):
-            ul[i] += 1.0 + ts
-        for c in range(us.shape[1]):
-            us[0, c] += 1.0 + ts
+    shift = _shift(worst, math.sqrt(_dot(ul, ul) + _dot(us, us)))
+    for i in range(ul.size):
+        ul[i] += shift
+    for c in range(us.shape[1]):
+        us[0, c] += shift
 
 
 @njit(cache=True, error_model="numpy")
-def start_into(d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, dn: Direction) -> None:
+def start_into(
+    d: Data, sc: Scaling, fac: Factor, pt: Point, dn: Direction
+) -> tuple[bool, float]:
     """Slacks and multipliers of the start, given the primal point ``(w, t, z)`` in ``pt``.
 
-    ``s = b - G x`` and CVXOPT's default dual start (least-norm ``y`` of ``G' y = -c``, with
-    ``W = I``), both shifted into the cones. ``sc`` must be the identity scaling.
+    ``s = b - G x``, with the linear rows shifted into the orthant by CVXOPT's rule (the
+    cones' slacks are not shifted: they stay ``b - G x``, see :class:`Point`), and CVXOPT's
+    default dual start (least-norm ``y`` of ``G' y = -c``, with ``W = I``) shifted into the
+    cones. ``sc`` must be the identity scaling. Returns whether ``b - G x`` is strictly
+    inside every cone (else nothing else is valid) and the linear rows' primal residual
+    ``rp`` (minus their shift).
     """
     m = d.lay.m
+    for c in range(2 * m):
+        s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
+        if not _interior(s0, s1, s2):
+            return False, 0.0
     pt.sl[:] = 1.0  # W = I on the linear rows: y / s = 1
     pt.yl[:] = 1.0
     factor_into(d, sc, pt.yl, pt.sl, fac)
     g_lin_into(d, pt.w, pt.t, pt.sl)
-    g_soc_into(pt.w, pt.t, pt.z, pt.ss)
+    worst = np.inf
     for j in range(pt.sl.size):
         pt.sl[j] = d.b_lin[j] - pt.sl[j]
-    for r in range(3):
-        for c in range(2 * m):
-            pt.ss[r, c] = _b_soc(r, c, m) - pt.ss[r, c]
+        worst = min(worst, pt.sl[j])
+    shift = _shift(worst, math.sqrt(_dot(pt.sl, pt.sl)))
+    for j in range(pt.sl.size):
+        pt.sl[j] += shift
     for i in range(m):
         dn.dw[i] = 0.0
         dn.dt[i] = -d.ct[i]
@@ -819,39 +920,40 @@ def start_into(d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, dn: Direc
     solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
     g_lin_into(d, dn.dw, dn.dt, pt.yl)
     g_soc_into(dn.dw, dn.dt, dn.dz, pt.ys)
-    _shift_into_cone(pt.sl, pt.ss)
     _shift_into_cone(pt.yl, pt.ys)
+    return True, -shift
 
 
 @njit(cache=True, error_model="numpy")
 def residuals_into(
-    d: Data, pt: Point, res: Residual
+    d: Data, pt: Point, res: Residual, scratch: FloatArray
 ) -> tuple[float, float, float, float, float]:
-    """Residuals (negated) into ``res``; returns ``(pcost, dcost, gap, |r_y|², |r_x|²)``."""
+    """Dual residual (negated) into ``res``; returns ``(pcost, dcost, gap, |r_y|², |r_x|²)``.
+
+    ``|r_y|²`` is the linear rows' primal residual ``b - G x - s`` of the iterate itself,
+    computed in ``scratch`` (the cones have none, see :class:`Point`).
+    """
     m = d.lay.m
     g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz)
-    g_lin_into(d, pt.w, pt.t, res.ryl)
-    g_soc_into(pt.w, pt.t, pt.z, res.rys)
     for i in range(m):
         res.gw[i] = -res.gw[i]
         res.gt[i] = -(res.gt[i] + d.ct[i])
         res.gz[i] = -res.gz[i]
-    for j in range(res.ryl.size):
-        res.ryl[j] = d.b_lin[j] - res.ryl[j] - pt.sl[j]
-    rys, ss, ys = res.rys, pt.ss, pt.ys
-    for c in range(2 * m):
-        for r in range(3):
-            rys[r, c] = -rys[r, c] - ss[r, c]
+    g_lin_into(d, pt.w, pt.t, scratch)
+    ry2 = 0.0
+    for j in range(scratch.size):
+        r = d.b_lin[j] - scratch[j] - pt.sl[j]
+        ry2 += r * r
+    ys = pt.ys
     ys_b = 0.0  # ys · b_soc with the constant part of the cone rows spelled out
+    gap = _dot(pt.sl, pt.yl)
+    for c in range(2 * m):
+        s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
+        gap += s0 * ys[0, c] + s1 * ys[1, c] + s2 * ys[2, c]
     for i in range(m):
-        rys[0, i] += 1.0
-        rys[2, i] -= 1.0
-        rys[2, m + i] += 2.0
         ys_b += ys[0, i] - ys[2, i] + 2.0 * ys[2, m + i]
     pcost = _dot(d.ct, pt.t)
     dcost = -_dot(pt.yl, d.b_lin) - ys_b
-    gap = _dot(pt.sl, pt.yl) + _dot(ss, ys)
-    ry2 = _dot(res.ryl, res.ryl) + _dot(rys, rys)
     rx2 = _dot(res.gw, res.gw) + _dot(res.gt, res.gt) + _dot(res.gz, res.gz)
     return pcost, dcost, gap, ry2, rx2
 
@@ -860,46 +962,30 @@ def residuals_into(
 def _max_step(pt: Point, dn: Direction) -> float:
     """Largest step along ``dn`` keeping ``s`` and ``y`` in their cones."""
     return min(max_step_lin(pt.sl, dn.dsl), max_step_lin(pt.yl, dn.dyl),
-               max_step_soc(pt.ss, dn.dss), max_step_soc(pt.ys, dn.dys))
+               max_step_slack_soc(pt, dn), max_step_soc(pt.ys, dn.dys))
 
 
 @njit(cache=True, error_model="numpy")
 def predictor_into(
-    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rhs: Rhs,
+    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rp: float,
     refine_above: float, dn: Direction,
 ) -> float:
     """Affine-scaling direction (right-hand side ``-λ∘λ``); returns Mehrotra's ``σ``."""
-    for j in range(rhs.bsl.size):  # λ∘λ = s y on the linear rows
-        rhs.bsl[j] = -pt.sl[j] * pt.yl[j]
-    for c in range(rhs.bss.shape[1]):
-        l0, l1, l2 = _lambda(sc, pt.ys, c)
-        rhs.bss[0, c] = -(l0 ** 2 + l1 ** 2 + l2 ** 2)
-        rhs.bss[1, c] = -2.0 * l0 * l1
-        rhs.bss[2, c] = -2.0 * l0 * l2
-    newton_into(d, sc, fac, nw, pt, res, rhs, refine_above, dn)
+    newton_into(d, sc, fac, nw, pt, res, rp, False, 0.0, refine_above, dn)
     alpha = _max_step(pt, dn)
     return float((1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT)
 
 
 @njit(cache=True, error_model="numpy")
 def corrector_into(
-    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rhs: Rhs,
+    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rp: float,
     refine_above: float, sigma_mu: float, dn: Direction,
 ) -> None:
     """Combined direction: the predictor's second-order term and centring ``σ μ``.
 
-    On entry ``dn`` holds the predictor's direction and ``rhs`` its right-hand side.
+    On entry ``dn`` holds the predictor's direction.
     """
-    for j in range(rhs.bsl.size):
-        rhs.bsl[j] = -pt.sl[j] * pt.yl[j] - dn.dsl[j] * dn.dyl[j] + sigma_mu
-    bss, dss, dys = rhs.bss, dn.dss, dn.dys
-    for c in range(bss.shape[1]):
-        a0, a1, a2 = _apply_winv(sc, dss[0, c], dss[1, c], dss[2, c], c)
-        b0, b1, b2 = _apply_w(sc, dys[0, c], dys[1, c], dys[2, c], c)
-        bss[0, c] += -(a0 * b0 + a1 * b1 + a2 * b2) + sigma_mu
-        bss[1, c] += -(a0 * b1 + b0 * a1)
-        bss[2, c] += -(a0 * b2 + b0 * a2)
-    newton_into(d, sc, fac, nw, pt, res, rhs, refine_above, dn)
+    newton_into(d, sc, fac, nw, pt, res, rp, True, sigma_mu, refine_above, dn)
 
 
 @njit(cache=True, error_model="numpy")
@@ -915,18 +1001,13 @@ def step(pt: Point, dn: Direction) -> float:
         return 0.0
     inside = False
     for _ in range(30):
-        if (_interior_after_step(pt.ss, alpha, dn.dss)
-                and _interior_after_step(pt.ys, alpha, dn.dys)):
+        if _interior_after_step(pt, alpha, dn):
             inside = True
             break
         alpha *= 0.5
     if not inside:
         return 0.0
-    for u, du in ((pt.ss, dn.dss), (pt.ys, dn.dys)):
-        for c in range(u.shape[1]):
-            u[0, c] = u[0, c] + alpha * du[0, c]
-            u[1, c] = u[1, c] + alpha * du[1, c]
-            u[2, c] = u[2, c] + alpha * du[2, c]
+    _axpy(alpha, dn.dys, pt.ys)
     _axpy(alpha, dn.dw, pt.w)
     _axpy(alpha, dn.dt, pt.t)
     _axpy(alpha, dn.dz, pt.z)
@@ -937,8 +1018,8 @@ def step(pt: Point, dn: Direction) -> float:
 
 @njit(cache=True, error_model="numpy")
 def iterate(
-    d: Data, pt: Point, res: Residual, dn: Direction, rhs: Rhs, sc: Scaling, fac: Factor,
-    nw: Work, log: FloatArray, tol: float, max_iter: int,
+    d: Data, pt: Point, res: Residual, dn: Direction, sc: Scaling, fac: Factor, nw: Work,
+    log: FloatArray, tol: float, max_iter: int,
 ) -> tuple[int, int]:
     """Mehrotra predictor–corrector iterations from the primal point ``(w, t, z)`` in ``pt``.
 
@@ -947,7 +1028,9 @@ def iterate(
     ``log`` (shape ``(max_iter + 1, len(LOG_COLUMNS))``) records iteration ``k``.
     """
     lay = d.lay
-    start_into(d, sc, fac, nw, pt, dn)
+    ok, rp = start_into(d, sc, fac, pt, dn)
+    if not ok:
+        return 0, NUMERICAL_ERROR
     res_x0 = max(1.0, math.sqrt(lay.m))
     b_soc2 = 0.0  # |b_soc|², entries in storage order
     for r in range(3):
@@ -960,7 +1043,7 @@ def iterate(
     best_gap, stalled = np.inf, 0
     best_pres, best_dres, jammed = np.inf, np.inf, 0
     for it in range(max_iter + 1):
-        pcost, dcost, gap, ry2, rx2 = residuals_into(d, pt, res)
+        pcost, dcost, gap, ry2, rx2 = residuals_into(d, pt, res, dn.dsl)
         pres = math.sqrt(ry2) / res_y0
         dres = math.sqrt(rx2) / res_x0
         relgap = gap / max(min(abs(pcost), abs(dcost)), 1e-300)
@@ -995,16 +1078,17 @@ def iterate(
         if not (math.isfinite(pres) and math.isfinite(dres) and math.isfinite(gap)):
             status = NUMERICAL_ERROR
             break
-        scaling_into(pt.ss, pt.ys, sc)
+        scaling_into(pt, sc)
         if not factor_into(d, sc, pt.yl, pt.sl, fac):
             status = NUMERICAL_ERROR
             break
         # Refinement only pays once the scaling is ill-conditioned, close to the optimum, and
         # only where the solve's own residual could show in the dual residual's test.
         refine_above = REFINE_RESIDUAL * tol * res_x0 if relgap < REFINE_BELOW else np.inf
-        sigma = predictor_into(d, sc, fac, nw, pt, res, rhs, refine_above, dn)
-        corrector_into(d, sc, fac, nw, pt, res, rhs, refine_above, sigma * (gap / nu), dn)
+        sigma = predictor_into(d, sc, fac, nw, pt, res, rp, refine_above, dn)
+        corrector_into(d, sc, fac, nw, pt, res, rp, refine_above, sigma * (gap / nu), dn)
         alpha = step(pt, dn)
+        rp *= 1.0 - alpha  # G Δx + Δs = by: the step removes the fraction α of it
         log[it, 5], log[it, 6] = sigma, alpha
         if alpha == 0.0:
             status = NUMERICAL_ERROR

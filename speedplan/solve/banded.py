@@ -295,25 +295,29 @@ def _row_multipliers(
 
 
 def _kernel_args(
-    d: ipm.Data, w0: FloatArray, t0: FloatArray, z0: FloatArray
-) -> tuple[ipm.Data, ipm.Point, ipm.Residual, ipm.Direction, ipm.Rhs, ipm.Scaling, ipm.Factor,
+    p: DiscreteProblem, d: ipm.Data
+) -> tuple[ipm.Data, ipm.Point, ipm.Residual, ipm.Direction, ipm.Scaling, ipm.Factor,
            ipm.Work]:
-    """The kernel's arrays for ``d`` with the start ``(w0, t0, z0)``, sizes checked."""
+    """The kernel's arrays for ``d``, sizes checked, with :func:`_start` in the point.
+
+    The start is copied into the point before the other arrays are allocated, and its own
+    arrays are freed at once: alive during the iteration they would add 24 bytes per node.
+    """
+    d.check()
     lay = d.lay
     pt = ipm.empty(ipm.Point, lay)
-    pt.w[:], pt.t[:], pt.z[:] = w0, t0, z0
+    pt.w[:], pt.t[:], pt.z[:] = _start(p, d)
     args = (d, pt, ipm.empty(ipm.Residual, lay), ipm.empty(ipm.Direction, lay),
-            ipm.empty(ipm.Rhs, lay), ipm.Scaling.identity(lay), ipm.empty(ipm.Factor, lay),
-            ipm.empty(ipm.Work, lay))
+            ipm.Scaling.identity(lay), ipm.empty(ipm.Factor, lay), ipm.empty(ipm.Work, lay))
     ipm.check_sizes(*args)
     return args
 
 
 def _run_kernel(
-    d: ipm.Data, w0: FloatArray, t0: FloatArray, z0: FloatArray, tol: float, max_iter: int
+    p: DiscreteProblem, d: ipm.Data, tol: float, max_iter: int
 ) -> tuple[FloatArray, FloatArray, int, int]:
-    """Iterate from ``(w0, t0, z0)``; ``(w, yl, iterations, status code)``, internal units."""
-    args = _kernel_args(d, w0, t0, z0)
+    """Iterate from :func:`_start`; ``(w, yl, iterations, status code)``, internal units."""
+    args = _kernel_args(p, d)
     log = np.full((max_iter + 1, len(ipm.LOG_COLUMNS)), np.nan)
     iterations, code = ipm.iterate(*args, log, tol, max_iter)
     _Kernel.last_log = log[: iterations + 1]
@@ -355,7 +359,7 @@ def _load_from_disk_cache() -> bool:
     """
     p = _example_problem()
     d, _ = _prepare(p, _positive_feasible(p)[1:-1])
-    args = (*_kernel_args(d, *_start(p, d)), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
+    args = (*_kernel_args(p, d), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
     import numba
 
     try:
@@ -716,7 +720,7 @@ def solve_unit_relaxation(
     wmf = _positive_feasible(unit)
     d, rows = _prepare(unit, wmf[1:-1])
     t_setup = time.perf_counter()
-    w_int, yl, iterations, code = _run_kernel(d, *_start(unit, d), tol, max_iter)
+    w_int, yl, iterations, code = _run_kernel(unit, d, tol, max_iter)
     # Clip rounding-level excursions past the bounds; the ends are the given values.
     w_low = np.zeros(d.lay.m) if unit.w_min is None else unit.w_min[1:-1]
     w = np.concatenate(([unit.w_start], np.clip(w_int * d.cw, w_low, unit.w_max[1:-1]),
