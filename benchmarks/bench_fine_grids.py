@@ -18,6 +18,7 @@ import warnings
 import speedplan as sp
 from speedplan.geometry import Line
 from speedplan.model import PlanRequest, build_model
+from speedplan.model.build import Leg
 from speedplan.solve.banded import ramp_steps
 
 LGV = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
@@ -28,7 +29,8 @@ CASES = [(10.0, 20000), (10.0, 30000), (10.0, 100000), (10.0, 200000), (30.0, 10
 def run(length: float, n: int) -> str | None:
     """Plan the straight; print a line; return the suggested n when refused."""
     path = sp.Path.from_segments([Line(length)])
-    steps = ramp_steps(build_model(PlanRequest.create(path, LGV, n=n)).problem)
+    legs = build_model(PlanRequest.create(path, LGV, n=n)).legs
+    steps = max(ramp_steps(leg.problem) for leg in legs if isinstance(leg, Leg))
     t0 = time.perf_counter()
     suggestion = None
     with warnings.catch_warnings():

@@ -863,8 +863,11 @@ def _axpy(alpha: float, x: FloatArray, y: FloatArray) -> None:
 
 @njit(cache=True, error_model="numpy")
 def _shift(worst: float, nrm: float) -> float:
-    """CVXOPT's initial-point rule: the shift ``1 + t`` along ``e`` when ``u`` is not interior
-    by margin (``t = -worst``, the most negative entry), else 0."""
+    """Return CVXOPT's initial-point shift along ``e``.
+
+    The shift is ``1 + t`` (``t = -worst``, the most negative entry) when ``u`` is not
+    interior by margin, else 0.
+    """
     ts = -worst
     return 1.0 + ts if ts >= -1e-8 * max(nrm, 1.0) else 0.0
 
