@@ -198,7 +198,7 @@ def _newton_state(seed: int):
     inst = paper_instance("rnd", "cnst", "cnst", n=60, seed=seed)
     p = _problem(inst.w_max, inst.A, inst.J)
     unit = p.scaled(*unit_scales(p))
-    d, _ = _prepare(unit, _positive_feasible(unit)[1:-1])
+    d = _prepare(unit, _positive_feasible(unit)[1:-1])
     lay = d.lay
     rng = np.random.default_rng(seed)
     pt = ipm.empty(ipm.Point, lay)
@@ -214,8 +214,7 @@ def _newton_state(seed: int):
     fac = ipm.empty(ipm.Factor, lay)
     assert ipm.factor_into(d, sc, pt.yl, pt.sl, fac)
     res = ipm.empty(ipm.Residual, lay)
-    for arr in res:
-        arr[:] = rng.normal(size=arr.shape)
+    ipm.dual_residual_into(d, pt, res)  # newton_into's bx is the iterate's dual residual
     return ipm, d, sc, fac, pt, res, float(rng.normal())
 
 
@@ -228,8 +227,12 @@ def test_newton_refines_only_above_its_residual_threshold(seed):
 
     def direction(refine_above):
         dn = ipm.empty(ipm.Direction, lay)
-        ipm.newton_into(d, sc, fac, ipm.empty(ipm.Work, lay), pt, res, rp, False, 0.0,
+        bx = [a.copy() for a in res]
+        ipm.newton_into(d, sc, fac, pt, res, rp, False, 0.0,
                         refine_above, dn)
+        # The refinement forms its right-hand side in res and puts bx back, bit for bit.
+        for a, b in zip(res, bx, strict=True):
+            np.testing.assert_array_equal(a, b)
         gx = (np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m))
         ipm.g_adjoint_into(d, dn.dyl, dn.dys, *gx)
         residual = np.sqrt(sum(float(np.sum((b - g) ** 2))

@@ -17,7 +17,7 @@ orthants (the linear rows) and ``2 m`` three-dimensional second-order cones, sto
 column-wise in arrays of shape ``(3, 2 m)``: first the node cones ``z² <= w``, then the
 cones ``t z >= 1``. The linear rows are ordered in blocks whose offsets :class:`Layout`
 holds: acceleration (``m + 1``), braking (``m + 1``), upper bounds (``m``), lower bounds
-(``kl``, nodes ``lk``), positive jerk rows (``k``, nodes ``jk``), negative jerk rows
+(``kl``, nodes ``lk``), positive jerk rows (``k``, by node: ``jstart``), negative jerk rows
 (``k``). Functions named ``*_into`` write their result into the trailing array arguments.
 The reduced Newton system is derived in ``docs/banded-ipm.md``.
 """
@@ -96,7 +96,8 @@ def layout(m: int, k: int, kl: int) -> Layout:
 
 def _shape(kind: str, lay: Layout) -> tuple[int, ...]:
     """Shape of an array of ``kind``: per node, linear row, cone (3, nc), cone, jerk row, floor."""
-    return {"node": (lay.m,), "lin": (lay.n_lin,), "cone": (3, lay.nc), "cones": (lay.nc,),
+    return {"node": (lay.m,), "lin": (lay.n_lin,), "rhs": (lay.jm,), "cone": (3, lay.nc),
+            "cones": (lay.nc,),
             "jerk": (lay.k,), "stencil": (3, lay.k), "start": (lay.m + 1,),
             "low": (lay.kl,)}[kind]
 
@@ -114,7 +115,7 @@ def _check(obj: tuple[Any, ...], lay: Layout) -> None:
         if name not in kinds:
             continue
         want = _shape(kinds[name], lay)
-        dtype = np.intp if name in ("jk", "lk", "jstart") else np.float64
+        dtype = np.intp if name in ("lk", "jstart") else np.float64
         if not (isinstance(arr, np.ndarray) and arr.shape == want and arr.dtype == dtype
                 and arr.flags.c_contiguous):
             got = getattr(arr, "shape", type(arr).__name__)
@@ -126,27 +127,32 @@ class Data(NamedTuple):
     """Problem data in internal units (see :func:`speedplan.solve.banded._prepare`).
 
     The stencil rows of every family (jerk, lateral jerk) are listed together, ordered by
-    node: row ``r`` reads ``±cj_r (jc_r · ŵ_{i-1:i+2}) - t̂_i <= b`` at node ``i = jk_r``, and the
-    rows of node ``i`` are ``jstart[i]:jstart[i + 1]``.
+    node: the rows of node ``i`` are ``r`` in ``jstart[i]:jstart[i + 1]``, and row ``r`` reads
+    ``±cj_r (jc_r · ŵ_{i-1:i+2}) - t̂_i <= b``. Every loop over the rows visits them node by
+    node, so no row stores its node.
     """
 
-    jk: IntArray  # node of each stencil row, non-decreasing
     jstart: IntArray  # first row of each node, shape (m + 1,)
     jc: FloatArray  # stencil of each row over ŵ_{i-1}, ŵ_i, ŵ_{i+1}, shape (3, k)
     cj: FloatArray  # coefficient of the stencil in its rows
     lk: IntArray  # interior nodes with a positive lower bound
     ct: FloatArray  # objective coefficients of t
     cw: FloatArray  # coefficients of w in the acceleration rows
-    b_lin: FloatArray  # right-hand side of the linear rows
+    b_lin: FloatArray  # right-hand side of the linear rows but the negative jerk rows
     lay: Layout
+
+    def rhs_lin(self) -> FloatArray:
+        """The right-hand side of every linear row, shape ``(n_lin,)`` (see :func:`_b_lin`)."""
+        lay = self.lay
+        return np.concatenate((self.b_lin, -self.b_lin[lay.jp : lay.jm]))
 
     def check(self) -> None:
         """Raise :class:`ValueError` unless every array has its shape for ``self.lay``."""
         _check(self, self.lay)
-        if self.jk.size and not bool(np.all(np.diff(self.jk) >= 0)):
-            raise ValueError("Data.jk must be non-decreasing")
-        if not np.array_equal(self.jstart, np.searchsorted(self.jk, np.arange(self.lay.m + 1))):
-            raise ValueError("Data.jstart must index the rows of each node")
+        js = self.jstart
+        if not (js[0] == 0 and js[-1] == self.lay.k and bool(np.all(np.diff(js) >= 0))):
+            raise ValueError("Data.jstart must index the rows of each node: non-decreasing "
+                             "from 0 to the number of stencil rows")
 
 
 class Point(NamedTuple):
@@ -229,25 +235,15 @@ class Factor(NamedTuple):
 
 
 
-class Work(NamedTuple):
-    """Scratch of one Newton solve: the right-hand side of its refinement."""
-
-    rw: FloatArray
-    rt: FloatArray
-    rz: FloatArray
-
-
-
 _KINDS: dict[type, dict[str, str]] = {
-    Data: {"jk": "jerk", "jstart": "start", "jc": "stencil", "cj": "jerk", "lk": "low",
-           "ct": "node", "cw": "node", "b_lin": "lin"},
+    Data: {"jstart": "start", "jc": "stencil", "cj": "jerk", "lk": "low",
+           "ct": "node", "cw": "node", "b_lin": "rhs"},
     Point: {"w": "node", "t": "node", "z": "node", "sl": "lin", "yl": "lin", "ys": "cone"},
     Residual: dict.fromkeys(Residual._fields, "node"),
     Direction: {"dw": "node", "dt": "node", "dz": "node", "dsl": "lin", "dyl": "lin",
                 "dys": "cone"},
     Scaling: {"beta": "cones", "v": "cone"},
     Factor: {**dict.fromkeys(Factor._fields, "node"), "alpha": "jerk"},
-    Work: dict.fromkeys(Work._fields, "node"),
 }
 
 
@@ -274,16 +270,24 @@ def _pad(w: FloatArray, i: int) -> float:
 
 
 @njit(cache=True, error_model="numpy")
-def _stencil_dot(d: Data, w: FloatArray, r: int) -> float:
+def _b_lin(d: Data, j: int) -> float:
+    """Right-hand side of linear row ``j``.
+
+    The negative jerk rows' is that of the positive ones negated (both are the fixed ends'
+    share of the same stencil), so ``Data.b_lin`` stops at the first negative jerk row.
+    """
+    return float(d.b_lin[j]) if j < d.lay.jm else -float(d.b_lin[j - d.lay.k])
+
+
+@njit(cache=True, error_model="numpy")
+def _stencil_dot(d: Data, w: FloatArray, i: int, r: int) -> float:
     """``jc_r · w_{i-1:i+2}`` for stencil row ``r`` at node ``i`` (zero outside the nodes)."""
-    i = d.jk[r]
     return float(d.jc[0, r] * _pad(w, i - 1) + d.jc[1, r] * w[i] + d.jc[2, r] * _pad(w, i + 1))
 
 
 @njit(cache=True, error_model="numpy")
-def _scatter_stencil(d: Data, r: int, value: float, out: FloatArray) -> None:
+def _scatter_stencil(d: Data, i: int, r: int, value: float, out: FloatArray) -> None:
     """``out += value * jc_r`` at ``w_{i-1:i+2}`` (the adjoint of :func:`_stencil_dot`)."""
-    i = d.jk[r]
     if i > 0:
         out[i - 1] += value * d.jc[0, r]
     out[i] += value * d.jc[1, r]
@@ -391,7 +395,7 @@ def _cone_ds(
 def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
     """Linear rows of ``G x`` (no constants)."""
     lay = d.lay
-    m, k = lay.m, lay.k
+    m = lay.m
     for j in range(lay.dec):
         right = d.cw[j] * w[j] if j < m else 0.0
         left = d.cw[j - 1] * w[j - 1] if j > 0 else 0.0
@@ -401,11 +405,11 @@ def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
         out[lay.up + i] = w[i]
     for r in range(lay.kl):
         out[lay.low + r] = -w[d.lk[r]]
-    for r in range(k):
-        i = d.jk[r]
-        jw = d.cj[r] * _stencil_dot(d, w, r)
-        out[lay.jp + r] = jw - t[i]
-        out[lay.jm + r] = -jw - t[i]
+    for i in range(m):
+        for r in range(d.jstart[i], d.jstart[i + 1]):
+            jw = d.cj[r] * _stencil_dot(d, w, i, r)
+            out[lay.jp + r] = jw - t[i]
+            out[lay.jm + r] = -jw - t[i]
 
 
 @njit(cache=True, error_model="numpy")
@@ -424,23 +428,40 @@ def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> 
 @njit(cache=True, error_model="numpy")
 def g_adjoint_into(
     d: Data, yl: FloatArray, ys: FloatArray, gw: FloatArray, gt: FloatArray, gz: FloatArray,
+    subtract: bool = False,
 ) -> None:
-    """``G' y`` split into its ``w``, ``t`` and ``z`` parts."""
+    """``G' y`` split into its ``w``, ``t`` and ``z`` parts; with ``subtract``, ``g -= G' y``.
+
+    Each entry is formed whole, node by node, before it is written: the stencil rows of
+    nodes ``i - 1``, ``i`` and ``i + 1`` are gathered in row order, so ``g - G' y`` rounds
+    as the difference of ``g`` and the finished ``G' y`` (the refinement's right-hand side
+    is formed in place in :func:`newton_into`).
+    """
     lay = d.lay
-    m, k = lay.m, lay.k
+    m = lay.m
+    rl = 0  # floors, by increasing node
     for i in range(m):
         acc_i = yl[i] - yl[lay.dec + i]
         acc_n = yl[i + 1] - yl[lay.dec + i + 1]
-        gw[i] = (d.cw[i] * (acc_i - acc_n) + yl[lay.up + i]
-                 - ys[0, i] - ys[2, i])
-        gt[i] = -(ys[0, m + i] + ys[1, m + i])
-        gz[i] = -2.0 * ys[1, i] - ys[0, m + i] + ys[1, m + i]
-    for r in range(lay.kl):
-        gw[d.lk[r]] -= yl[lay.low + r]
-    for r in range(k):
-        jp, jm = yl[lay.jp + r], yl[lay.jm + r]
-        _scatter_stencil(d, r, d.cj[r] * (jp - jm), gw)
-        gt[d.jk[r]] -= jp + jm
+        vw = (d.cw[i] * (acc_i - acc_n) + yl[lay.up + i]
+              - ys[0, i] - ys[2, i])
+        vt = -(ys[0, m + i] + ys[1, m + i])
+        vz = -2.0 * ys[1, i] - ys[0, m + i] + ys[1, m + i]
+        while rl < lay.kl and d.lk[rl] == i:
+            vw -= yl[lay.low + rl]
+            rl += 1
+        for node in range(max(i - 1, 0), min(i + 2, m)):
+            for r in range(d.jstart[node], d.jstart[node + 1]):
+                jp, jm = yl[lay.jp + r], yl[lay.jm + r]
+                vw += d.cj[r] * (jp - jm) * d.jc[i - node + 1, r]
+                if node == i:
+                    vt -= jp + jm
+        if subtract:
+            gw[i] -= vw
+            gt[i] -= vt
+            gz[i] -= vz
+        else:
+            gw[i], gt[i], gz[i] = vw, vt, vz
 
 
 # --- cones: steps, interiority, scaling --------------------------------------------------------
@@ -717,13 +738,14 @@ def solve_normal_inplace(
         xt[i] = fac.p[i] * rt + fac.q[i] * rz
         xz[i] = fac.q[i] * rt + fac.r[i] * rz
         xw[i] -= fac.bwz[i] * xz[i]
-    for r in range(d.lay.k):
-        _scatter_stencil(d, r, -fac.alpha[r] * xt[d.jk[r]], xw)
+    for i in range(m):
+        for r in range(d.jstart[i], d.jstart[i + 1]):
+            _scatter_stencil(d, i, r, -fac.alpha[r] * xt[i], xw)
     solve_banded_inplace(fac, xw)
     for i in range(m):
         ct = 0.0
         for r in range(d.jstart[i], d.jstart[i + 1]):
-            ct += fac.alpha[r] * _stencil_dot(d, xw, r)
+            ct += fac.alpha[r] * _stencil_dot(d, xw, i, r)
         cz = fac.bwz[i] * xw[i]
         xt[i] -= fac.p[i] * ct + fac.q[i] * cz
         xz[i] -= fac.q[i] * ct + fac.r[i] * cz
@@ -797,12 +819,14 @@ def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> No
 
 @njit(cache=True, error_model="numpy")
 def newton_into(
-    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rp: float,
+    d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     corrector: bool, sigma_mu: float, refine_above: float, dn: Direction,
 ) -> None:
     """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs`` into ``dn``.
 
-    ``bx`` is the residual ``res``, ``by`` is ``rp`` on the linear rows and zero on the cones,
+    ``bx`` is the residual ``res``, which must be the iterate's (:func:`dual_residual_into`:
+    the refinement forms its own right-hand side in ``res``, then forms ``bx`` again from
+    ``pt``), ``by`` is ``rp`` on the linear rows and zero on the cones,
     ``bs`` as :func:`_v_into` says (``corrector``, ``sigma_mu``; the corrector reads the
     predictor's direction from ``dn``). One round of iterative refinement follows if the
     2-norm of the residual ``bx - G'Δy`` exceeds ``refine_above`` (``inf``: no refinement,
@@ -821,23 +845,22 @@ def newton_into(
     # the reduced solve, which grows as H becomes ill-conditioned near the optimum. A round
     # of iterative refinement with the same factor restores it.
     if refine_above < np.inf:
-        rw, rt, rz = nw.rw, nw.rt, nw.rz
-        g_adjoint_into(d, dn.dyl, dn.dys, rw, rt, rz)
+        # The residual bx - G'Δy is formed in res itself, and bx formed again from the
+        # iterate afterwards (it is a function of pt alone): no array of its own.
+        rw, rt, rz = res.gw, res.gt, res.gz
+        g_adjoint_into(d, dn.dyl, dn.dys, rw, rt, rz, True)
         res2 = 0.0
         for i in range(rw.size):
-            rw[i] = res.gw[i] - rw[i]
-            rt[i] = res.gt[i] - rt[i]
-            rz[i] = res.gz[i] - rz[i]
             res2 += rw[i] * rw[i] + rt[i] * rt[i] + rz[i] * rz[i]
-        if not math.sqrt(res2) > refine_above:
-            return
-        solve_normal_inplace(d, fac, rw, rt, rz)
-        _recover_v_into(sc, pt, rp, dn)  # the same v, from the unrefined direction
-        for i in range(rw.size):
-            dn.dw[i] += rw[i]
-            dn.dt[i] += rt[i]
-            dn.dz[i] += rz[i]
-        _ds_dy_into(d, sc, pt, rp, dn)
+        if math.sqrt(res2) > refine_above:
+            solve_normal_inplace(d, fac, rw, rt, rz)
+            _recover_v_into(sc, pt, rp, dn)  # the same v, from the unrefined direction
+            for i in range(rw.size):
+                dn.dw[i] += rw[i]
+                dn.dt[i] += rt[i]
+                dn.dz[i] += rz[i]
+            _ds_dy_into(d, sc, pt, rp, dn)
+        dual_residual_into(d, pt, res)
 
 
 # --- the iteration, step by step ------------------------------------------------------------
@@ -911,7 +934,7 @@ def start_into(
     g_lin_into(d, pt.w, pt.t, pt.sl)
     worst = np.inf
     for j in range(pt.sl.size):
-        pt.sl[j] = d.b_lin[j] - pt.sl[j]
+        pt.sl[j] = _b_lin(d, j) - pt.sl[j]
         worst = min(worst, pt.sl[j])
     shift = _shift(worst, math.sqrt(_dot(pt.sl, pt.sl)))
     for j in range(pt.sl.size):
@@ -928,6 +951,16 @@ def start_into(
 
 
 @njit(cache=True, error_model="numpy")
+def dual_residual_into(d: Data, pt: Point, res: Residual) -> None:
+    """The dual residual, negated, ``-(G'y + c)``, into ``res``."""
+    g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz)
+    for i in range(d.lay.m):
+        res.gw[i] = -res.gw[i]
+        res.gt[i] = -(res.gt[i] + d.ct[i])
+        res.gz[i] = -res.gz[i]
+
+
+@njit(cache=True, error_model="numpy")
 def residuals_into(
     d: Data, pt: Point, res: Residual, scratch: FloatArray
 ) -> tuple[float, float, float, float, float]:
@@ -937,15 +970,11 @@ def residuals_into(
     computed in ``scratch`` (the cones have none, see :class:`Point`).
     """
     m = d.lay.m
-    g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz)
-    for i in range(m):
-        res.gw[i] = -res.gw[i]
-        res.gt[i] = -(res.gt[i] + d.ct[i])
-        res.gz[i] = -res.gz[i]
+    dual_residual_into(d, pt, res)
     g_lin_into(d, pt.w, pt.t, scratch)
     ry2 = 0.0
     for j in range(scratch.size):
-        r = d.b_lin[j] - scratch[j] - pt.sl[j]
+        r = _b_lin(d, j) - scratch[j] - pt.sl[j]
         ry2 += r * r
     ys = pt.ys
     ys_b = 0.0  # ys · b_soc with the constant part of the cone rows spelled out
@@ -956,7 +985,10 @@ def residuals_into(
     for i in range(m):
         ys_b += ys[0, i] - ys[2, i] + 2.0 * ys[2, m + i]
     pcost = _dot(d.ct, pt.t)
-    dcost = -_dot(pt.yl, d.b_lin) - ys_b
+    yb = 0.0
+    for j in range(pt.yl.size):
+        yb += pt.yl[j] * _b_lin(d, j)
+    dcost = -yb - ys_b
     rx2 = _dot(res.gw, res.gw) + _dot(res.gt, res.gt) + _dot(res.gz, res.gz)
     return pcost, dcost, gap, ry2, rx2
 
@@ -970,25 +1002,25 @@ def _max_step(pt: Point, dn: Direction) -> float:
 
 @njit(cache=True, error_model="numpy")
 def predictor_into(
-    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rp: float,
+    d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     refine_above: float, dn: Direction,
 ) -> float:
     """Affine-scaling direction (right-hand side ``-λ∘λ``); returns Mehrotra's ``σ``."""
-    newton_into(d, sc, fac, nw, pt, res, rp, False, 0.0, refine_above, dn)
+    newton_into(d, sc, fac, pt, res, rp, False, 0.0, refine_above, dn)
     alpha = _max_step(pt, dn)
     return float((1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT)
 
 
 @njit(cache=True, error_model="numpy")
 def corrector_into(
-    d: Data, sc: Scaling, fac: Factor, nw: Work, pt: Point, res: Residual, rp: float,
+    d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     refine_above: float, sigma_mu: float, dn: Direction,
 ) -> None:
     """Combined direction: the predictor's second-order term and centring ``σ μ``.
 
     On entry ``dn`` holds the predictor's direction.
     """
-    newton_into(d, sc, fac, nw, pt, res, rp, True, sigma_mu, refine_above, dn)
+    newton_into(d, sc, fac, pt, res, rp, True, sigma_mu, refine_above, dn)
 
 
 @njit(cache=True, error_model="numpy")
@@ -1021,7 +1053,7 @@ def step(pt: Point, dn: Direction) -> float:
 
 @njit(cache=True, error_model="numpy")
 def iterate(
-    d: Data, pt: Point, res: Residual, dn: Direction, sc: Scaling, fac: Factor, nw: Work,
+    d: Data, pt: Point, res: Residual, dn: Direction, sc: Scaling, fac: Factor,
     log: FloatArray, tol: float, max_iter: int,
 ) -> tuple[int, int]:
     """Mehrotra predictor–corrector iterations from the primal point ``(w, t, z)`` in ``pt``.
@@ -1039,7 +1071,11 @@ def iterate(
     for r in range(3):
         for c in range(lay.nc):
             b_soc2 += _b_soc(r, c, lay.m) * _b_soc(r, c, lay.m)
-    res_y0 = max(1.0, math.sqrt(_dot(d.b_lin, d.b_lin) + b_soc2))
+    b_lin2 = 0.0
+    for j in range(lay.n_lin):
+        b = _b_lin(d, j)
+        b_lin2 += b * b
+    res_y0 = max(1.0, math.sqrt(b_lin2 + b_soc2))
     nu = lay.n_lin + lay.nc  # barrier degree: one per linear row and per cone
     status = MAX_ITERATIONS
     it = 0
@@ -1088,8 +1124,8 @@ def iterate(
         # Refinement only pays once the scaling is ill-conditioned, close to the optimum, and
         # only where the solve's own residual could show in the dual residual's test.
         refine_above = REFINE_RESIDUAL * tol * res_x0 if relgap < REFINE_BELOW else np.inf
-        sigma = predictor_into(d, sc, fac, nw, pt, res, rp, refine_above, dn)
-        corrector_into(d, sc, fac, nw, pt, res, rp, refine_above, sigma * (gap / nu), dn)
+        sigma = predictor_into(d, sc, fac, pt, res, rp, refine_above, dn)
+        corrector_into(d, sc, fac, pt, res, rp, refine_above, sigma * (gap / nu), dn)
         alpha = step(pt, dn)
         rp *= 1.0 - alpha  # G Δx + Δs = by: the step removes the fraction α of it
         log[it, 5], log[it, 6] = sigma, alpha

@@ -126,7 +126,21 @@ class _Rows(NamedTuple):
     node: IntArray
 
 
-def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> tuple[ipm.Data, _Rows]:
+def _stencil_rows(p: DiscreteProblem) -> tuple[list[IntArray], IntArray, _Rows]:
+    """The finite rows of each stencil family, their order in the kernel, and its table.
+
+    The kernel lists the rows by node, families in order at each node. The table (family
+    and node of each listed row) is only read after the kernel: built again then, it is not
+    alive during the iteration (8 bytes per row).
+    """
+    finite = [np.flatnonzero(np.isfinite(family.bound)) for family in p.stencil_families()]
+    nodes = np.concatenate(finite)
+    order = np.argsort(nodes, kind="stable")
+    family = np.concatenate([np.full(rows.size, f) for f, rows in enumerate(finite)])
+    return finite, order, _Rows(family=family[order], node=nodes[order].astype(np.intp))
+
+
+def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
     """Flatten the (already scaled) problem into the arrays the iteration uses.
 
     Variables are scaled per node, ``w = cw ŵ``, ``z = sqrt(cw) ẑ``, ``t = ct t̂`` with
@@ -146,23 +160,21 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> tuple[ipm.Data, _Rows]:
     cwp = np.concatenate(([0.0], cw, [0.0]))
     w_const = np.zeros(n)
     w_const[0], w_const[-1] = p.w_start, p.w_end
-    nodes, fams, stencils, coefs, consts = [], [], [], [], []
-    for f, family in enumerate(p.stencil_families()):
-        rows = np.flatnonzero(np.isfinite(family.bound))
+    finite, order, table = _stencil_rows(p)
+    jstart = np.searchsorted(table.node, np.arange(m + 1)).astype(np.intp)
+    k = table.node.size
+    del table  # the rows' nodes are not alive during the kernel (jstart stands for them)
+    stencils, coefs, consts = [], [], []
+    for family, rows in zip(p.stencil_families(), finite, strict=True):
         c = np.asarray(family.coef)[rows]
-        nodes.append(rows)
-        fams.append(np.full(rows.size, f))
         stencils.append(c * np.column_stack((cwp[rows], cw[rows], cwp[rows + 2])))
         cj = p.tau[rows] / family.bound[rows] / ct[rows]
         coefs.append(cj)
         # The fixed ends' share of the row, moved to the right-hand side.
         consts.append((c[:, 0] * w_const[rows] + c[:, 1] * w_const[rows + 1]
                        + c[:, 2] * w_const[rows + 2]) * cj)
-    order = np.argsort(np.concatenate(nodes), kind="stable")  # by node, families in order
-    jk = np.concatenate(nodes)[order].astype(np.intp)
     jconst = np.concatenate(consts)[order]
-    w_min = np.zeros(m) if p.w_min is None else p.w_min[1:-1]
-    lk = np.flatnonzero(w_min > 0)
+    lk = np.zeros(0, dtype=np.intp) if p.w_min is None else np.flatnonzero(p.w_min[1:-1] > 0)
     # G x + s = b with the fixed ends moved to b: b = bound - (row applied to the fixed ends).
     dconst = np.diff(w_const)
     b_lin = np.concatenate(
@@ -170,18 +182,17 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> tuple[ipm.Data, _Rows]:
             p.accel * p.h - dconst,
             p.decel * p.h + dconst,
             p.w_max[1:-1] / cw,
-            -w_min[lk] / cw[lk],
-            -jconst,
-            jconst,
+            np.zeros(0) if p.w_min is None else -p.w_min[1:-1][lk] / cw[lk],
+            -jconst,  # the negative jerk rows' +jconst is not stored (ipm._b_lin)
         )
     )
     data = ipm.Data(
-        jk=jk, jstart=np.searchsorted(jk, np.arange(m + 1)).astype(np.intp),
+        jstart=jstart,
         jc=np.ascontiguousarray(np.concatenate(stencils)[order].T),
         cj=np.concatenate(coefs)[order], lk=lk.astype(np.intp), ct=ct, cw=cw, b_lin=b_lin,
-        lay=ipm.layout(m, jk.size, lk.size),
+        lay=ipm.layout(m, k, lk.size),
     )
-    return data, _Rows(family=np.concatenate(fams)[order], node=jk)
+    return data
 
 
 # --- certificates -------------------------------------------------------------------------
@@ -264,7 +275,7 @@ def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, Flo
     # Stencil rows at t = 0: G x - b gives cj (jc · ŵ) plus the fixed ends' share (the
     # kernel's arithmetic, in numpy: the kernel itself is entered only once per solve).
     padded = np.concatenate(([0.0], w_hat, [0.0]))
-    i = d.jk
+    i = np.repeat(np.arange(d.lay.m), np.diff(d.jstart))  # the node of each row
     rows = d.cj * (d.jc[0] * padded[i] + d.jc[1] * padded[i + 1] + d.jc[2] * padded[i + 2])
     load = np.zeros(w_hat.size)
     np.maximum.at(load, i, np.abs(rows - d.b_lin[d.lay.jp : d.lay.jm]))
@@ -296,8 +307,7 @@ def _row_multipliers(
 
 def _kernel_args(
     p: DiscreteProblem, d: ipm.Data
-) -> tuple[ipm.Data, ipm.Point, ipm.Residual, ipm.Direction, ipm.Scaling, ipm.Factor,
-           ipm.Work]:
+) -> tuple[ipm.Data, ipm.Point, ipm.Residual, ipm.Direction, ipm.Scaling, ipm.Factor]:
     """The kernel's arrays for ``d``, sizes checked, with :func:`_start` in the point.
 
     The start is copied into the point before the other arrays are allocated, and its own
@@ -308,7 +318,7 @@ def _kernel_args(
     pt = ipm.empty(ipm.Point, lay)
     pt.w[:], pt.t[:], pt.z[:] = _start(p, d)
     args = (d, pt, ipm.empty(ipm.Residual, lay), ipm.empty(ipm.Direction, lay),
-            ipm.Scaling.identity(lay), ipm.empty(ipm.Factor, lay), ipm.empty(ipm.Work, lay))
+            ipm.Scaling.identity(lay), ipm.empty(ipm.Factor, lay))
     ipm.check_sizes(*args)
     return args
 
@@ -358,7 +368,7 @@ def _load_from_disk_cache() -> bool:
     dispatcher offers no public "load but do not compile"); any failure means "not loaded".
     """
     p = _example_problem()
-    d, _ = _prepare(p, _positive_feasible(p)[1:-1])
+    d = _prepare(p, _positive_feasible(p)[1:-1])
     args = (*_kernel_args(p, d), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
     import numba
 
@@ -718,7 +728,7 @@ def solve_unit_relaxation(
         raise SolverError("the relaxation needs n >= 3 grid nodes", backend="banded",
                           status="InvalidProblem")
     wmf = _positive_feasible(unit)
-    d, rows = _prepare(unit, wmf[1:-1])
+    d = _prepare(unit, wmf[1:-1])
     t_setup = time.perf_counter()
     w_int, yl, iterations, code = _run_kernel(unit, d, tol, max_iter)
     # Clip rounding-level excursions past the bounds; the ends are the given values.
@@ -727,7 +737,7 @@ def solve_unit_relaxation(
                         [unit.w_end]))
     t = _primal_t(unit, w)
     primal = float(t.sum())
-    dual = _lagrangian_bound(unit, *_row_multipliers(unit, d, rows, yl))
+    dual = _lagrangian_bound(unit, *_row_multipliers(unit, d, _stencil_rows(unit)[2], yl))
     status = ipm.STATUS_NAMES[code]
     if status != "Solved":
         # Like Clarabel's AlmostSolved: accepted only with a certified gap and feasible w,

@@ -101,15 +101,19 @@ class DiscreteProblem:
         """Number of grid nodes."""
         return int(self.s.shape[0])
 
-    @cached_property
+    # h, tau and the second-difference weights are computed on access, not cached: a
+    # cached copy on the problem and on its scaled copy stayed alive through every solve
+    # (56 bytes per node at the banded kernel's peak), and each costs microseconds.
+    @property
     def h(self) -> FloatArray:
         """Steps ``h_i = s_{i+1} - s_i``, shape (n-1,)."""
         return np.diff(self.s)
 
-    @cached_property
+    @property
     def tau(self) -> FloatArray:
         """Interior cell lengths ``(h_{i-1} + h_i) / 2``, shape (n-2,)."""
-        return 0.5 * (self.h[:-1] + self.h[1:])
+        h = self.h
+        return 0.5 * (h[:-1] + h[1:])
 
     @cached_property
     def uniform(self) -> bool:
@@ -139,10 +143,11 @@ class DiscreteProblem:
             return ()
         return (self.lateral,) if isinstance(self.lateral, StencilRows) else tuple(self.lateral)
 
-    @cached_property
+    @property
     def second_difference_weights(self) -> FloatArray:
         """Weights ``(n-2, 3)`` of ``w_{i-1}, w_i, w_{i+1}`` in ``w''_i`` (non-uniform grid)."""
-        h0, h1 = self.h[:-1], self.h[1:]
+        h = self.h
+        h0, h1 = h[:-1], h[1:]
         return np.column_stack(
             (2.0 / (h0 * (h0 + h1)), -2.0 / (h0 * h1), 2.0 / (h1 * (h0 + h1)))
         )
