@@ -123,12 +123,18 @@ def test_constraint_map_matches_the_definition_and_its_adjoint(seed):
     assert lhs == pytest.approx(float(x @ gty), rel=1e-12)
     ref = g_lin.T @ yl + np.einsum("rck,rc->k", g_soc, ys)
     np.testing.assert_allclose(gty, ref, rtol=1e-12, atol=1e-12)
-    # subtract=True: g - G' y, rounded as the difference of g and the finished G' y.
+    # The other modes round as the finished G' y combined with g; each returns the squared
+    # norms of what it wrote.
     g0 = [rng.normal(size=lay.m) for _ in range(3)]
-    got = [a.copy() for a in g0]
-    ipm.g_adjoint_into(d, yl, ys, *got, True)
-    for a, g, b in zip(got, g0, (gw, gt, gz), strict=True):
-        np.testing.assert_array_equal(a, g - b)
+    ct = np.zeros(3 * lay.m)
+    ct[lay.m : 2 * lay.m] = d.ct
+    for mode, want in ((ipm.ADJ_SUBTRACT, np.concatenate(g0) - gty),
+                       (ipm.ADJ_ADD, gty + np.concatenate(g0)),
+                       (ipm.ADJ_DUAL_RESIDUAL, -(gty + ct))):
+        got = [a.copy() for a in g0]
+        norms = ipm.g_adjoint_into(d, yl, ys, *got, mode)
+        np.testing.assert_array_equal(np.concatenate(got), want)
+        assert norms == pytest.approx([float(a @ a) for a in got], rel=1e-13)
 
 
 def _in_soc(u: np.ndarray) -> bool:

@@ -57,6 +57,9 @@ ALMOST_GAP = 1e-6
 #: (fuzz_zones seed 2 case 98: stopped at iteration 56 by the gap alone, solved at 117).
 NO_PROGRESS_ITERATIONS = 20
 
+#: How :func:`g_adjoint_into` writes ``G' y`` into its output.
+ADJ_SET, ADJ_SUBTRACT, ADJ_ADD, ADJ_DUAL_RESIDUAL = 0, 1, 2, 3
+
 #: Columns of :func:`iterate`'s log, one row per iteration.
 LOG_COLUMNS = ("pcost", "dcost", "relgap", "pres", "dres", "sigma", "step")
 
@@ -428,17 +431,20 @@ def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> 
 @njit(cache=True, error_model="numpy")
 def g_adjoint_into(
     d: Data, yl: FloatArray, ys: FloatArray, gw: FloatArray, gt: FloatArray, gz: FloatArray,
-    subtract: bool = False,
-) -> None:
-    """``G' y`` split into its ``w``, ``t`` and ``z`` parts; with ``subtract``, ``g -= G' y``.
+    mode: int = ADJ_SET,
+) -> tuple[float, float, float]:
+    """``G' y`` split into its ``w``, ``t`` and ``z`` parts, written into ``g`` by ``mode``.
 
-    Each entry is formed whole, node by node, before it is written: the stencil rows of
-    nodes ``i - 1``, ``i`` and ``i + 1`` are gathered in row order, so ``g - G' y`` rounds
-    as the difference of ``g`` and the finished ``G' y`` (the refinement's right-hand side
-    is formed in place in :func:`newton_into`).
+    ``ADJ_SET``: ``g = G' y``; ``ADJ_SUBTRACT``: ``g -= G' y``; ``ADJ_ADD``: ``g += G' y``;
+    ``ADJ_DUAL_RESIDUAL``: ``g = -(G' y + c)`` (``c`` is ``ct`` on ``t``). Each entry is
+    formed whole, node by node, before it is written: the stencil rows of nodes ``i - 1``,
+    ``i`` and ``i + 1`` are gathered in row order, so the modes round as the finished
+    ``G' y`` combined with ``g``, one pass over memory where a separate pass would add a
+    second. Returns the squared norms of the three parts as written.
     """
     lay = d.lay
     m = lay.m
+    sw = st = sz = 0.0
     rl = 0  # floors, by increasing node
     for i in range(m):
         acc_i = yl[i] - yl[lay.dec + i]
@@ -456,12 +462,17 @@ def g_adjoint_into(
                 vw += d.cj[r] * (jp - jm) * d.jc[i - node + 1, r]
                 if node == i:
                     vt -= jp + jm
-        if subtract:
-            gw[i] -= vw
-            gt[i] -= vt
-            gz[i] -= vz
-        else:
-            gw[i], gt[i], gz[i] = vw, vt, vz
+        if mode == ADJ_SUBTRACT:
+            vw, vt, vz = gw[i] - vw, gt[i] - vt, gz[i] - vz
+        elif mode == ADJ_ADD:
+            vw, vt, vz = vw + gw[i], vt + gt[i], vz + gz[i]
+        elif mode == ADJ_DUAL_RESIDUAL:
+            vw, vt, vz = -vw, -(vt + d.ct[i]), -vz
+        gw[i], gt[i], gz[i] = vw, vt, vz
+        sw += vw * vw
+        st += vt * vt
+        sz += vz * vz
+    return sw, st, sz
 
 
 # --- cones: steps, interiority, scaling --------------------------------------------------------
@@ -834,11 +845,8 @@ def newton_into(
     """
     # With v = H by - W⁻¹ u (λ ∘ u = bs): (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
     _v_into(sc, pt, rp, corrector, sigma_mu, dn)
-    g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz)
-    for i in range(dn.dw.size):
-        dn.dw[i] += res.gw[i]
-        dn.dt[i] += res.gt[i]
-        dn.dz[i] += res.gz[i]
+    dn.dw[:], dn.dt[:], dn.dz[:] = res.gw, res.gt, res.gz
+    g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz, ADJ_ADD)
     solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
     _ds_dy_into(d, sc, pt, rp, dn)
     # The last two equations hold by construction; only G'Δy = bx inherits the rounding of
@@ -848,7 +856,7 @@ def newton_into(
         # The residual bx - G'Δy is formed in res itself, and bx formed again from the
         # iterate afterwards (it is a function of pt alone): no array of its own.
         rw, rt, rz = res.gw, res.gt, res.gz
-        g_adjoint_into(d, dn.dyl, dn.dys, rw, rt, rz, True)
+        g_adjoint_into(d, dn.dyl, dn.dys, rw, rt, rz, ADJ_SUBTRACT)
         res2 = 0.0
         for i in range(rw.size):
             res2 += rw[i] * rw[i] + rt[i] * rt[i] + rz[i] * rz[i]
@@ -951,13 +959,10 @@ def start_into(
 
 
 @njit(cache=True, error_model="numpy")
-def dual_residual_into(d: Data, pt: Point, res: Residual) -> None:
-    """The dual residual, negated, ``-(G'y + c)``, into ``res``."""
-    g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz)
-    for i in range(d.lay.m):
-        res.gw[i] = -res.gw[i]
-        res.gt[i] = -(res.gt[i] + d.ct[i])
-        res.gz[i] = -res.gz[i]
+def dual_residual_into(d: Data, pt: Point, res: Residual) -> float:
+    """The dual residual, negated, ``-(G'y + c)``, into ``res``; returns its squared norm."""
+    sw, st, sz = g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz, ADJ_DUAL_RESIDUAL)
+    return sw + st + sz
 
 
 @njit(cache=True, error_model="numpy")
@@ -970,26 +975,25 @@ def residuals_into(
     computed in ``scratch`` (the cones have none, see :class:`Point`).
     """
     m = d.lay.m
-    dual_residual_into(d, pt, res)
+    rx2 = dual_residual_into(d, pt, res)
     g_lin_into(d, pt.w, pt.t, scratch)
-    ry2 = 0.0
+    sl, yl = pt.sl, pt.yl
+    ry2 = gap = yb = 0.0  # one pass over the linear rows for |r_y|², s'y and y'b
     for j in range(scratch.size):
-        r = _b_lin(d, j) - scratch[j] - pt.sl[j]
+        b = _b_lin(d, j)
+        r = b - scratch[j] - sl[j]
         ry2 += r * r
+        gap += sl[j] * yl[j]
+        yb += yl[j] * b
     ys = pt.ys
     ys_b = 0.0  # ys · b_soc with the constant part of the cone rows spelled out
-    gap = _dot(pt.sl, pt.yl)
     for c in range(2 * m):
         s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
         gap += s0 * ys[0, c] + s1 * ys[1, c] + s2 * ys[2, c]
-    for i in range(m):
-        ys_b += ys[0, i] - ys[2, i] + 2.0 * ys[2, m + i]
+        if c < m:
+            ys_b += ys[0, c] - ys[2, c] + 2.0 * ys[2, m + c]
     pcost = _dot(d.ct, pt.t)
-    yb = 0.0
-    for j in range(pt.yl.size):
-        yb += pt.yl[j] * _b_lin(d, j)
     dcost = -yb - ys_b
-    rx2 = _dot(res.gw, res.gw) + _dot(res.gt, res.gt) + _dot(res.gz, res.gz)
     return pcost, dcost, gap, ry2, rx2
 
 
