@@ -52,6 +52,14 @@ def instances() -> list[tuple[str, DiscreteProblem]]:
             for k, leg in enumerate(legs):
                 suffix = f"/{k}" if len(legs) > 1 else ""
                 out.append((f"{os.path.basename(f)}:{n}{suffix}", leg.problem))
+    # Rows the sample plans above never have: lateral-jerk families (two per node at the
+    # joins of path pieces) and floors w_min (a moving, braking start).
+    aisle = read_path(os.path.join(ROOT, "paths", "aisle_corners.csv"))
+    comfort = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5, j_lat_max=0.3)
+    for tag, kw in (("lateral", {}), ("lateral+moving", {"v0": 0.8, "a0": -0.2, "n": 800})):
+        legs = [leg for leg in build_model(PlanRequest.create(aisle, comfort, **kw)).legs
+                if isinstance(leg, Leg)]
+        out += [(f"aisle_corners.csv:{tag}/{k}", leg.problem) for k, leg in enumerate(legs)]
     return out
 
 

@@ -27,8 +27,11 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from ._numba_cache import tolerate_stale_indexes
 from .checks import FloatArray, IntArray
 from .numerics import GAUSS_NODES, GAUSS_WEIGHTS
+
+tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 __all__ = ["integrals", "invert", "kinematics"]
 

@@ -30,7 +30,10 @@ from typing import Any, NamedTuple, TypeVar
 import numpy as np
 from numba import njit
 
+from ..core._numba_cache import tolerate_stale_indexes
 from ..core.checks import FloatArray, IntArray
+
+tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 _T = TypeVar("_T")
 
@@ -98,7 +101,11 @@ def layout(m: int, k: int, kl: int) -> Layout:
 
 
 def _shape(kind: str, lay: Layout) -> tuple[int, ...]:
-    """Shape of an array of ``kind``: per node, linear row, cone (3, nc), cone, jerk row, floor."""
+    """Shape of an array of ``kind``.
+
+    Per node, linear row, right-hand side (linear rows before the negative jerk rows), cone
+    (3, nc), cone, jerk row, stencil (3, k), node starts (m + 1), floor.
+    """
     return {"node": (lay.m,), "lin": (lay.n_lin,), "rhs": (lay.jm,), "cone": (3, lay.nc),
             "cones": (lay.nc,),
             "jerk": (lay.k,), "stencil": (3, lay.k), "start": (lay.m + 1,),
@@ -156,6 +163,8 @@ class Data(NamedTuple):
         if not (js[0] == 0 and js[-1] == self.lay.k and bool(np.all(np.diff(js) >= 0))):
             raise ValueError("Data.jstart must index the rows of each node: non-decreasing "
                              "from 0 to the number of stencil rows")
+        if self.lk.size and not bool(np.all(np.diff(self.lk) > 0)):
+            raise ValueError("Data.lk must be strictly increasing (one floor per node)")
 
 
 class Point(NamedTuple):
@@ -435,8 +444,9 @@ def g_adjoint_into(
 ) -> tuple[float, float, float]:
     """``G' y`` split into its ``w``, ``t`` and ``z`` parts, written into ``g`` by ``mode``.
 
-    ``ADJ_SET``: ``g = G' y``; ``ADJ_SUBTRACT``: ``g -= G' y``; ``ADJ_ADD``: ``g += G' y``;
-    ``ADJ_DUAL_RESIDUAL``: ``g = -(G' y + c)`` (``c`` is ``ct`` on ``t``). Each entry is
+    ``ADJ_SET`` (and any other value): ``g = G' y``; ``ADJ_SUBTRACT``: ``g -= G' y``;
+    ``ADJ_ADD``: ``g += G' y``; ``ADJ_DUAL_RESIDUAL``: ``g = -(G' y + c)`` (``c`` is ``ct``
+    on ``t``). The floors ``lk`` must be strictly increasing (:meth:`Data.check`). Each entry is
     formed whole, node by node, before it is written: the stencil rows of nodes ``i - 1``,
     ``i`` and ``i + 1`` are gathered in row order, so the modes round as the finished
     ``G' y`` combined with ``g``, one pass over memory where a separate pass would add a

@@ -24,7 +24,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..core._numba_cache import tolerate_stale_indexes
 from ..core.checks import FloatArray, IntArray
+
+tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 # IPOPT's inertia-correction constants, the numpy path's (banded_nlp). Written here, not
 # imported: numba freezes globals into cached code and re-validates the cache against this

@@ -292,7 +292,7 @@ def _row_multipliers(
     """
     lay = d.lay
     nu = []
-    for f in range(len(p.stencil_families())):
+    for f in range(1 + len(p.lateral_families)):  # the jerk rows, then each lateral family
         mine = rows.family == f
         node = rows.node[mine]
         nu_p, nu_m = np.zeros(lay.m), np.zeros(lay.m)
