@@ -19,43 +19,30 @@ from pathlib import Path
 import pytest
 
 # One kernel module in two versions, the function on the same line in both: version 1 calls
-# it with a NamedTuple that version 2 no longer defines.
+# it with a NamedTuple that version 2 no longer defines (two comment lines in its place).
+_MODULE = """
+    from typing import NamedTuple
+    import numpy as np
+    from numba import njit
+    {harden}
+    {gone}
+    class Kept(NamedTuple):
+        a: np.ndarray
+    @njit(cache=True)
+    def total(x):
+        return x.a.sum()
+    ARG = {arg}
+"""
 _VERSIONS = {
-    1: """
-        from typing import NamedTuple
-        import numpy as np
-        from numba import njit
-        {harden}
-        class Gone(NamedTuple):
-            a: np.ndarray
-        class Kept(NamedTuple):
-            a: np.ndarray
-        @njit(cache=True)
-        def total(x):
-            return x.a.sum()
-        ARG = Gone(np.ones(3))
-    """,
-    2: """
-        from typing import NamedTuple
-        import numpy as np
-        from numba import njit
-        {harden}
-        class Kept(NamedTuple):
-            a: np.ndarray
-        #
-        #
-        @njit(cache=True)
-        def total(x):
-            return x.a.sum()
-        ARG = Kept(np.ones(4))
-    """,
+    1: {"gone": "class Gone(NamedTuple):\n        a: np.ndarray", "arg": "Gone(np.ones(3))"},
+    2: {"gone": "#\n    #", "arg": "Kept(np.ones(4))"},
 }
 _HARDEN = ("from speedplan.core._numba_cache import tolerate_stale_indexes; "
            "tolerate_stale_indexes()")
 
 
 def _run(tmp_path: Path, version: int, harden: bool) -> subprocess.CompletedProcess[str]:
-    src = textwrap.dedent(_VERSIONS[version]).format(harden=_HARDEN if harden else "")
+    src = textwrap.dedent(_MODULE.format(harden=_HARDEN if harden else "", **_VERSIONS[version]))
     (tmp_path / "kernelmod.py").write_text(src)
     os.utime(tmp_path / "kernelmod.py", (version * 1000.0, version * 1000.0))  # a new stamp
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
@@ -82,11 +69,17 @@ def test_a_stale_index_naming_a_removed_class_is_recompiled_over(tmp_path):
     assert again.returncode == 0, again.stderr
 
 
-def test_every_kernel_module_hardens_the_cache_before_its_kernels():
-    from numba.core.caching import IndexDataCacheFile
-
-    import speedplan.core._law_kernel
-    import speedplan.solve._banded_ipm
-    import speedplan.solve._banded_nlp_kernels  # noqa: F401
-
-    assert IndexDataCacheFile._load_index.__name__ == "_load_index_or_empty"
+@pytest.mark.slow
+@pytest.mark.parametrize("module", ["speedplan.core._law_kernel", "speedplan.solve._banded_ipm",
+                                    "speedplan.solve._banded_nlp_kernels"])
+def test_every_kernel_module_hardens_the_cache_on_its_own(module):
+    # In a fresh process, loading the module alone must install the guard (in this process
+    # another module may already have). The kernel modules are imported lazily: their body
+    # runs at the first attribute access, before any kernel can be called.
+    check = (f"import importlib; importlib.import_module({module!r}).njit; "
+             "from numba.core.caching import IndexDataCacheFile as C; "
+             "print(C._load_index.__name__)")
+    out = subprocess.run([sys.executable, "-c", check], capture_output=True, text=True,
+                         timeout=240, check=False)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "_load_index_or_empty"
