@@ -218,13 +218,18 @@ def test_compiled_and_numpy_time_laws_agree():
             assert np.max(np.abs(a - b)) <= 1e-13 * max(np.max(np.abs(b)), 1e-300)
 
 
+@pytest.mark.parametrize("compiled", [True, False])
 @pytest.mark.parametrize("seed", range(4))
-def test_compiled_inversion_meets_its_time_tolerance(seed):
-    # The compiled inversion skips the integral that would confirm a Newton step when the
-    # step's predicted error is far inside the tolerance: the times the offsets reach (the
-    # same 16-point integral from the piece's start, or its standstill end) must still be
-    # the requested ones to 1e-15 of the piece's time, up to rounding.
+def test_inversion_meets_its_time_tolerance(seed, compiled):
+    # The inversion takes the closed-form offset on w-pieces that start moving and skips the
+    # integral that would confirm a Newton step when the step's predicted error is far
+    # inside the tolerance: the times the offsets reach (the 16-point integral from the
+    # piece's start, or its standstill end) must still be the requested ones to 1e-15 of the
+    # piece's time, up to rounding.
     from speedplan.core import _law_kernel
+    from speedplan.timing import _law_numpy
+
+    inverse = (_law_kernel if compiled else _law_numpy).invert
 
     rng = np.random.default_rng(seed)
     s = np.cumsum(rng.uniform(0.05, 0.15, 300) * 10 ** rng.uniform(-3, 3))
@@ -244,7 +249,7 @@ def test_compiled_inversion_meets_its_time_tolerance(seed):
         t = np.concatenate((np.arange(0.0, law.duration, law.duration / 5000),
                             rng.uniform(0.0, law.duration, 5000)))
         k = np.clip(np.searchsorted(T, t, side="right") - 1, 0, p.c.size - 1)
-        dx, dr = _law_kernel.invert(p, T, k, t)
+        dx, dr = inverse(p, T, k, t)
         right = (p.y_right[k] <= 0.0) & (p.y[k] > 0.0)
         off = np.where(right, dr, dx)
         reached = _law_kernel.integrals(p, k, np.zeros(k.size), off, right)

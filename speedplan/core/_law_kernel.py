@@ -5,14 +5,16 @@ Plain arrays in, plain arrays out (the law's chain of quadratic pieces in ``w`` 
 (and with it the background compilation of a fresh environment) compiles it together with
 the banded kernel, without the solver layer importing the timing layer.
 
-The numpy formulation (one ``(16, samples)`` array per Newton step, 5-8 passes over memory
-per step, every sample iterated as long as the slowest) cost 30-40 ms for the 10 000 samples
-of a 100 Hz trajectory; here each sample runs its own safeguarded Newton iteration on one
-16-point Gauss–Legendre integral, the same iteration and stopping rule (``|t(σ) - τ| <=
-1e-15`` of the piece's time), started from the third-order kinematic expansion at the piece's
-left knot (``σ ≈ v τ + a τ²/2 + j τ³/6``), so that one Newton step and the confirming
-integral usually suffice. Results agree with the numpy formulation to rounding (sampled
-states within 2e-15 of their scale on every sample path). Used by
+The time inversion: on a ``w``-piece that starts moving, the offset reached at time ``τ`` is
+the exact solution of ``dσ/dτ = sqrt(w(σ))`` (:func:`_moving_offset`); it meets the
+quadrature's time to the same ``1e-15`` of the piece's time as the iteration does, at a
+fifth of its cost (the 10 000 samples of a 100 Hz trajectory: 0.6 ms against 3.3 ms).
+Pieces in ``u`` and pieces that start or end at a standstill run a safeguarded Newton
+iteration on one 16-point Gauss–Legendre integral (stopping at ``|t(σ) - τ| <= 1e-15`` of
+the piece's time), started from the third-order kinematic expansion at the left knot
+(``σ ≈ v τ + a τ²/2 + j τ³/6``) or, at a standstill, the piece's own power law. Results
+agree with the numpy formulation to rounding (sampled states within 2e-15 of their scale on
+every sample path). Used by
 :mod:`speedplan.timing.law` once numba is loaded (before that, the same formulas in numpy:
 ``speedplan.timing._law_numpy``): ``import speedplan`` stays free of numba. Explicit
 signatures, cached on disk: with numba's runtime loaded (the banded kernel) the module loads
@@ -170,6 +172,25 @@ def _step_settles(e: float, v: float, acc: float, jerk: float, ttol: float,
     return 10.0 * err <= 0.25 * ttol * v
 
 
+@njit("f8(f8, f8, f8, f8)", cache=True, error_model="numpy")
+def _moving_offset(tau: float, y0: float, g0: float, c0: float) -> float:
+    """Offset reached at time ``tau`` on a ``w``-piece that starts moving: the exact solution.
+
+    ``w = y0 + g0 σ + c0 σ²/2`` makes ``dσ/dτ = sqrt(w)`` solvable: with ``k = sqrt(|c0|/2)``,
+    ``σ(τ) = v0 τ S(kτ) + (g0 τ²/4) S(kτ/2)²``, ``S(z) = sinh(z)/z`` for ``c0 > 0``,
+    ``sin(z)/z`` for ``c0 < 0`` and 1 for ``c0 = 0``. Written with ``S``, neither term
+    cancels as ``c0 → 0`` (the ``cosh(kτ) - 1`` of the textbook form does).
+    """
+    half = 0.5 * tau * math.sqrt(0.5 * abs(c0))
+    if half == 0.0:
+        s_full, s_half = 1.0, 1.0
+    elif c0 > 0.0:
+        s_full, s_half = math.sinh(2.0 * half) / (2.0 * half), math.sinh(half) / half
+    else:
+        s_full, s_half = math.sin(2.0 * half) / (2.0 * half), math.sin(half) / half
+    return math.sqrt(y0) * tau * s_full + 0.25 * g0 * tau * tau * s_half * s_half
+
+
 @njit(f"void({_PIECES}, f8[::1], i8[::1], f8[::1], f8[:, ::1], f8[::1], f8[::1])",
       cache=True, error_model="numpy")
 def _invert_into(pieces: Pieces, T: FloatArray, j: IntArray, t: FloatArray, rule: FloatArray,
@@ -186,19 +207,23 @@ def _invert_into(pieces: Pieces, T: FloatArray, j: IntArray, t: FloatArray, rule
         tau = T[jk + 1] - t[k] if rest_right else t[k] - T[jk]
         frac = tau / span_t if span_t > 0 else 0.0
         frac = min(max(frac, 0.0), 1.0)
+        if not (rest_left or rest_right or is_u[jk]):  # exact, no iteration
+            if tau >= span_t:
+                off = width
+            elif tau <= 0:
+                off = 0.0
+            else:
+                off = min(max(_moving_offset(tau, y[jk], g[jk], c[jk]), 0.0), width)
+            dx_out[k], dr_out[k] = off, width - off
+            continue
         if rest_left or rest_right:  # the piece's own power law
             off = width * frac**power
         else:  # third order in time from the left knot: one or two Newton steps remain
             y0, g0, c0 = y[jk], g[jk], c[jk]
-            if is_u[jk]:
-                cube = np.cbrt(y0)
-                v0 = math.sqrt(y0 * cube)
-                a0 = (2.0 / 3.0) * cube * g0
-                j0 = (2.0 / 9.0) * g0 * g0 + (2.0 / 3.0) * y0 * c0
-            else:
-                v0 = math.sqrt(y0)
-                a0 = 0.5 * g0
-                j0 = 0.5 * c0 * v0
+            cube = np.cbrt(y0)
+            v0 = math.sqrt(y0 * cube)
+            a0 = (2.0 / 3.0) * cube * g0
+            j0 = (2.0 / 9.0) * g0 * g0 + (2.0 / 3.0) * y0 * c0
             off = tau * (v0 + tau * (0.5 * a0 + tau * j0 / 6.0))
             if not (off > 0.0 and off < width):
                 off = width * frac

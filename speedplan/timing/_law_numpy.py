@@ -93,6 +93,20 @@ def integrals(p: Any, j: IntArray, lo: FloatArray, hi: FloatArray,
     return out
 
 
+def _moving_offset(tau: FloatArray, y0: FloatArray, g0: FloatArray,
+                   c0: FloatArray) -> FloatArray:
+    """``speedplan.core._law_kernel._moving_offset``, elementwise."""
+    half = 0.5 * tau * np.sqrt(0.5 * np.abs(c0))
+    safe = np.where(half == 0.0, 1.0, half)
+    with np.errstate(over="ignore", invalid="ignore"):
+        s_full = np.where(half == 0.0, 1.0, np.where(c0 > 0.0, np.sinh(2.0 * safe),
+                                                     np.sin(2.0 * safe)) / (2.0 * safe))
+        s_half = np.where(half == 0.0, 1.0, np.where(c0 > 0.0, np.sinh(safe),
+                                                     np.sin(safe)) / safe)
+    out: FloatArray = np.sqrt(y0) * tau * s_full + 0.25 * g0 * tau * tau * s_half * s_half
+    return out
+
+
 def invert(p: Any, T: FloatArray, j: IntArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Offsets ``(dx, dr)`` reached at times ``t`` in pieces ``j`` (see ``TimeLaw._invert``)."""
     width = p.x[j + 1] - p.x[j]
@@ -105,9 +119,15 @@ def invert(p: Any, T: FloatArray, j: IntArray, t: FloatArray) -> tuple[FloatArra
     with np.errstate(divide="ignore", invalid="ignore"):
         frac = np.clip(np.where(span_t > 0, tau / span_t, 0.0), 0.0, 1.0)
     off = width * np.where(rest_left | rest_right, frac**power, frac)
+    inner = (tau > 0) & (tau < span_t)  # at a knot the offset is exact
+    # A w-piece that starts moving has its offset in closed form; the rest iterate.
+    exact = np.flatnonzero(inner & ~(rest_left | rest_right | p.is_u[j]))
+    je = j[exact]
+    off[exact] = np.clip(_moving_offset(tau[exact], p.y[je], p.g[je], p.c[je]), 0.0,
+                         width[exact])
     lo, hi = np.zeros_like(off), width.copy()
     ttol = 1e-15 * np.maximum(span_t, 1e-300)
-    act = np.flatnonzero((tau > 0) & (tau < span_t))  # at a knot the offset is exact
+    act = np.flatnonzero(inner & (rest_left | rest_right | p.is_u[j]))
     for _ in range(100):
         if act.size == 0:
             break

@@ -452,15 +452,16 @@ class TimeLaw:
     def _invert(self, t: FloatArray) -> tuple[IntArray, FloatArray, FloatArray]:
         """Piece and offsets ``(j, dx, dr)`` reached at times ``t``.
 
-        Safeguarded Newton on the time within each piece, in the offset from the piece's
-        standstill end when it has one (else from its left knot): next to a stop the offset
-        keeps full relative precision, where an arc length near a long path's end would be
-        quantised to 1e-16 of the path (and the speed with it). Starts from the piece's own
-        power law (``σ = τ³`` in ``u``, ``τ²`` in ``w`` at a standstill, else linear, or in
-        the compiled kernel the third-order kinematic expansion at the left knot);
-        Newton steps are kept only inside the bracket, bisection otherwise. Compiled, one
-        iteration per time (:mod:`speedplan.core._law_kernel`; numpy before numba is
-        loaded).
+        On a ``w``-piece that starts moving, the exact solution of ``dσ/dτ = sqrt(w)`` (closed
+        form in ``sinh`` or ``sin``). Elsewhere a safeguarded Newton iteration on the time
+        within each piece, in the offset from the piece's standstill end when it has one (else
+        from its left knot): next to a stop the offset keeps full relative precision, where
+        an arc length near a long path's end would be quantised to 1e-16 of the path (and
+        the speed with it). It starts from the piece's own power law (``σ = τ³`` in ``u``,
+        ``τ²`` in ``w`` at a standstill, else linear, or in the compiled kernel the
+        third-order kinematic expansion at the left knot); Newton steps are kept only inside
+        the bracket, bisection otherwise. Compiled (:mod:`speedplan.core._law_kernel`; numpy
+        before numba is loaded).
         """
         p = self._pieces
         T = self.knot_times
