@@ -158,3 +158,73 @@ def no_jerk_lower_bound(bound, length, a_max, a_decel, v0=0.0, vf=0.0, samples=4
         first = np.where(tc > 0, 2.0 * tc / (up + np.sqrt(wa)), 0.0)
         second = np.where(h - tc > 0, 2.0 * (h - tc) / (down + np.sqrt(wb)), 0.0)
     return float(np.sum(first + second)), s, w
+
+
+@dataclass(frozen=True)
+class IpoptAnswer:
+    """CasADi + IPOPT on a discrete problem's plain formulation.
+
+    ``w`` has the fixed end values; ``violation_price`` is the travel time IPOPT's point buys
+    by violating its rows and bounds, to first order, relative to its objective
+    (:func:`ipopt_plain`).
+    """
+
+    w: np.ndarray
+    success: bool
+    status: str
+    violation_price: float
+
+
+def interior_bounds(p):
+    """``[max(w_min, 1e-9 max(1, max w_max)), w_max]`` on every node (as speedplan's bounds)."""
+    ub = p.w_max.astype(np.float64)
+    lb = np.minimum(1e-9 * max(1.0, float(np.max(p.w_max))), ub)
+    if p.w_min is not None:
+        lb = np.maximum(lb, p.w_min)
+    return lb, ub
+
+
+def ipopt_plain(p, w0, options=None):
+    """IPOPT (``options`` on top of its defaults) on ``min Σ τ_i / sqrt(w_i)`` from ``w0``.
+
+    The plain formulation, written independently of speedplan's solvers: rows
+    ``w_{i+1} - w_i ∈ [-decel_i h_i, accel_i h_i]`` and ``(c · w) sqrt(w_i) ∈ [-B_i, B_i]``
+    for every stencil family (rows with an infinite bound left out), bounds
+    :func:`interior_bounds`.
+
+    IPOPT stops once rows hold to ``constr_viol_tol`` and relaxes its bounds by
+    ``bound_relax_factor``; near a standstill that sliver of violation buys travel time that
+    no feasible point has. Relaxing row ``i`` by ``δ_i`` lowers the optimum by ``|λ_i| δ_i``
+    to first order (``λ_i`` its multiplier), so ``objective (1 + violation_price)``, with
+    ``violation_price = Σ |λ_i| max(violation_i, 0) / objective`` from IPOPT's own
+    multipliers, is its objective at equal feasibility to first order.
+    """
+    import casadi as ca
+
+    x = ca.SX.sym("w", p.n - 2)
+    wf = ca.vertcat(p.w_start, x, p.w_end)
+    rows, lbg, ubg = [wf[1:] - wf[:-1]], [-p.decel * p.h], [p.accel * p.h]
+    for fam in p.stencil_families():
+        keep = np.flatnonzero(np.isfinite(fam.bound))
+        if keep.size:
+            stencil = ca.DM(p.stencil_matrix(fam.coef)[keep].tocsc())
+            rows.append(ca.mtimes(stencil, wf) * ca.sqrt(x[keep.tolist()]))
+            lbg.append(-fam.bound[keep])
+            ubg.append(fam.bound[keep])
+    solver = ca.nlpsol("plain", "ipopt", {"x": x, "f": ca.sum1(ca.DM(p.tau) / ca.sqrt(x)),
+                                          "g": ca.vertcat(*rows)},
+                       {"ipopt": {"print_level": 0, "sb": "yes", **(options or {})},
+                        "print_time": False})
+    lb, ub = (b[1:-1] for b in interior_bounds(p))
+    lo_g, hi_g = np.concatenate(lbg), np.concatenate(ubg)
+    sol = solver(x0=np.clip(w0[1:-1], lb, ub), lbx=lb, ubx=ub, lbg=lo_g, ubg=hi_g)
+    stats = solver.stats()
+    x_opt = np.asarray(sol["x"]).ravel()
+    g_val = np.asarray(sol["g"]).ravel()
+    viol_g = np.maximum(np.maximum(g_val - hi_g, lo_g - g_val), 0.0)
+    viol_x = np.maximum(np.maximum(x_opt - ub, lb - x_opt), 0.0)
+    bought = (np.abs(np.asarray(sol["lam_g"]).ravel()) @ viol_g
+              + np.abs(np.asarray(sol["lam_x"]).ravel()) @ viol_x)
+    return IpoptAnswer(w=np.concatenate(([p.w_start], x_opt, [p.w_end])),
+                       success=bool(stats["success"]), status=str(stats["return_status"]),
+                       violation_price=float(bought / float(sol["f"])))

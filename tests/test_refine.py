@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import os
 import warnings
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
 import pytest
+from oracles import ipopt_plain
 
 import speedplan as sp
 from speedplan.core.errors import SolverError
@@ -60,26 +62,15 @@ def _feasible(p: DiscreteProblem, w) -> bool:
 
 
 def _ipopt_tight(p: DiscreteProblem, w0) -> tuple[bool, float]:
-    """IPOPT, default options but tight tolerances, plain formulation (independent code)."""
-    x = ca.SX.sym("w", p.n - 2)
-    wf = ca.vertcat(p.w_start, x, p.w_end)
-    rows, lbg, ubg = [wf[1:] - wf[:-1]], [-p.decel * p.h], [p.accel * p.h]
-    for fam in p.stencil_families():
-        d2 = ca.DM(p.stencil_matrix(fam.coef).tocsc())
-        rows.append(ca.mtimes(d2, wf) * ca.sqrt(x))
-        lbg.append(-fam.bound)
-        ubg.append(fam.bound)
-    solver = ca.nlpsol("t", "ipopt", {"x": x, "f": ca.sum1(ca.DM(p.tau) / ca.sqrt(x)),
-                                      "g": ca.vertcat(*rows)},
-                       {"ipopt": {"print_level": 0, "sb": "yes", "tol": 1e-10,
-                                  "constr_viol_tol": 1e-10}, "print_time": False})
-    lb = np.full(p.n - 2, 1e-9)
-    sol = solver(x0=np.clip(w0[1:-1], lb, p.w_max[1:-1]), lbx=lb, ubx=p.w_max[1:-1],
-                 lbg=np.concatenate(lbg), ubg=np.concatenate(ubg))
-    w = np.concatenate(([p.w_start], np.asarray(sol["x"]).ravel(), [p.w_end]))
-    w = np.clip(w, 0.0, p.w_max)
-    ok = solver.stats()["success"] and _feasible(p, w)
-    return ok, p.travel_time(w)
+    """IPOPT with tight tolerances (``tests/oracles.py``): accepted, and its objective at
+    equal feasibility (plus the first-order price of the rows it still violates)."""
+    ans = ipopt_plain(p, w0, {"tol": 1e-10, "constr_viol_tol": 1e-10})
+    w = np.clip(ans.w, 0.0, p.w_max)
+    return ans.success and _feasible(p, w), p.travel_time(w) * (1.0 + ans.violation_price)
+
+
+#: Objectives of two converged runs (IPOPT's ``tol = 1e-10``, ours ``1e-9``) differ by this.
+SAME_OBJECTIVE = 1e-8
 
 
 def test_condensed_newton_matrix_matches_automatic_differentiation():
@@ -281,7 +272,28 @@ def test_refinement_is_feasible_certified_and_never_worse_than_ipopt(family, see
     assert objective >= min(relax.dual_objective, relax.primal_objective) * (1 - 1e-9)
     ok, ipopt_objective = _ipopt_tight(p, relax.w)
     assert ok
-    assert objective <= ipopt_objective * (1 + 1e-6)
+    assert objective <= ipopt_objective * (1 + SAME_OBJECTIVE)
+
+
+#: ``benchmarks/data/refine_corpus.npz`` entries (``plan()`` problems of an earlier model,
+#: braking starts, relaxed ``w`` stored) where IPOPT's tight run ends below the refinement by
+#: 2.5e-5 and 2.1e-6: bought by rows it leaves violated by 18 % and 0.4 % of ``jerk_tol``.
+CORPUS = Path(__file__).resolve().parents[1] / "benchmarks" / "data" / "refine_corpus.npz"
+
+
+@pytest.mark.parametrize("entry", [1, 37])
+def test_refinement_is_never_worse_than_ipopt_at_equal_feasibility(entry):
+    z = np.load(CORPUS)
+    get = {name: z[f"{entry}/{name}"] for name in ("s", "w_max", "accel", "decel", "jerk",
+                                                    "w_min", "ends", "w0")}
+    p = _unit(DiscreteProblem(s=get["s"], w_max=get["w_max"], accel=get["accel"],
+                              decel=get["decel"], jerk=get["jerk"], w_start=float(get["ends"][0]),
+                              w_end=float(get["ends"][1]),
+                              w_min=get["w_min"] if get["w_min"].any() else None))
+    res = refine(p, get["w0"])
+    assert res.success and _feasible(p, res.w)
+    ok, ipopt_objective = _ipopt_tight(p, get["w0"])
+    assert ok and p.travel_time(res.w) <= ipopt_objective * (1 + SAME_OBJECTIVE)
 
 
 def test_best_of_the_starts_is_returned():
@@ -318,7 +330,7 @@ def test_lateral_jerk_rows_are_refined():
     assert res.success and _feasible(p, res.w)
     assert np.max(p.lateral_rows(res.w)) <= p.jerk_tol
     ok, ipopt_objective = _ipopt_tight(p, relax.w)
-    assert ok and p.travel_time(res.w) <= ipopt_objective * (1 + 1e-6)
+    assert ok and p.travel_time(res.w) <= ipopt_objective * (1 + SAME_OBJECTIVE)
 
 
 def test_restoration_phase_recovers_a_start_that_violates_many_rows():
