@@ -107,10 +107,15 @@ def _moving_offset(tau: FloatArray, y0: FloatArray, g0: FloatArray,
     return out
 
 
-def invert(p: Any, T: FloatArray, j: IntArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Offsets ``(dx, dr)`` reached at times ``t`` in pieces ``j`` (see ``TimeLaw._invert``)."""
+def invert(p: Any, T: FloatArray, j: IntArray, t: FloatArray,
+           exact: np.ndarray) -> tuple[FloatArray, FloatArray]:
+    """Offsets ``(dx, dr)`` reached at times ``t`` in pieces ``j`` (see ``TimeLaw._invert``).
+
+    ``exact``: per piece, whether to take the closed form (``TimeLaw._exact_inverse``).
+    """
     width = p.x[j + 1] - p.x[j]
     span_t = T[j + 1] - T[j]
+    closed = exact[j]  # moving at both ends: neither standstill branch below applies
     rest_left = p.y[j] <= 0.0
     rest_right = (p.y_right[j] <= 0.0) & ~rest_left
     power = np.where(p.is_u[j], 3.0, 2.0)
@@ -120,14 +125,9 @@ def invert(p: Any, T: FloatArray, j: IntArray, t: FloatArray) -> tuple[FloatArra
         frac = np.clip(np.where(span_t > 0, tau / span_t, 0.0), 0.0, 1.0)
     off = width * np.where(rest_left | rest_right, frac**power, frac)
     inner = (tau > 0) & (tau < span_t)  # at a knot the offset is exact
-    # A w-piece that starts moving has its offset in closed form; the rest iterate.
-    exact = np.flatnonzero(inner & ~(rest_left | rest_right | p.is_u[j]))
-    je = j[exact]
-    off[exact] = np.clip(_moving_offset(tau[exact], p.y[je], p.g[je], p.c[je]), 0.0,
-                         width[exact])
     lo, hi = np.zeros_like(off), width.copy()
     ttol = 1e-15 * np.maximum(span_t, 1e-300)
-    act = np.flatnonzero(inner & (rest_left | rest_right | p.is_u[j]))
+    act = np.flatnonzero(inner & ~closed)
     for _ in range(100):
         if act.size == 0:
             break
@@ -147,4 +147,14 @@ def invert(p: Any, T: FloatArray, j: IntArray, t: FloatArray) -> tuple[FloatArra
     off = np.where(tau >= span_t, width, np.where(tau <= 0, 0.0, off))
     dx = np.where(rest_right, width - off, off)
     dr = np.where(rest_right, off, width - off)
+    # The closed form, from the knot nearer in time (that knot's offset kept exact).
+    left = np.flatnonzero(inner & closed & (tau <= 0.5 * span_t))
+    jl = j[left]
+    dx[left] = np.clip(_moving_offset(tau[left], p.y[jl], p.g[jl], p.c[jl]), 0.0, width[left])
+    dr[left] = width[left] - dx[left]
+    right = np.flatnonzero(inner & closed & (tau > 0.5 * span_t))
+    jr = j[right]
+    dr[right] = np.clip(_moving_offset(T[jr + 1] - t[right], p.y_right[jr], -p.g_right[jr],
+                                       p.c[jr]), 0.0, width[right])
+    dx[right] = width[right] - dr[right]
     return dx, dr

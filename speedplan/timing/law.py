@@ -449,11 +449,30 @@ class TimeLaw:
         """Times at the grid nodes ``s`` [s]."""
         return self.knot_times[0::2]
 
+    @cached_property
+    def _exact_inverse(self) -> np.ndarray:
+        """Per piece: whether the offset reached at a time is taken in closed form.
+
+        A ``w``-piece moving at both ends, whose knot times the 16-point rule computes to
+        rounding: the nearest root of ``w`` lies outside the Bernstein ellipse of parameter
+        :data:`EXACT_RULE_RHO` around the piece (the rule's error on ``1/sqrt(w)`` then falls
+        as ``ρ^{-32}``). Elsewhere the inversion iterates on the rule itself, which keeps the
+        sampled positions continuous at the knots the rule placed (the exact offset would
+        jump there where the rule is off). Pieces of ``plan()``'s grids have ``ρ`` in the
+        tens.
+        """
+        p = self._pieces
+        moving = (p.y[:-1] > 0.0) & (p.y_right > 0.0) & ~p.is_u
+        rho = rule_rho(p.y[:-1], p.g[:-1], p.c, np.diff(p.x))
+        out: np.ndarray = moving & (rho >= EXACT_RULE_RHO)
+        return out
+
     def _invert(self, t: FloatArray) -> tuple[IntArray, FloatArray, FloatArray]:
         """Piece and offsets ``(j, dx, dr)`` reached at times ``t``.
 
-        On a ``w``-piece that starts moving, the exact solution of ``dσ/dτ = sqrt(w)`` (closed
-        form in ``sinh`` or ``sin``). Elsewhere a safeguarded Newton iteration on the time
+        On a ``w``-piece moving at both ends, the exact solution of ``dσ/dτ = sqrt(w)``
+        (closed form in ``sinh`` or ``sin``, from the knot nearer in time;
+        :attr:`_exact_inverse`). Elsewhere a safeguarded Newton iteration on the time
         within each piece, in the offset from the piece's standstill end when it has one (else
         from its left knot): next to a stop the offset keeps full relative precision, where
         an arc length near a long path's end would be quantised to 1e-16 of the path (and
@@ -470,7 +489,7 @@ class TimeLaw:
         if self.linear:
             dx, dr = _invert_linear(p, T, j, t)
         else:
-            dx, dr = backend().invert(p, T, j, t)
+            dx, dr = backend().invert(p, T, j, t, self._exact_inverse)
         return j, dx, dr
 
     def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
@@ -485,6 +504,39 @@ class TimeLaw:
     def position_at(self, t: FloatArray) -> FloatArray:
         """Arc length ``s(t)`` at times ``t`` [m] (see :meth:`state_at`)."""
         return self.state_at(t)[0]
+
+
+#: Bernstein-ellipse parameter of a piece's nearest root of ``w`` above which the
+#: 16-point Gauss–Legendre rule integrates ``1/sqrt(w)`` to rounding (``4^{-32} ≈ 5e-20``).
+EXACT_RULE_RHO = 4.0
+
+
+def rule_rho(y: FloatArray, g: FloatArray, c: FloatArray, width: FloatArray) -> FloatArray:
+    """Bernstein parameter ``ρ`` of the nearest root of ``y + g σ + c σ²/2`` per piece.
+
+    ``ρ = |z + sqrt(z² - 1)|`` (the branch above 1) of the root at ``σ = (z + 1) width / 2``:
+    the largest ellipse with foci at the piece's ends in which ``1/sqrt(w)`` is analytic.
+    ``inf`` when ``w`` has no finite root.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.timing.law import rule_rho
+    >>> # w linear from 1 to 4 over a unit piece: its root at σ = -1/3, z = -5/3, ρ = 3
+    >>> rule_rho(np.array([1.0]), np.array([3.0]), np.array([0.0]), np.array([1.0])).round(12)
+    array([3.])
+    """
+    a = 0.5 * c.astype(np.complex128)
+    with np.errstate(all="ignore"):
+        disc = np.sqrt(g.astype(np.complex128) ** 2 - 4.0 * a * y)
+        q = -0.5 * (g + np.where(g >= 0.0, 1.0, -1.0) * disc)  # no cancellation
+        rho = np.full(y.shape, np.inf)
+        for root in (np.where(a != 0, q / a, np.inf), np.where(q != 0, y / q, np.inf)):
+            z = 2.0 * root / width - 1.0
+            u = np.abs(z + np.sqrt(z - 1.0) * np.sqrt(z + 1.0))
+            r = np.maximum(u, 1.0 / u)
+            rho = np.minimum(rho, np.where(np.isfinite(r), r, np.inf))
+    return rho
 
 
 def _invert_linear(p: _Pieces, T: FloatArray, j: IntArray, t: FloatArray
