@@ -268,36 +268,39 @@ def test_inversion_meets_its_time_tolerance(seed, compiled):
 
 
 @pytest.mark.parametrize("compiled", [True, False])
-def test_closed_form_keeps_the_offset_to_a_slow_end(compiled):
-    # Next to a slow (not stopped) end the offset from that end must keep its own relative
-    # precision: the closed form runs from the knot nearer in time, with that knot's value
-    # and slope (accurate there; the left knot's, carried across the piece, are off by the
-    # rounding of w's largest values). Reference: the rule's own time from the right knot,
-    # inverted by bisection to the last bit (scipy's brentq).
+def test_closed_form_offsets_are_the_rules_inverse_to_a_few_ulps(compiled):
+    # Where the offset is taken in closed form, it must be the rule's own inverse to the
+    # last bits, measured from the knot nearer in time: there the offset keeps its relative
+    # precision, next to a slow (not stopped) end too, where the left knot's value and
+    # slope, carried across the piece, are off by the rounding of w's largest values.
+    # Reference: the rule's time from that knot, inverted by bisection (scipy's brentq).
     from scipy.optimize import brentq
 
     from speedplan.core import _law_kernel
     from speedplan.timing import _law_numpy
 
     inverse = (_law_kernel if compiled else _law_numpy).invert
-    steps = 0.2 * 0.97 ** np.arange(200)  # graded towards the end
-    s = np.concatenate(([0.0], np.cumsum(steps)))
-    w = 1e-6 + 4.0 * (1.0 - s / s[-1]) ** 2  # 2 m/s down to 1 mm/s
-    law = TimeLaw(s, w, accel_start=0.0)
-    p, T = law._pieces, law.knot_times
-    pieces = np.flatnonzero(law._exact_inverse)[-40:]  # the slowest pieces in closed form
-    assert pieces.size == 40
-    frac = np.array([1e-9, 1e-6, 1e-3, 0.1, 0.45])
-    k = np.repeat(pieces, frac.size)
-    t = T[k + 1] - np.tile(frac, pieces.size) * (T[k + 1] - T[k])
-    _, dr = inverse(p, T, k, t, law._exact_inverse)
-    width = p.x[k + 1] - p.x[k]
+    rng = np.random.default_rng(0)
+    s = np.concatenate(([0.0], np.cumsum(0.2 * 0.97 ** np.arange(200))))  # graded to the end
+    s2 = np.cumsum(rng.uniform(0.05, 0.15, 300) * 10 ** rng.uniform(-3, 3))
+    laws = [TimeLaw(s, 1e-6 + 4.0 * (1.0 - s / s[-1]) ** 2, accel_start=0.0),  # to 1 mm/s
+            TimeLaw(s2 - s2[0], 3.0 * (1.0 + np.sin((s2 - s2[0]) / s2[-1] * 7.0) ** 2),
+                    accel_start=0.0, accel_end=0.0)]
+    for law in laws:
+        p, T, exact = law._pieces, law.knot_times, law._exact_inverse
+        k = np.concatenate((np.flatnonzero(exact)[-30:], rng.choice(np.flatnonzero(exact), 70)))
+        span = T[k + 1] - T[k]
+        half = 0.5 * span * rng.uniform(0.0, 1.0, k.size) ** 3  # many next to a knot
+        from_left = rng.uniform(size=k.size) < 0.5
+        t = np.where(from_left, T[k] + half, T[k + 1] - half)
+        dx, dr = inverse(p, T, k, t, exact)
+        for i in range(k.size):
+            goal = t[i] - T[k[i]] if from_left[i] else T[k[i] + 1] - t[i]
+            here = np.array([from_left[i] == 0])
 
-    def time_to_end(d, i):
-        reached = _law_kernel.integrals(p, k[i:i + 1], np.zeros(1), np.array([d]),
-                                        np.array([True]))[0]
-        return reached - (T[k[i] + 1] - t[i])
+            def missed(d, piece=k[i:i + 1], goal=goal, here=here, p=p):
+                return _law_kernel.integrals(p, piece, np.zeros(1), np.array([d]), here)[0] - goal
 
-    ref = np.array([brentq(time_to_end, 0.0, width[i], args=(i,), xtol=1e-300, rtol=9e-16)
-                    for i in range(k.size)])
-    assert np.all(np.abs(dr - ref) <= 1e-13 * ref)
+            ref = brentq(missed, 0.0, p.x[k[i] + 1] - p.x[k[i]], xtol=1e-300, rtol=9e-16)
+            got = dx[i] if from_left[i] else dr[i]
+            assert abs(got - ref) <= 2e-15 * ref, (i, got, ref)
