@@ -104,9 +104,10 @@ STARTS = {start.name: start for start in banded_nlp.STARTS}
 SOLVERS = ("old", "new", "plain", "plain-tight", "plain-1e-12", "ipopt", "fatrop", *STARTS)
 TIGHT = {"tol": 1e-10, "constr_viol_tol": 1e-10}
 TIGHTER = {"tol": 1e-12, "constr_viol_tol": 1e-12}
-#: "Worse at equal feasibility" counts differences above this (relative): IPOPT's and our
-#: objectives are converged to ~1e-9 (``tol``), the first-order price to its square.
-FEASIBLE_MARGIN = 1e-8
+#: "Worse at equal feasibility" counts differences above this (relative): the refinement
+#: stops at a scaled optimality error of 1e-9 (``banded_nlp.TOL``), which leaves up to 1.6e-8
+#: of the objective on lateral-jerk legs (IPOPT started at its point gains that much).
+FEASIBLE_MARGIN = 2e-8
 FATROP_BOUND_RELAX = 1e-8  # fatrop's fixed bound relaxation (not settable in CasADi)
 
 
@@ -197,9 +198,11 @@ def evaluate(case: Case, run: Run) -> dict[str, float | bool]:
     w = np.clip(run.w * case.w_scale, 0.0, p.w_max)
     ok = run.success and accepted(case, run.w)
     obj = p.travel_time(w)
+    # At equal feasibility: the point as returned (clipping would pay for the bounds' share
+    # of the price a second time) plus the price of all its violations.
+    feasible = p.travel_time(run.w * case.w_scale) * (1.0 + run.violation_price)
     return {"ok": ok, "obj": obj, "gap": obj / case.lower_bound - 1.0,
-            "viol": p.jerk_violation(w) / p.jerk_tol,
-            "obj_feasible": obj * (1.0 + run.violation_price)}
+            "viol": p.jerk_violation(w) / p.jerk_tol, "obj_feasible": feasible}
 
 
 # --- solvers ----------------------------------------------------------------------------------

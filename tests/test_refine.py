@@ -63,14 +63,17 @@ def _feasible(p: DiscreteProblem, w) -> bool:
 
 def _ipopt_tight(p: DiscreteProblem, w0) -> tuple[bool, float]:
     """IPOPT with tight tolerances (``tests/oracles.py``): accepted, and its objective at
-    equal feasibility (plus the first-order price of the rows it still violates)."""
+    equal feasibility (plus the first-order price of the rows and bounds it still violates,
+    at the point it returned)."""
     ans = ipopt_plain(p, w0, {"tol": 1e-10, "constr_viol_tol": 1e-10})
-    w = np.clip(ans.w, 0.0, p.w_max)
-    return ans.success and _feasible(p, w), p.travel_time(w) * (1.0 + ans.violation_price)
+    ok = ans.success and _feasible(p, np.clip(ans.w, 0.0, p.w_max))
+    return ok, p.travel_time(ans.w) * (1.0 + ans.violation_price)
 
 
-#: Objectives of two converged runs (IPOPT's ``tol = 1e-10``, ours ``1e-9``) differ by this.
-SAME_OBJECTIVE = 1e-8
+#: Objectives of two converged runs differ by this: the refinement stops at a scaled
+#: optimality error of 1e-9, which leaves up to 1.6e-8 of the objective on lateral-jerk
+#: legs (docs/performance.md, *At equal feasibility*).
+SAME_OBJECTIVE = 2e-8
 
 
 def test_condensed_newton_matrix_matches_automatic_differentiation():
