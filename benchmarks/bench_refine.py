@@ -44,9 +44,9 @@ Every answer is checked with ``solve_problem``'s acceptance test on the original
 *At equal feasibility.* IPOPT's points violate rows by up to its ``constr_viol_tol`` (and
 its bounds by ``bound_relax_factor``), and near a standstill that buys travel time no
 feasible point has; ``new``'s rows hold exactly. The last column and the summary therefore
-also compare ``new`` with plain-tight's objective plus the first-order price of its
-violations, ``Σ |λ_i| violation_i`` with IPOPT's own multipliers (``tests/oracles.py``,
-``ipopt_plain``).
+also compare ``new`` with plain-tight's objective at the point it returned (not clipped)
+plus the first-order price of its violations, ``Σ |λ_i| violation_i`` with IPOPT's own
+multipliers (``tests/oracles.py``, ``ipopt_plain``).
 
 Instances
 ---------

@@ -197,7 +197,8 @@ def ipopt_plain(p, w0, options=None):
     no feasible point has. Relaxing row ``i`` by ``δ_i`` lowers the optimum by ``|λ_i| δ_i``
     to first order (``λ_i`` its multiplier), so ``objective (1 + violation_price)``, with
     ``violation_price = Σ |λ_i| max(violation_i, 0) / objective`` from IPOPT's own
-    multipliers, is its objective at equal feasibility to first order.
+    multipliers, is its objective at equal feasibility to first order (take the objective at
+    ``w`` as returned: clipping it into the bounds would pay for their share a second time).
     """
     import casadi as ca
 
