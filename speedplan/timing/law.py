@@ -458,8 +458,8 @@ class TimeLaw:
         :data:`EXACT_RULE_RHO` around the piece (the rule's error on ``1/sqrt(w)`` then falls
         as ``ρ^{-32}``). Elsewhere the inversion iterates on the rule itself, which keeps the
         sampled positions continuous at the knots the rule placed (the exact offset would
-        jump there where the rule is off). Pieces of ``plan()``'s grids have ``ρ`` in the
-        tens.
+        jump there where the rule is off). On ``plan()``'s grids the moving pieces have
+        ``ρ`` of 260 or more (the sample paths, default grids).
         """
         p = self._pieces
         moving = (p.y[:-1] > 0.0) & (p.y_right > 0.0) & ~p.is_u
