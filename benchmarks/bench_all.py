@@ -29,7 +29,8 @@ Prints, in order:
 5. ``import speedplan`` (subprocess, median of ``--import-runs``) and the first ``plan()`` in
    a fresh process with an empty numba cache (``NUMBA_CACHE_DIR`` in a temporary directory).
 6. ``solve_discrete`` at 10 k and 100 k nodes: tracemalloc peak per node and the time ratio,
-   sizes interleaved (as ``bench_kernel_scaling.py``).
+   sizes interleaved, split into iterations and time per node and iteration
+   (``bench_kernel_scaling.py``; ``--seeds`` for more random draws).
 7. The refinement (``speedplan.solve.refine.refine``) on the stored corpus of inexact
    ``plan()`` relaxations (``benchmarks/data/refine_corpus.npz``, see ``bench_refine.py``).
 """
@@ -45,7 +46,6 @@ import subprocess
 import sys
 import tempfile
 import time
-import tracemalloc
 import warnings
 from collections import defaultdict
 from collections.abc import Callable, Iterator
@@ -61,7 +61,6 @@ from speedplan.io import read_path, read_zones
 from speedplan.model import Leg, PlanRequest, build_model
 from speedplan.solve.banded import compile_kernel
 from speedplan.solve.discrete import solve_problem
-from speedplan.solve.paper import paper_instance
 from speedplan.timing import SpeedProfile
 
 ROOT = FsPath(__file__).resolve().parents[1]
@@ -394,25 +393,15 @@ def section_startup(import_runs: int) -> None:
 # --- 6. memory and scaling of solve_discrete -----------------------------------------------
 
 
-def section_memory(sizes: list[int], rounds: int) -> None:
+def section_memory(sizes: list[int], rounds: int, seeds: list[int]) -> None:
+    """As ``bench_kernel_scaling.py``: memory, times and the ratio split into its factors."""
+    sys.path.insert(0, str(FsPath(__file__).parent))
+    from bench_kernel_scaling import interleaved
+
     print(f"\n== 6. solve_discrete (paper rnd/cnst/cnst): memory per node, time ratio over "
           f"{rounds} interleaved rounds ==")
-    insts = {n: paper_instance("rnd", "cnst", "cnst", n=n, seed=0) for n in sizes}
-    for n, inst in insts.items():
-        tracemalloc.start()
-        sp.solve_discrete(inst.w_max, inst.A, inst.J, backend="banded")
-        peak = tracemalloc.get_traced_memory()[1]
-        tracemalloc.stop()
-        print(f"n={n:>7}: tracemalloc peak {peak / n:6.0f} bytes/node")
-    times: dict[int, list[float]] = {n: [] for n in sizes}
-    for _ in range(rounds):
-        for n, inst in insts.items():
-            t0 = time.perf_counter()
-            sp.solve_discrete(inst.w_max, inst.A, inst.J, backend="banded")
-            times[n].append(time.perf_counter() - t0)
-    med = {n: statistics.median(t) for n, t in times.items()}
-    print("  ".join(f"n={n}: {med[n]:.4f} s" for n in sizes)
-          + f"  ratio {med[sizes[-1]] / med[sizes[0]]:.2f}")
+    for seed in seeds:
+        interleaved(sizes, rounds, seed)
 
 
 # --- 7. the refinement -------------------------------------------------------------------
@@ -443,6 +432,8 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--import-runs", type=int, default=9)
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0],
+                    help="section 6: one random draw per seed (the target's is seed 0)")
     ap.add_argument("--quick", action="store_true", help="3 repeats, sizes 1 k and 10 k")
     ap.add_argument("--only", nargs="+", type=int, choices=range(1, 8),
                     help="run only these sections")
@@ -464,7 +455,7 @@ def main(argv: list[str] | None = None) -> None:
     if 5 in only:
         section_startup(args.import_runs)
     if 6 in only:
-        section_memory(sizes, 3 if args.quick else args.rounds)
+        section_memory(sizes, 3 if args.quick else args.rounds, args.seeds)
     if 7 in only:
         section_refine(20 if args.quick else None)
 

@@ -60,6 +60,7 @@ from .geometry.bounds import check_zones
 from .geometry.fitting import DEFAULT_KIND, KINDS
 from .geometry.primitives import ClothoidPiece
 from .route import Route
+from .route.profile import RouteTrajectory
 from .route.vda5050 import trajectory_path
 from .timing.trajectory import COLUMNS, Trajectory, text_output
 
@@ -635,6 +636,11 @@ def _trajectory_from_columns(name: str, cols: dict[str, Any], metadata: dict[str
     if len(sizes) != 1 or 0 in sizes:
         raise InvalidInputError(f"{name}: the columns must be non-empty and of equal length")
     arrays["heading"] = np.unwrap(arrays["heading"])  # the file holds it wrapped
+    if "edge" in cols:  # a route's trajectory (RouteTrajectory writes the edge last)
+        edge = as_array(f"{name}: column 'edge'", cols["edge"], ndim=1)
+        if edge.size != arrays["t"].size:
+            raise InvalidInputError(f"{name}: the columns must be non-empty and of equal length")
+        return RouteTrajectory(**arrays, edge=edge, metadata=metadata)
     return Trajectory(**arrays, metadata=metadata)
 
 
@@ -644,7 +650,8 @@ def read_trajectory(file: Source, *, format: str | None = None) -> Trajectory:
     The values come back bit for bit, except the heading: the files hold it wrapped to
     ``[-π, π)`` and it is unwrapped again (``numpy.unwrap``), so it is continuous and starts
     in ``[-π, π)``. The metadata (``# key: value`` lines of a CSV file) is in
-    ``Trajectory.metadata``.
+    ``Trajectory.metadata``. A route's trajectory (with an ``edge`` column) comes back as a
+    :class:`~speedplan.route.RouteTrajectory`.
 
     Parameters
     ----------
@@ -687,5 +694,6 @@ def read_trajectory(file: Source, *, format: str | None = None) -> Trajectory:
             key, _, value = line[1:].partition(":")
             metadata[key.strip()] = _metadata_value(value.strip())
     names, _units, rows = _csv_table(text, name)
-    cols = {c: _numeric_column(name, rows, names.index(c), c) for c in COLUMNS if c in names}
+    cols = {c: _numeric_column(name, rows, names.index(c), c) for c in (*COLUMNS, "edge")
+            if c in names}
     return _trajectory_from_columns(name, cols, metadata)

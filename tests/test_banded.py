@@ -193,12 +193,13 @@ def test_banded_stop_is_accepted_on_its_certificate_whatever_stopped_it(monkeypa
 def _newton_state(seed: int):
     """A Newton system of the kernel at a random interior point (sizes of an n=60 problem)."""
     from speedplan.solve import _banded_ipm as ipm
-    from speedplan.solve.banded import _positive_feasible, _prepare, unit_scales
+    from speedplan.solve.banded import _prepare, unit_scales
+    from speedplan.solve.nojerk import positive_feasible_w
 
     inst = paper_instance("rnd", "cnst", "cnst", n=60, seed=seed)
     p = _problem(inst.w_max, inst.A, inst.J)
     unit = p.scaled(*unit_scales(p))
-    d = _prepare(unit, _positive_feasible(unit)[1:-1])
+    d = _prepare(unit, positive_feasible_w(unit)[1:-1])
     lay = d.lay
     rng = np.random.default_rng(seed)
     pt = ipm.empty(ipm.Point, lay)

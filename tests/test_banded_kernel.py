@@ -13,7 +13,8 @@ import pytest
 import scipy.linalg
 
 from speedplan.solve import _banded_ipm as ipm
-from speedplan.solve.banded import _positive_feasible, _prepare, unit_scales
+from speedplan.solve.banded import _prepare, unit_scales
+from speedplan.solve.nojerk import positive_feasible_w
 from speedplan.solve.paper import paper_instance
 from speedplan.solve.problem import DiscreteProblem, StencilRows
 
@@ -41,7 +42,7 @@ def _problem(seed: int) -> DiscreteProblem:
 def _setup(seed: int):
     p = _problem(seed)
     unit = p.scaled(*unit_scales(p))
-    d = _prepare(unit, _positive_feasible(unit)[1:-1])
+    d = _prepare(unit, positive_feasible_w(unit)[1:-1])
     return unit, d
 
 
@@ -376,7 +377,7 @@ def test_kernel_keeps_fifty_seven_doubles_per_node():
     p = DiscreteProblem(s=np.arange(inst.w_max.size, dtype=float), w_max=inst.w_max,
                         accel=inst.A, decel=inst.A, jerk=inst.J)
     unit = p.scaled(*unit_scales(p))
-    d = _prepare(unit, _positive_feasible(unit)[1:-1])
+    d = _prepare(unit, positive_feasible_w(unit)[1:-1])
     kernel = _kernel_args(unit, d)[1:]
     doubles = sum(a.size for part in kernel for a in part) / d.lay.m
     assert 56.9 < doubles <= 57.01

@@ -23,6 +23,7 @@ from shared import examples
 from trust_fuzz import FAILURES, draw_case, run_case, summarise
 
 import speedplan as sp
+from speedplan.core.limits import LIMIT_RANGE
 
 DOCUMENTED = (sp.InvalidInputError, sp.InfeasibleError, sp.SolverError)
 CHUNKS, PER_CHUNK = 10, 50  # 500 straight moves
@@ -100,7 +101,7 @@ def test_plan_on_default_grids_returns_verified_profile_or_documented_error(**kw
     _check(**kw, n=None)
 
 
-@pytest.mark.parametrize("bad", [np.nan, np.inf, -1.0, 0.0])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -1.0, 0.0, 1e-300, 1e-10, 2e9, 1e300])
 @pytest.mark.parametrize("field", ["v_max", "a_max", "a_lat_max", "j_max", "a_decel"])
 def test_limits_reject_bad_values_by_name(field, bad):
     kwargs = dict(v_max=1.0, a_max=1.0, a_lat_max=1.0, j_max=1.0)
@@ -110,3 +111,14 @@ def test_limits_reject_bad_values_by_name(field, bad):
         return
     with pytest.raises(sp.InvalidInputError, match=f"`{field}`"):
         sp.Limits(**kwargs)
+
+
+@pytest.mark.parametrize("kwargs", [dict(v_max=1e300), dict(j_max=1e-300), dict(j_max=1e-200)])
+def test_extreme_limits_are_refused_by_name_not_overflowed(kwargs):
+    # These ended in an OverflowError deep inside the model (v_max³ / j_max² and the like).
+    lim = {**dict(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5), **kwargs}
+    path = sp.Path.from_waypoints([[0, 0], [10, 0], [14, 4]])
+    with pytest.raises(sp.InvalidInputError, match=f"`{next(iter(kwargs))}`.*outside"):
+        sp.plan(path, sp.Limits(**lim))
+    edge = {name: LIMIT_RANGE[0 if value < 1 else 1] for name, value in kwargs.items()}
+    sp.Limits(**{**lim, **edge})  # the range's own ends are limits

@@ -180,6 +180,37 @@ def test_moving_start_begins_exactly_at_the_given_state():
     assert traj.a[-1] == pytest.approx(-0.2, abs=1e-9)
 
 
+def test_at_refuses_times_of_more_than_one_dimension():
+    # A 2-D array of times ended in "truth value of an array is ambiguous" inside the law.
+    prof = plan(Path.from_segments([Line(10.0)]), LGV)
+    with pytest.raises(InvalidInputError, match=r"`t`.*1-D"):
+        prof.at([[1.0, 2.0]])
+    assert prof.at(1.0).t.shape == (1,) and prof.at([1.0, 2.0]).t.shape == (2,)
+
+
+@pytest.mark.parametrize("where", ["start", "end"])
+def test_states_above_a_limit_by_rounding_are_taken_at_the_limit(where):
+    # A state read off a plan (an order update) can sit above a limit by the time law's
+    # rounding: 4.4e-9 in speed, 1.9e-9 in acceleration were refused before. Taken at the
+    # limit now; 1e-5 above is still refused.
+    line = Path.from_segments([Line(20.0)])
+    v_key, a_key = ("v0", "a0") if where == "start" else ("vf", "af")
+    prof = plan(line, LGV, **{v_key: LGV.v_max * (1 + 4.4e-9)})
+    end = prof.at([0.0 if where == "start" else prof.duration])
+    assert end.v[0] == pytest.approx(LGV.v_max, rel=1e-12)
+    assert end.v[0] <= LGV.v_max * (1 + 1e-12)  # at the bound, not 4.4e-9 above
+    assert prof.status == "optimal"
+    a_edge = LGV.a_max if where == "start" else -LGV.a_decel
+    prof = plan(line, LGV, **{v_key: 1.0, a_key: a_edge * (1 + 1.9e-9)})
+    end = prof.at([0.0 if where == "start" else prof.duration])
+    assert abs(end.a[0]) <= abs(a_edge) * (1 + 1e-12)  # at the limit, not 1.9e-9 above
+    assert prof.status == "optimal"
+    with pytest.raises(InvalidInputError, match=f"`{v_key}`"):
+        plan(line, LGV, **{v_key: LGV.v_max * (1 + 1e-5)})
+    with pytest.raises(InvalidInputError, match=f"`{a_key}`"):
+        plan(line, LGV, **{v_key: 1.0, a_key: a_edge * (1 + 1e-5)})
+
+
 def test_impossible_boundary_states():
     line = Path.from_segments([Line(20.0)])
     with pytest.raises(InvalidInputError, match="`a0`"):
@@ -191,6 +222,13 @@ def test_impossible_boundary_states():
     with pytest.raises(InfeasibleError, match=r"falls to .* < 0") as info:
         plan(line, LGV, v0=0.2, a0=-0.9)
     assert info.value.constraint == "jerk" and info.value.s == 0.0
+    # A zero knot of v_limit between grid nodes forces a standstill inside the leg: said in
+    # metres along the path (it was the solver's rescaled position, 6441 on this 15.5 m path).
+    bent = Path.from_waypoints([[0, 0], [10, 0], [14, 4]])
+    with pytest.raises(InfeasibleError, match=r"no motion passes s=5 m") as info:
+        plan(bent, LGV, v_limit=([0.0, 5.0, 16.0], [1.0, 0.0, 1.0]))
+    assert info.value.constraint == "w_max"
+    assert info.value.s == pytest.approx(5.0, abs=0.01)
     zone = SpeedZone([(1.0, -1.0), (5.0, -1.0), (5.0, 1.0), (1.0, 1.0)], v_max=0.5)
     with pytest.raises(InfeasibleError, match=r"from v0=2 m/s.* cannot slow down") as info:
         plan(line, LGV, v0=2.0, zones=[zone])

@@ -256,6 +256,24 @@ def test_unreachable_boundary_is_infeasible_with_location():
         solve_discrete(np.full(10, 1.0), 1.0, 1.0, w_start=2.0)
 
 
+@pytest.mark.parametrize("backend", ["banded", "clarabel"])
+@pytest.mark.parametrize("h", [1e-3, 0.5, 40.0])
+def test_forced_standstill_is_infeasible_at_its_own_position(h, backend):
+    # A zero bound between nodes (or at one) that the acceleration rows carry onto the grid
+    # leaves no positive w inside; the error names the node in the problem's own grid
+    # positions. It named the solver's rescaled ones (unit mean step) before.
+    n = 41
+    w_max = np.full(n, 4.0)
+    w_max[17] = 0.0  # solve_discrete refuses this input; plan() grids can carry it
+    problem = DiscreteProblem(s=10.0 + h * np.arange(n), w_max=w_max, accel=np.ones(n - 1),
+                              decel=np.ones(n - 1), jerk=np.ones(n - 2))
+    with pytest.raises(InfeasibleError, match="w > 0") as info:
+        solve_problem(problem, backend=backend)
+    assert info.value.constraint == "w_max"
+    assert info.value.s == pytest.approx(10.0 + 17 * h, rel=1e-12)
+    assert f"s={10.0 + 17 * h:.6g}" in str(info.value)
+
+
 @pytest.mark.parametrize("family", [("rnd", "cnst", "cnst"), ("rnd", "cnst", "logrnd")])
 def test_banded_backend_gives_the_same_certified_answer(family):
     inst = paper_instance(*family, n=N_CI, seed=7)

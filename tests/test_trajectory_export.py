@@ -156,6 +156,20 @@ def test_read_trajectory_round_trip(loop_traj, tmp_path):
         read_trajectory(io.StringIO("x,y\n0,0\n1,1\n"))
 
 
+def test_a_route_trajectory_comes_back_with_its_edges(tmp_path):
+    # It came back as a plain Trajectory, its edge column dropped.
+    route = sp.Route.from_vda5050("paths/orders/order_v2.json")
+    traj = sp.plan_route(route, LGV).sample(0.05)
+    assert np.unique(traj.edge).size > 1
+    for name in ("r.csv", "r.json"):
+        f = tmp_path / name
+        (traj.to_csv if name.endswith("csv") else traj.to_json)(f)
+        back = read_trajectory(f)
+        assert isinstance(back, sp.route.RouteTrajectory), name
+        assert np.array_equal(back.edge, traj.edge) and np.array_equal(back.v, traj.v)
+        assert back.metadata["edge_ids"] == traj.metadata["edge_ids"]
+
+
 def test_to_dict_keeps_the_continuous_heading(loop_traj):
     d = loop_traj.to_dict()
     assert list(d) == list(COLUMNS)

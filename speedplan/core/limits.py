@@ -7,8 +7,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .checks import as_scalar
+from .errors import InvalidInputError
 
-__all__ = ["Limits"]
+__all__ = ["LIMIT_RANGE", "Limits"]
+
+#: Finite limits lie within nine decades either side of 1 (SI units): from a stage moving
+#: nanometres per second to far beyond any vehicle. Outside it, the model's closed forms
+#: (``v³ / j²`` and the like) overflow or underflow in double precision.
+LIMIT_RANGE = (1e-9, 1e9)
 
 
 @dataclass(frozen=True)
@@ -68,6 +74,15 @@ class Limits:
             value = getattr(self, name)
             set_(self, name, np.inf if value is None else as_scalar(name, value, positive=True,
                                                                      allow_inf=True))
+        for name in ("v_max", "a_max", "a_lat_max", "j_max", "a_decel", "j_lat_max",
+                     "yaw_rate_max"):
+            value = getattr(self, name)
+            if np.isfinite(value) and not LIMIT_RANGE[0] <= value <= LIMIT_RANGE[1]:
+                raise InvalidInputError(
+                    f"`{name}`={value!r} is outside [{LIMIT_RANGE[0]:g}, {LIMIT_RANGE[1]:g}], "
+                    "the range of finite limits planned for (SI units); pass inf for no "
+                    "limit, or express the problem in other units (e.g. mm, ms)"
+                )
 
     @property
     def A(self) -> float:

@@ -11,7 +11,7 @@ speeds and metres.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -32,10 +32,11 @@ from .grid import (
     graded_ends,
     hidden_dips,
     rest_phase_length,
+    top_speed,
     uniform_grid,
 )
 from .refine import subdivided_grid
-from .request import PlanRequest
+from .request import STATE_ROUNDING, PlanRequest
 from .standstill import calibrate_standstill_rows
 
 __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
@@ -236,7 +237,7 @@ def build_model(request: PlanRequest) -> Model:
     length = float(path.length)
     bound = SpeedBound(path, lim, None if request.zones is None else list(request.zones),
                        request.v_limit, spans=request.spans).memoised()
-    _check_end_speeds(request, bound, length)
+    request = _end_speeds(request, bound, length)
     rests = rest_points(request)
     cuts = [0.0, *(r.s for r in rests), length]
     legs: list[Leg | ForcedLeg] = []
@@ -302,8 +303,9 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
     if request.n is not None or request.ds is not None:
         s = uniform_grid(length, n=request.n, ds=request.ds)
         if request.jerk_limited:
-            s = graded_ends(s, _transient(request, v0, a0, lim.a_max, length),
-                            _transient(request, vf, -af, lim.a_decel, length))
+            v_top = top_speed(leg_bound, length, lim.v_max, v0 * v0, vf * vf)
+            s = graded_ends(s, _transient(request, v0, a0, lim.a_max, length, v_top),
+                            _transient(request, vf, -af, lim.a_decel, length, v_top))
         _check_moving_ends_resolved(s, lo, v0, a0, vf, af)
     elif request.jerk_limited:
         s = _default_grid(request, leg_bound, lo, hi, v0, a0, vf, af)
@@ -451,23 +453,23 @@ def _cut_out_dips(s: FloatArray, edges: FloatArray) -> FloatArray:
 
 
 def _transient(request: PlanRequest, v: float, a: float, a_limit: float,
-               length: float) -> float | None:
+               length: float, v_top: float) -> float | None:
     """Length of a leg's first boundary transient (its last one: ``v = vf``, ``a = -af``).
 
     At a smooth standstill the first jerk phase from rest (``None`` for the paper's free
     standstill, where the acceleration may jump). A moving state: the shorter of the
     distance covered while its acceleration is brought to 0, a jerk transition
     ``v min(t_j, √(v / j))`` at the lowest speed it passes (the default grid's scale) and,
-    braking, the distance ``v² / (2 |a|)`` to rest at that deceleration.
+    braking, the distance ``v² / (2 |a|)`` to rest at that deceleration. The phases are
+    those under ``v_top``, the leg's top speed (:func:`~speedplan.model.grid.top_speed`).
     """
-    lim = request.limits
-    j = lim.j_max
+    j = request.limits.j_max
     if v == 0.0 and a == 0.0:
-        return (rest_phase_length(a_limit, lim.v_max, j, length)
+        return (rest_phase_length(a_limit, v_top, j, length)
                 if request.smooth_standstill else None)
     low = turnaround_speed(v, a, j) if a < 0 else v
     speed = low if low > 0 else v
-    t_j = min(a_limit / j, float(np.sqrt(lim.v_max / j)))
+    t_j = min(a_limit / j, float(np.sqrt(v_top / j)))
     scale = speed * min(t_j, float(np.sqrt(speed / j)))
     if a != 0.0:
         t = abs(a) / j
@@ -605,15 +607,28 @@ def _zero_cause(bound: SpeedBound) -> str:
             "(Path.from_waypoints with the default kind)")
 
 
-def _check_end_speeds(request: PlanRequest, bound: SpeedBound, length: float) -> None:
-    ends = bound(np.array([0.0, length]))
-    for name, v, b, where in (("v0", request.v0, ends[0], 0.0),
-                              ("vf", request.vf, ends[1], length)):
-        if v * v > b * (1 + 1e-9):
-            raise InvalidInputError(
-                f"`{name}`={v!r} m/s exceeds the speed bound {np.sqrt(b):.6g} m/s at "
-                f"s={where:.6g} m (v_max, lateral acceleration or a zone); pass a lower speed"
-            )
+def _end_speeds(request: PlanRequest, bound: SpeedBound, length: float) -> PlanRequest:
+    """``request`` with ``v0``, ``vf`` under the speed bound at the ends, or an error.
+
+    A speed above the bound by at most :data:`~speedplan.model.request.STATE_ROUNDING` is
+    taken at the bound (a state read off a plan: the time law's rounding).
+    """
+    ends = np.sqrt(bound(np.array([0.0, length])))
+    v0, vf = (_under_bound(name, v, float(b), where) for name, v, b, where in (
+        ("v0", request.v0, ends[0], 0.0), ("vf", request.vf, ends[1], length)))
+    if (v0, vf) == (request.v0, request.vf):
+        return request
+    return replace(request, v0=v0, vf=vf)
+
+
+def _under_bound(name: str, v: float, bound: float, where: float) -> float:
+    """``min(v, bound)``; :class:`InvalidInputError` if ``v`` exceeds it beyond rounding."""
+    if v > bound * (1.0 + STATE_ROUNDING):
+        raise InvalidInputError(
+            f"`{name}`={v!r} m/s exceeds the speed bound {bound:.6g} m/s at "
+            f"s={where:.6g} m (v_max, lateral acceleration or a zone); pass a lower speed"
+        )
+    return min(v, bound)
 
 
 def _check_floor(floor: FloatArray, w_max: FloatArray, s: FloatArray, lo: float, v0: float,
@@ -772,6 +787,10 @@ def _explain(exc: InfeasibleError, leg: Leg) -> InfeasibleError:
         msg = (f"cannot slow down in time for the speed bound {v_there:.6g} m/s at "
                f"s={where:.4g} m from v0={leg.v0:.6g} m/s, a0={leg.a0:.6g} m/s² under "
                f"j_max={lim.j_max:.6g} m/s³ and a_decel={lim.a_decel:.6g} m/s²")
+    elif exc.constraint == "w_max":
+        msg = (f"no motion passes s={where:.4g} m: the speed bound there ({v_there:.3g} m/s) "
+               f"and the acceleration bounds leave no positive speed inside the leg; split "
+               f"the path there to plan a stop, or raise the bound")
     else:
         msg = str(exc)
     return InfeasibleError(msg, constraint=exc.constraint, s=where)

@@ -15,7 +15,8 @@ from ..geometry import Path, SpeedZone
 from ..geometry.bounds import SpanLimit, check_spans, check_zones
 from ..solve.discrete import BACKENDS, REFINE_MODES
 
-__all__ = ["MIN_RELATIVE_LENGTH", "REACH_MODES", "STANDSTILL_MODES", "PlanRequest"]
+__all__ = ["MIN_RELATIVE_LENGTH", "REACH_MODES", "STANDSTILL_MODES", "STATE_ROUNDING",
+           "PlanRequest", "within_limit"]
 
 #: ``"smooth"``: acceleration is 0 at a standstill and jerk-limited from the first instant.
 #: ``"free"``: the paper's model, where acceleration may jump at a standstill.
@@ -33,6 +34,37 @@ REACH_MODES = ("max_jerk", "distance")
 #: much shorter paths (nearly coincident waypoints) made the solvers fail with misleading
 #: messages.
 MIN_RELATIVE_LENGTH = 1e-9
+
+#: A boundary speed or acceleration above its limit by at most this fraction of the limit is
+#: taken at the limit: the rounding of a state read off a plan (measured up to 9e-9, e.g. an
+#: order update started from the vehicle's planned state), far below any vehicle's
+#: resolution. Anything more is refused as before.
+STATE_ROUNDING = 1e-6
+
+
+def within_limit(name: str, value: float, limit: float, unit: str, what: str) -> float:
+    """``value``, or ``limit`` if ``value`` exceeds it by at most :data:`STATE_ROUNDING`.
+
+    Raises :class:`~speedplan.InvalidInputError` naming ``name`` beyond that; ``what`` says
+    which limit it is. ``limit`` may be negative (a lower limit, as ``-a_decel``: then
+    "exceeds" means "falls below").
+
+    Examples
+    --------
+    >>> within_limit("v0", 2.0000000004, 2.0, "m/s", "the speed bound")
+    2.0
+    >>> within_limit("a0", -1.5, -1.0, "m/s²", "-a_decel")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    speedplan.core.errors.InvalidInputError: `a0`=-1.5 m/s² is beyond -a_decel = -1.0 m/s²; ...
+    """
+    beyond = value < limit if limit < 0 else value > limit
+    if not beyond:
+        return value
+    if abs(value - limit) <= STATE_ROUNDING * abs(limit):
+        return limit
+    raise InvalidInputError(f"`{name}`={value!r} {unit} is beyond {what} = {limit!r} {unit}; "
+                            "pass a value within the limits")
 
 
 @dataclass(frozen=True)
@@ -100,9 +132,9 @@ class PlanRequest:
             n=None if n is None else int(n),
             ds=None if ds is None else as_scalar("ds", ds, positive=True),
             v0=as_scalar("v0", v0, nonnegative=True),
-            a0=as_scalar("a0", a0),
+            a0=_acceleration("a0", as_scalar("a0", a0), limits),
             vf=as_scalar("vf", vf, nonnegative=True),
-            af=as_scalar("af", af),
+            af=_acceleration("af", as_scalar("af", af), limits),
             zones=None if zones is None else tuple(check_zones(zones)),
             v_limit=v_limit,
             refine=refine,
@@ -126,13 +158,6 @@ class PlanRequest:
         return self.jerk_limited and self.standstill == "smooth"
 
     def _check_accelerations(self) -> None:
-        lim = self.limits
-        for name, a in (("a0", self.a0), ("af", self.af)):
-            if a > lim.a_max * (1 + 1e-12) or a < -lim.a_decel * (1 + 1e-12):
-                raise InvalidInputError(
-                    f"`{name}`={a!r} m/s² is outside [-a_decel, a_max] = "
-                    f"[{-lim.a_decel!r}, {lim.a_max!r}]; pass an acceleration within the limits"
-                )
         if self.smooth_standstill:
             for vname, v, aname, a in (("v0", self.v0, "a0", self.a0),
                                        ("vf", self.vf, "af", self.af)):
@@ -165,3 +190,9 @@ def _check_stops(stops: Any, length: float) -> tuple[float, ...]:
             "(the ends are always at the boundary states v0/vf)"
         )
     return tuple(float(s) for s in np.unique(arr))
+
+
+def _acceleration(name: str, a: float, lim: Limits) -> float:
+    """A boundary acceleration within ``[-a_decel, a_max]`` (see :func:`within_limit`)."""
+    a = within_limit(name, a, lim.a_max, "m/s²", "a_max")
+    return within_limit(name, a, -lim.a_decel, "m/s²", "-a_decel")

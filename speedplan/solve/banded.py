@@ -71,9 +71,9 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
-from ..core.errors import InfeasibleError, InvalidInputError, SolverError
+from ..core.errors import InvalidInputError, SolverError
 from .clarabel_ import RelaxationResult
-from .nojerk import check_reachable, max_feasible_w, min_feasible_w
+from .nojerk import check_reachable, max_feasible_w, min_feasible_w, positive_feasible_w
 from .problem import DiscreteProblem
 
 __all__ = [
@@ -368,7 +368,7 @@ def _load_from_disk_cache() -> bool:
     dispatcher offers no public "load but do not compile"); any failure means "not loaded".
     """
     p = _example_problem()
-    d = _prepare(p, _positive_feasible(p)[1:-1])
+    d = _prepare(p, positive_feasible_w(p)[1:-1])
     args = (*_kernel_args(p, d), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
     import numba
 
@@ -632,26 +632,6 @@ def unit_scales(problem: DiscreteProblem) -> tuple[float, float]:
     return float(np.mean(problem.h)), float(np.max(problem.w_max))
 
 
-def _positive_feasible(problem: DiscreteProblem) -> FloatArray:
-    """The fastest feasible ``w``; :class:`InfeasibleError` unless it is positive inside.
-
-    The jerk rows never make the relaxation infeasible (``t`` may grow), so feasibility is
-    that of the linear rows with strictly positive interior ``w``: the O(n) no-jerk pass.
-    The boundary values are assumed reachable (:func:`~speedplan.solve.nojerk.check_reachable`).
-    """
-    wmf = max_feasible_w(problem)
-    inner = wmf[1:-1]
-    if inner.size and float(np.min(inner)) <= 0.0:
-        i = int(np.argmin(inner)) + 1
-        raise InfeasibleError(
-            f"the relaxation is infeasible: no speed law with w > 0 at s={problem.s[i]:.6g} "
-            "meets the speed bound and the acceleration bounds",
-            constraint="w_max",
-            s=float(problem.s[i]),
-        )
-    return wmf
-
-
 def solve_relaxation_banded(
     problem: DiscreteProblem, *, tol: float = 1e-8, max_iter: int = MAX_ITERATIONS
 ) -> RelaxationResult:
@@ -702,6 +682,7 @@ def solve_relaxation_banded(
     t_start = time.perf_counter()
     if problem.n >= 3:
         check_reachable(problem)
+        positive_feasible_w(problem)  # here, for an error in the problem's own positions
     s_scale, w_scale = unit_scales(problem)
     res = solve_unit_relaxation(problem.scaled(s_scale, w_scale), tol=tol, max_iter=max_iter)
     time_scale = s_scale / np.sqrt(w_scale)
@@ -727,7 +708,7 @@ def solve_unit_relaxation(
     if unit.n < 3:
         raise SolverError("the relaxation needs n >= 3 grid nodes", backend="banded",
                           status="InvalidProblem")
-    wmf = _positive_feasible(unit)
+    wmf = positive_feasible_w(unit)
     d = _prepare(unit, wmf[1:-1])
     t_setup = time.perf_counter()
     w_int, yl, iterations, code = _run_kernel(unit, d, tol, max_iter)

@@ -22,7 +22,7 @@ from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, c
 from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
 from .banded import check_grid_resolvable, kernel_for_auto, solve_unit_relaxation, unit_scales
 from .clarabel_ import RelaxationResult, solve_relaxation
-from .nojerk import check_reachable, max_feasible_w
+from .nojerk import check_reachable, max_feasible_w, positive_feasible_w
 from .problem import DiscreteProblem
 from .refine import refine as refine_nlp
 from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
@@ -150,6 +150,7 @@ def solve_problem(
         )
 
     check_grid_resolvable(problem)  # before any solver spends a minute on it
+    positive_feasible_w(problem)  # before scaling: its error names s in the problem's units
     if backend == "auto":  # only now: the pass above needs no solver (and no compilation)
         backend = _auto_backend(problem)
     # Solve in units where the mean step and the largest bound are 1: well-scaled cones.

@@ -14,7 +14,7 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
 from .problem import DiscreteProblem
 
-__all__ = ["check_reachable", "max_feasible_w", "min_feasible_w"]
+__all__ = ["check_reachable", "max_feasible_w", "min_feasible_w", "positive_feasible_w"]
 
 
 def _cumulative(rate_h: FloatArray) -> FloatArray:
@@ -51,6 +51,39 @@ def max_feasible_w(problem: DiscreteProblem, *, pin_ends: bool = True) -> FloatA
     w = _forward(bound, problem.accel * problem.h)
     w = _forward(w[::-1], (problem.decel * problem.h)[::-1])[::-1]
     return np.maximum(w, 0.0)
+
+
+def positive_feasible_w(problem: DiscreteProblem) -> FloatArray:
+    """:func:`max_feasible_w`; :class:`InfeasibleError` unless it is positive inside.
+
+    With jerk rows the travel time of a ``w`` that vanishes at an interior node is infinite,
+    and no solver can find a finite one there: a zero speed bound inside, or bounds and
+    acceleration rows that force one. The error's ``s`` is in the problem's own grid
+    positions, so call this before scaling the problem (``DiscreteProblem.scaled``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.solve.problem import DiscreteProblem
+    >>> p = DiscreteProblem(s=np.arange(5.0) * 2.0, w_max=np.array([1.0, 1.0, 0.0, 1.0, 1.0]),
+    ...                     accel=np.ones(4), decel=np.ones(4), jerk=np.ones(3))
+    >>> try:
+    ...     positive_feasible_w(p)
+    ... except InfeasibleError as exc:
+    ...     print(exc.constraint, exc.s)
+    w_max 4.0
+    """
+    w = max_feasible_w(problem)
+    inner = w[1:-1]
+    if inner.size and float(np.min(inner)) <= 0.0:
+        i = int(np.argmin(inner)) + 1
+        raise InfeasibleError(
+            f"the relaxation is infeasible: no speed law with w > 0 at s={problem.s[i]:.6g} "
+            "meets the speed bound and the acceleration bounds",
+            constraint="w_max",
+            s=float(problem.s[i]),
+        )
+    return w
 
 
 def min_feasible_w(problem: DiscreteProblem) -> FloatArray:

@@ -213,6 +213,9 @@ class SpeedProfile:
         ([0.0, 0.0], [0.0, 10.0])
         """
         times = as_array("t", t)
+        if times.ndim > 1:
+            raise InvalidInputError(f"`t` must be a number or a 1-D array of times [s]; got "
+                                    f"shape {times.shape} (pass t.ravel() for every entry)")
         tt = np.clip(np.atleast_1d(times), 0.0, self.duration)
         q, w, v, a, jerk = self.law.state_at(tt)
         xy, heading, kappa = self.path.evaluate(q)
