@@ -229,6 +229,9 @@ def test_impossible_boundary_states():
         plan(bent, LGV, v_limit=([0.0, 5.0, 16.0], [1.0, 0.0, 1.0]))
     assert info.value.constraint == "w_max"
     assert info.value.s == pytest.approx(5.0, abs=0.01)
+    # Zero at the ends, rising in proportion to the distance: never left. It blamed curvature.
+    with pytest.raises(InvalidInputError, match="a knot of v_limit at 0"):
+        plan(Path.from_segments([Line(10.0)]), LGV, v_limit=([0, 5, 10], [0.0, 1.0, 0.0]))
     zone = SpeedZone([(1.0, -1.0), (5.0, -1.0), (5.0, 1.0), (1.0, 1.0)], v_max=0.5)
     with pytest.raises(InfeasibleError, match=r"from v0=2 m/s.* cannot slow down") as info:
         plan(line, LGV, v0=2.0, zones=[zone])

@@ -74,6 +74,22 @@ class Limits:
             value = getattr(self, name)
             set_(self, name, np.inf if value is None else as_scalar(name, value, positive=True,
                                                                      allow_inf=True))
+
+    def check_range(self) -> None:
+        """Raise :class:`~speedplan.InvalidInputError` unless every finite limit is in range.
+
+        The range is :data:`LIMIT_RANGE`. :func:`speedplan.plan` checks the limits it is
+        given; the limits it derives may pass the range's ends (a marginal boundary state
+        planned with 2 % more jerk than ``j_max = 1e9``).
+
+        Examples
+        --------
+        >>> Limits(v_max=1e300, a_max=1, a_lat_max=1, j_max=1).check_range()
+        ...  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        speedplan.core.errors.InvalidInputError: `v_max`=1e+300 is outside [1e-09, 1e+09], ...
+        """
         for name in ("v_max", "a_max", "a_lat_max", "j_max", "a_decel", "j_lat_max",
                      "yaw_rate_max"):
             value = getattr(self, name)

@@ -375,12 +375,14 @@ def _default_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: fl
     low = [v for v in (v0, vf) if v > 0] + [
         turnaround_speed(v, a, lim.j_max) for v, a in ((v0, a0), (vf, -af))
         if v > 0 and a < 0]
+    v_top = top_speed(leg_bound, length, lim.v_max, v0 * v0, vf * vf)
     return adaptive_grid(length, lambda q: env.cap(q, leg_bound(q)), a_max=lim.a_max,
                          a_decel=lim.a_decel, v_max=lim.v_max, j_max=lim.j_max,
                          w_start=v0**2, w_end=vf**2,
                          v_low=min((v for v in low if v > 0), default=None),
                          anchors=grid_anchors(request, lo, hi), max_nodes=max_nodes,
-                         breakpoints=bound_breakpoints(request.path, leg_bound))
+                         breakpoints=bound_breakpoints(request.path, leg_bound),
+                         v_top=v_top)
 
 
 def _no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: float,
@@ -603,6 +605,9 @@ def _check_moving_ends_resolved(s: FloatArray, lo: float, v0: float, a0: float, 
 def _zero_cause(bound: SpeedBound) -> str:
     if bound.zones and any(z.v_max == 0 for z in bound.zones):
         return "a zone with v_max=0 stops the vehicle"
+    if bound.v_limit is not None and bool(np.any(np.asarray(bound.v_limit[1]) == 0)):
+        return ("a knot of v_limit at 0 m/s: the bound falls to 0 there, and a bound that "
+                "rises from 0 only in proportion to the distance cannot be left in finite time")
     return ("infinite curvature, e.g. a sharp polyline corner: round the corners "
             "(Path.from_waypoints with the default kind)")
 

@@ -118,6 +118,7 @@ class PlanRequest:
             raise InvalidInputError(
                 f"`limits` must be a speedplan.Limits; got {type(limits).__name__}"
             )
+        limits.check_range()
         choice("refine", refine, REFINE_MODES)
         choice("standstill", standstill, STANDSTILL_MODES)
         choice("backend", backend, BACKENDS)
