@@ -36,7 +36,7 @@ from .grid import (
     uniform_grid,
 )
 from .refine import subdivided_grid
-from .request import STATE_ROUNDING, PlanRequest
+from .request import PlanRequest, within_limit
 from .standstill import calibrate_standstill_rows
 
 __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
@@ -619,21 +619,13 @@ def _end_speeds(request: PlanRequest, bound: SpeedBound, length: float) -> PlanR
     taken at the bound (a state read off a plan: the time law's rounding).
     """
     ends = np.sqrt(bound(np.array([0.0, length])))
-    v0, vf = (_under_bound(name, v, float(b), where) for name, v, b, where in (
-        ("v0", request.v0, ends[0], 0.0), ("vf", request.vf, ends[1], length)))
+    v0, vf = (within_limit(name, v, float(b), "m/s", f"the speed bound at s={where:.6g} m "
+                           "(v_max, lateral acceleration, a zone or v_limit)")
+              for name, v, b, where in (("v0", request.v0, ends[0], 0.0),
+                                        ("vf", request.vf, ends[1], length)))
     if (v0, vf) == (request.v0, request.vf):
         return request
     return replace(request, v0=v0, vf=vf)
-
-
-def _under_bound(name: str, v: float, bound: float, where: float) -> float:
-    """``min(v, bound)``; :class:`InvalidInputError` if ``v`` exceeds it beyond rounding."""
-    if v > bound * (1.0 + STATE_ROUNDING):
-        raise InvalidInputError(
-            f"`{name}`={v!r} m/s exceeds the speed bound {bound:.6g} m/s at "
-            f"s={where:.6g} m (v_max, lateral acceleration or a zone); pass a lower speed"
-        )
-    return min(v, bound)
 
 
 def _check_floor(floor: FloatArray, w_max: FloatArray, s: FloatArray, lo: float, v0: float,

@@ -53,10 +53,12 @@ def within_limit(name: str, value: float, limit: float, unit: str, what: str) ->
     --------
     >>> within_limit("v0", 2.0000000004, 2.0, "m/s", "the speed bound")
     2.0
-    >>> within_limit("a0", -1.5, -1.0, "m/s²", "-a_decel")  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    speedplan.core.errors.InvalidInputError: `a0`=-1.5 m/s² is beyond -a_decel = -1.0 m/s²; ...
+    >>> from speedplan import InvalidInputError
+    >>> try:
+    ...     within_limit("a0", -1.5, -1.0, "m/s²", "-a_decel")
+    ... except InvalidInputError as exc:
+    ...     print(str(exc)[:42])
+    `a0`=-1.5 m/s² is beyond -a_decel = -1.0 m
     """
     beyond = value < limit if limit < 0 else value > limit
     if not beyond:
