@@ -131,20 +131,19 @@ def test_a_short_move_with_tiny_jerk_phases_is_answered_by_the_banded_method():
     _physical(profile, length, lim)
 
 
-
 @pytest.mark.parametrize(("length", "cap", "lim"), [
     # Capped far below v_max by a span, a zone or v_limit (an edge's maxSpeed in a route):
     # the default grid sized its end transients from v_max and came out 1.2e-3 slower than
-    # ruckig at the cap (independent review, span_excess case 13) ...
+    # ruckig at the cap (an independent review; benchmarks/fuzz_caps.py draws such moves) ...
     (172.9, 0.06039, Limits(v_max=4.93, a_max=0.4172, a_lat_max=1.0, j_max=0.03581)),
     (32.54, 0.06776, Limits(v_max=3.383, a_max=3.707, a_lat_max=1.0, j_max=0.08693)),
-    # ... or 2.2e-4 *faster*, with the jerk 4.3 % over j_max (case 11).
+    # ... or 2.2e-4 *faster*, with the jerk 4.3 % over j_max.
     (1.848, 0.1455, Limits(v_max=7.125, a_max=0.2465, a_lat_max=1.0, j_max=0.02665)),
 ])
 @pytest.mark.parametrize("how", ["span", "v_limit"])
 @pytest.mark.parametrize("n", [None, 300])
 def test_a_cap_far_below_v_max_is_planned_to_its_own_optimum(length, cap, lim, how, n):
-    # A user grid's graded ends had the same cause: 7.6e-3 above at n = 300 (case 13).
+    # A user grid's graded ends had the same cause: 7.6e-3 above at n = 300 (the first move).
     path = _line(length)
     kw = ({"spans": [SpanLimit(0.0, length, v_max=cap)]} if how == "span"
           else {"v_limit": ([0.0, length], [cap, cap])})
