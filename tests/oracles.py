@@ -229,3 +229,23 @@ def ipopt_plain(p, w0, options=None):
     return IpoptAnswer(w=np.concatenate(([p.w_start], x_opt, [p.w_end])),
                        success=bool(stats["success"]), status=str(stats["return_status"]),
                        violation_price=float(bought / float(sol["f"])))
+
+
+def corner_reversals(traj, j_max, threshold=0.25):
+    """Sign reversals of the jerk column in each corner (a run of samples with ``κ != 0``).
+
+    Only samples with ``|j| >= threshold * j_max`` count, so a jerk that merely crosses zero
+    between phases is not counted. The column, not a finite difference of ``a``, is what a
+    controller that feeds the jerk forward reads: a chatter at the grid's frequency (steps of
+    a few millimetres, faster than 100 Hz at walking speed) is invisible in differences of
+    the sampled ``a`` but not in the column.
+    """
+    jerk = np.asarray(traj.j)
+    curved = np.abs(np.asarray(traj.curvature)) > 1e-12
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], curved.astype(int), [0]))))
+    counts = []
+    for lo, hi in zip(edges[::2], edges[1::2], strict=True):
+        j = jerk[lo:hi]
+        signs = np.sign(j[np.abs(j) >= threshold * j_max])
+        counts.append(int(np.count_nonzero(np.diff(signs))))
+    return counts

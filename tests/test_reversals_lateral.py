@@ -194,6 +194,17 @@ def _cvxpy_lateral_relaxation(s, w_max, a_max, j_max, kappa, rate, j_lat):
     # d(κ w)/ds at the node, times sqrt(w): κ' w + κ (w_{i+1} - w_{i-1}) / (2h).
     lat = cp.multiply(rate, wi) + cp.multiply(kappa, (w[2:] - w[:-2]) / (2 * h))
     cons += [lat <= j_lat * t / h, -lat <= j_lat * t / h]
+    # The same at each cell's midpoint with the one-sided slope, held with sqrt(w) of both
+    # ends (t of the cell's interior end nodes).
+    mid = 0.5 * (s[:-1] + s[1:])
+    k_mid = np.interp(mid, s[1:-1], kappa, left=np.nan, right=np.nan)
+    k_mid[0], k_mid[-1] = kappa[0] - 0.5 * (kappa[1] - kappa[0]), \
+        kappa[-1] + 0.5 * (kappa[-1] - kappa[-2])  # κ is linear in s on a clothoid
+    r_mid = np.concatenate(([rate[0]], rate))
+    lat_mid = (cp.multiply(r_mid, 0.5 * (w[1:] + w[:-1]))
+               + cp.multiply(k_mid, (w[1:] - w[:-1]) / h))
+    for cells, nodes in ((slice(1, n - 1), slice(None)), (slice(0, n - 2), slice(None))):
+        cons += [lat_mid[cells] <= j_lat * t[nodes] / h, -lat_mid[cells] <= j_lat * t[nodes] / h]
     prob = cp.Problem(cp.Minimize(cp.sum(t)), cons)
     prob.solve(solver=cp.CLARABEL, tol_gap_abs=1e-10, tol_gap_rel=1e-10, tol_feas=1e-10)
     return prob.value

@@ -6,10 +6,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .checks import as_scalar
+from .checks import as_scalar, choice
 from .errors import InvalidInputError
 
-__all__ = ["LIMIT_RANGE", "Limits"]
+__all__ = ["GRIP_MODELS", "LIMIT_RANGE", "Limits"]
+
+#: How the tangential and the lateral acceleration share the tyres' (or wheels') grip:
+#: ``"independent"``, each within its own limit; ``"ellipse"``, the friction ellipse
+#: ``(a / a_max)² + (a_lat / a_lat_max)² <= 1`` (``a_decel`` in place of ``a_max`` when
+#: braking).
+GRIP_MODELS = ("independent", "ellipse")
 
 #: Finite limits lie within nine decades either side of 1 (SI units): from a stage moving
 #: nanometres per second to far beyond any vehicle. Outside it, the model's closed forms
@@ -39,6 +45,13 @@ class Limits:
         paths: where the curvature jumps the vehicle has to stop.
     yaw_rate_max : float, optional
         Yaw-rate limit ``|κ| v`` [rad/s]; ``None`` or ``inf`` for none (the default).
+    grip : {"independent", "ellipse"}
+        ``"independent"`` (default): the tangential and the lateral acceleration each within
+        its own limit. ``"ellipse"``: they share one friction ellipse,
+        ``(a / a_max)² + (a_lat / a_lat_max)² <= 1`` with ``a_decel`` for ``a_max`` when
+        braking — a road vehicle cannot brake fully while cornering at its lateral limit.
+        A second-order cone in ``w``: the relaxation keeps its certificate. Needs a finite
+        ``a_lat_max``.
 
     Notes
     -----
@@ -60,6 +73,7 @@ class Limits:
     a_decel: float = field(default=None)  # type: ignore[assignment]
     j_lat_max: float = field(default=None)  # type: ignore[assignment]
     yaw_rate_max: float = field(default=None)  # type: ignore[assignment]
+    grip: str = "independent"
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -74,6 +88,16 @@ class Limits:
             value = getattr(self, name)
             set_(self, name, np.inf if value is None else as_scalar(name, value, positive=True,
                                                                      allow_inf=True))
+        choice("grip", self.grip, GRIP_MODELS)
+        if self.grip == "ellipse" and not np.isfinite(self.a_lat_max):
+            raise InvalidInputError(
+                "`grip`='ellipse' shares the grip between `a_max` and `a_lat_max`: give a "
+                "finite `a_lat_max`, or grip='independent'")
+
+    @property
+    def ellipse(self) -> bool:
+        """Whether the accelerations share a friction ellipse (``grip="ellipse"``)."""
+        return self.grip == "ellipse"
 
     def check_range(self) -> None:
         """Raise :class:`~speedplan.InvalidInputError` unless every finite limit is in range.

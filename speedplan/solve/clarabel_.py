@@ -5,6 +5,10 @@ relaxation ``t_i >= τ_i / sqrt(w_i)``, ``t_i >= ±τ_i w''_i / J_i`` becomes tw
 cones per node: ``z² <= w`` as ``||(2z, w - 1)|| <= w + 1`` and ``t z >= τ`` as
 ``||(2 sqrt(τ), t - z)|| <= t + z`` (one cone fewer than the paper's three). The whole matrix is
 assembled with vectorised numpy in COO form.
+
+Friction-ellipse rows (:attr:`DiscreteProblem.grip`) add one variable per cell, ``u_i`` at
+least the cell's acceleration and braking as fractions of their limits (two linear rows),
+and two 3-D cones per cell, ``||(u_i, g_j w_j)|| <= 1`` at either end ``j``.
 """
 
 from __future__ import annotations
@@ -62,8 +66,8 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
 
     n = problem.n
     m = n - 2
-    iw, it, iz = 0, n, n + m
-    nvar = n + 2 * m
+    iw, it, iz, iu = 0, n, n + m, n + 2 * m
+    nvar = n + 2 * m + (n - 1 if problem.has_grip else 0)
     h, tau = problem.h, problem.tau
     interior = np.arange(1, n - 1)
     seg = np.arange(n - 1)
@@ -113,7 +117,15 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
                 np.zeros(k),
             )
         n_jerk += 2 * k
-    n_nonneg = 2 * (n - 1) + m + n_lower + n_jerk
+    n_grip = 0
+    if problem.has_grip:  # (±(w_{i+1} - w_i) / (h A)) - u_i <= 0
+        ucol = iu + seg
+        for lo_col, hi_col, limit in ((iw + seg, iw + seg + 1, problem.accel),
+                                      (iw + seg + 1, iw + seg, problem.decel)):
+            add(n - 1, [hi_col, lo_col, ucol],
+                [1.0 / (h * limit), -1.0 / (h * limit), -one(n - 1)], np.zeros(n - 1))
+        n_grip = 2 * (n - 1)
+    n_nonneg = 2 * (n - 1) + m + n_lower + n_jerk + n_grip
     # Second-order cones, interleaved per node: (w+1, 2z, w-1) and (t+z, t-z, 2 sqrt(τ)).
     j = np.arange(m)
     wc, tc, zc = iw + interior, it + j, iz + j
@@ -127,6 +139,22 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
     rhs[:, 0], rhs[:, 2], rhs[:, 5] = 1.0, -1.0, 2.0 * np.sqrt(tau)
     b_parts.append(rhs.ravel())
     row0 += 6 * m
+    n_grip_cones = 0
+    if problem.grip is not None:  # (1, u_i, g_j w_j) at the cell's ends j = i, i + 1
+        k = 2 * (n - 1)
+        cell = np.concatenate((seg, seg))
+        node = np.concatenate((seg, seg + 1))
+        r = np.column_stack((3 * np.arange(k) + 1, 3 * np.arange(k) + 2))
+        c = np.column_stack((iu + cell, iw + node))
+        v = np.column_stack((-one(k), -problem.grip[node]))
+        blocks_r.append(r.ravel() + row0)
+        blocks_c.append(c.ravel())
+        blocks_v.append(v.ravel())
+        rhs = np.zeros((k, 3))
+        rhs[:, 0] = 1.0
+        b_parts.append(rhs.ravel())
+        row0 += 3 * k
+        n_grip_cones = k
 
     A = sp.csc_matrix(
         (np.concatenate(blocks_v), (np.concatenate(blocks_r), np.concatenate(blocks_c))),
@@ -136,7 +164,7 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
     q = np.zeros(nvar)
     q[it : it + m] = 1.0
     cones = [clarabel.ZeroConeT(2), clarabel.NonnegativeConeT(n_nonneg)]
-    cones += [clarabel.SecondOrderConeT(3)] * (2 * m)
+    cones += [clarabel.SecondOrderConeT(3)] * (2 * m + n_grip_cones)
     return A, b, q, cones
 
 

@@ -23,7 +23,7 @@ from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
 from .banded import check_grid_resolvable, kernel_for_auto, solve_unit_relaxation, unit_scales
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .nojerk import check_reachable, max_feasible_w, positive_feasible_w
-from .problem import DiscreteProblem
+from .problem import GRIP_TOL, DiscreteProblem
 from .refine import refine as refine_nlp
 from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
@@ -69,8 +69,11 @@ def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArr
 
 
 def _auto_backend(problem: DiscreteProblem) -> str:
-    """``backend="auto"``: banded from :data:`AUTO_BANDED_FROM` nodes on, once it is compiled."""
-    if problem.n < AUTO_BANDED_FROM:
+    """``backend="auto"``: banded from :data:`AUTO_BANDED_FROM` nodes on, once it is compiled.
+
+    Friction-ellipse rows are Clarabel's alone (the banded kernel holds no cone of them).
+    """
+    if problem.n < AUTO_BANDED_FROM or problem.has_grip:
         return "clarabel"
     return "banded" if kernel_for_auto(wait=problem.n >= AUTO_WAIT_FROM) else "clarabel"
 
@@ -104,7 +107,7 @@ def _relax_with_fallback(
     try:
         return _arriving(RELAXATION_BACKENDS[backend](unit), unit, backend), backend, None
     except SolverError as first:
-        if not fallback:
+        if not fallback or unit.has_grip:  # the other backend holds no friction ellipse
             raise
         other = "banded" if backend == "clarabel" else "clarabel"
         try:
@@ -140,7 +143,11 @@ def solve_problem(
     refine = choice("refine", refine, REFINE_MODES)
     backend = choice("backend", backend, BACKENDS)
     check_reachable(problem)
-    if not problem.has_jerk or problem.n < 3:
+    if problem.has_grip and backend == "banded":
+        raise InvalidInputError(
+            "`backend`='banded' holds no friction-ellipse rows (Limits grip='ellipse'); use "
+            "backend='auto' or 'clarabel'")
+    if not (problem.has_jerk or problem.has_grip) or problem.n < 3:
         w = max_feasible_w(problem)
         obj = problem.travel_time(w)
         return DiscreteSolution(
@@ -162,7 +169,10 @@ def solve_problem(
     w_relaxed[0], w_relaxed[-1] = problem.w_start, problem.w_end
     lower = min(relax.dual_objective, relax.primal_objective) * time_scale
     relaxed_violation = problem.jerk_violation(w_relaxed)
-    exact = relaxed_violation <= problem.jerk_tol
+    # An interior-point answer meets the convex rows to its tolerance; a friction ellipse
+    # held by 1e-7 less is still exact (the convex rows are not relaxed).
+    exact = relaxed_violation <= problem.jerk_tol and problem.grip_violation(
+        w_relaxed) <= GRIP_TOL
     relaxation = RelaxationInfo(
         backend=backend, status=relax.status, iterations=relax.iterations,
         time=relax.solve_time + relax.setup_time, w=w_relaxed,
@@ -179,7 +189,8 @@ def solve_problem(
         def feasible(w_unit: FloatArray) -> bool:
             w_ref = np.clip(w_unit * w_scale, 0.0, problem.w_max)
             return bool(problem.linear_violation(w_ref) <= _linear_tol(problem)
-                        and problem.jerk_violation(w_ref) <= problem.jerk_tol)
+                        and problem.jerk_violation(w_ref) <= problem.jerk_tol
+                        and problem.grip_violation(w_ref) <= GRIP_TOL)
 
         ref = refine_nlp(unit, relax.w, accept=feasible)
         w_ref = np.clip(ref.w * w_scale, 0.0, problem.w_max)

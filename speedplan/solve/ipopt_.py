@@ -91,6 +91,27 @@ def _rows(problem: DiscreteProblem, x: Any) -> tuple[Any, FloatArray, FloatArray
     return ca.vertcat(*parts), np.concatenate(lbg), np.concatenate(ubg)
 
 
+def _grip_rows(problem: DiscreteProblem, x: Any, u: Any) -> tuple[Any, FloatArray, FloatArray]:
+    """Friction-ellipse rows with the cells' acceleration fractions ``u`` as variables.
+
+    ``u_i >= ±(w_{i+1} - w_i) / (h A)`` keeps the rows smooth (``max`` is not).
+    """
+    import casadi as ca
+
+    assert problem.grip is not None
+    w_full = ca.vertcat(problem.w_start, x, problem.w_end)
+    dw = w_full[1:] - w_full[:-1]
+    g = ca.DM(problem.grip)
+    lat = g * w_full
+    k = problem.n - 1
+    rows = ca.vertcat(u - dw / ca.DM(problem.h * problem.accel),
+                      u + dw / ca.DM(problem.h * problem.decel),
+                      u * u + lat[:-1] * lat[:-1], u * u + lat[1:] * lat[1:])
+    lbg = np.concatenate((np.zeros(2 * k), np.full(2 * k, -np.inf)))
+    ubg = np.concatenate((np.full(2 * k, np.inf), np.ones(2 * k)))
+    return rows, lbg, ubg
+
+
 def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
     """Run IPOPT on the original problem from ``w0`` (interior nodes free, ends fixed).
 
@@ -123,18 +144,31 @@ def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
     wmin = 1e-9 * max(1.0, float(np.max(problem.w_max)))
     x = ca.SX.sym("w", m)
     g, lbg, ubg = _rows(problem, x)
-    nlp = {"x": x, "f": ca.dot(ca.DM(problem.tau), 1.0 / ca.sqrt(x)), "g": g}
+    ub = problem.w_max[1:-1]
+    lb = np.minimum(wmin, ub)
+    if problem.w_min is not None:
+        lb = np.maximum(lb, problem.w_min[1:-1])
+    x0 = np.clip(w0[1:-1], lb, ub)
+    variables = x
+    if problem.grip is not None:
+        u = ca.SX.sym("u", problem.n - 1)
+        grip, glb, gub = _grip_rows(problem, x, u)
+        g, lbg, ubg = ca.vertcat(g, grip), np.concatenate((lbg, glb)), np.concatenate((ubg, gub))
+        variables = ca.vertcat(x, u)
+        w_start = np.concatenate(([problem.w_start], x0, [problem.w_end]))
+        dw = np.diff(w_start)
+        u0 = np.clip(np.maximum(dw / (problem.h * problem.accel),
+                                -dw / (problem.h * problem.decel)), 0.0, 1.0)
+        x0, lb, ub = (np.concatenate((x0, u0)), np.concatenate((lb, np.zeros(u0.size))),
+                      np.concatenate((ub, np.ones(u0.size))))
+    nlp = {"x": variables, "f": ca.dot(ca.DM(problem.tau), 1.0 / ca.sqrt(x)), "g": g}
     try:
         solver = ca.nlpsol("refine", "ipopt", nlp, {"ipopt": IPOPT_OPTIONS, **NLPSOL_OPTIONS})
-        ub = problem.w_max[1:-1]
-        lb = np.minimum(wmin, ub)
-        if problem.w_min is not None:
-            lb = np.maximum(lb, problem.w_min[1:-1])
-        sol = solver(x0=np.clip(w0[1:-1], lb, ub), lbx=lb, ubx=ub, lbg=lbg, ubg=ubg)
+        sol = solver(x0=x0, lbx=lb, ubx=ub, lbg=lbg, ubg=ubg)
     except RuntimeError as exc:
         raise SolverError(f"IPOPT failed to run: {exc}", backend="ipopt") from exc
     stats = solver.stats()
-    w = np.concatenate(([problem.w_start], np.asarray(sol["x"]).ravel(), [problem.w_end]))
+    w = np.concatenate(([problem.w_start], np.asarray(sol["x"]).ravel()[:m], [problem.w_end]))
     return RefineResult(
         w=w,
         status=str(stats.get("return_status", "unknown")),

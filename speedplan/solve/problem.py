@@ -31,6 +31,10 @@ __all__ = ["DiscreteProblem", "StencilRows"]
 #: paper's scale and makes the test invariant when ``w`` is rescaled.
 JERK_TOL = 1e-5
 JERK_TOL_REL = JERK_TOL / 100.0
+#: Largest excess of the friction-ellipse rows over 1 a solution may have: an interior-point
+#: method meets a cone to its own tolerance (Clarabel's answers: up to 1.5e-6, measured on an
+#: arc), 1e-5 of the grip is far inside what ``verify()`` tolerates (1 %).
+GRIP_TOL = 1e-5
 
 
 @dataclass(frozen=True)
@@ -84,6 +88,13 @@ class DiscreteProblem:
         Lateral-jerk rows, relaxed like the jerk rows and part of the exactness test; several
         families when a node needs more than one row (the one-sided curvature rates at a join
         of path pieces).
+    grip : ndarray, shape (n,), optional
+        Friction-ellipse rows: with ``g_i`` the lateral acceleration per unit ``w`` at node
+        ``i`` as a fraction of its limit (``|κ_i| / a_lat_max``) and ``u_i`` cell ``i``'s
+        acceleration as a fraction of its limit, ``max((w_{i+1} - w_i) / (h_i A_i),
+        (w_i - w_{i+1}) / (h_i D_i))``, both ends of every cell hold
+        ``u_i² + (g w)² <= 1`` — a second-order cone in ``w``, convex: the relaxation keeps
+        its certificate.
     """
 
     s: FloatArray
@@ -95,6 +106,7 @@ class DiscreteProblem:
     w_end: float = 0.0
     w_min: FloatArray | None = None
     lateral: StencilRows | tuple[StencilRows, ...] | None = None
+    grip: FloatArray | None = None
 
     @property
     def n(self) -> int:
@@ -135,6 +147,37 @@ class DiscreteProblem:
     def has_lateral(self) -> bool:
         """Whether any lateral-jerk row is finite."""
         return any(bool(np.isfinite(f.bound).any()) for f in self.lateral_families)
+
+    @property
+    def has_grip(self) -> bool:
+        """Whether the problem has friction-ellipse rows (:attr:`grip`)."""
+        return self.grip is not None
+
+    def grip_load(self, w: FloatArray) -> FloatArray:
+        """Per cell, the larger of ``sqrt(u² + (g w)²)`` at its two ends (1 at the ellipse).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> p = DiscreteProblem(s=np.array([0.0, 1.0]), w_max=np.ones(2), accel=np.array([2.0]),
+        ...                     decel=np.array([2.0]), jerk=np.zeros(0),
+        ...                     grip=np.array([0.0, 1.0]))
+        >>> p.grip_load(np.array([0.0, 0.6]))  # u = 0.3, g w = 0.6 at the cell's end
+        array([0.67082039])
+        """
+        if self.grip is None:
+            return np.zeros(self.n - 1)
+        dw = np.diff(w)
+        u = np.maximum(dw / (self.h * self.accel), -dw / (self.h * self.decel))
+        lat = self.grip * np.maximum(w, 0.0)
+        out: FloatArray = np.hypot(u, np.maximum(lat[:-1], lat[1:]))
+        return out
+
+    def grip_violation(self, w: FloatArray) -> float:
+        """Largest excess of the friction-ellipse rows over 1 (0 without them)."""
+        if self.grip is None or self.n < 2:
+            return 0.0
+        return max(float(np.max(self.grip_load(w))) - 1.0, 0.0)
 
     @property
     def lateral_families(self) -> tuple[StencilRows, ...]:
@@ -313,4 +356,5 @@ class DiscreteProblem:
             w_end=self.w_end / w_scale,
             w_min=None if self.w_min is None else self.w_min / w_scale,
             lateral=tuple(f.scaled(s_scale, w_scale) for f in self.lateral_families) or None,
+            grip=None if self.grip is None else self.grip * w_scale,
         )

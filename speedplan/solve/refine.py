@@ -20,7 +20,7 @@ import numpy as np
 from ..core.checks import FloatArray
 from .banded_nlp import LATERAL_STARTS, STARTS, solve_banded_nlp
 from .ipopt_ import RefineResult, refine_ipopt
-from .problem import DiscreteProblem
+from .problem import GRIP_TOL, DiscreteProblem
 
 __all__ = ["AGREE", "refine"]
 
@@ -76,7 +76,9 @@ def refine(
     last: tuple[FloatArray, str] = (np.asarray(w0, dtype=np.float64), "not run")
     iterations = 0
     found: list[float] = []
-    for start in LATERAL_STARTS if problem.has_lateral else STARTS:
+    # The banded method holds no friction-ellipse rows: IPOPT refines those problems.
+    starts = () if problem.has_grip else LATERAL_STARTS if problem.has_lateral else STARTS
+    for start in starts:
         res = solve_banded_nlp(problem, w0, start)
         iterations += res.iterations
         status = f"banded/{start.name}: {res.status}"
@@ -108,6 +110,7 @@ def _default_acceptance(problem: DiscreteProblem) -> Callable[[FloatArray], bool
 
     def accept(w: FloatArray) -> bool:
         return bool(problem.linear_violation(w) <= tol
-                    and problem.jerk_violation(w) <= problem.jerk_tol)
+                    and problem.jerk_violation(w) <= problem.jerk_tol
+                    and problem.grip_violation(w) <= GRIP_TOL)
 
     return accept

@@ -40,6 +40,7 @@ TOLERANCES: dict[str, float] = {
     "jerk": 0.05,
     "yaw_rate": 0.001,
     "lateral_jerk": 0.05,
+    "grip": 0.01,
 }
 #: Every checked limit, in report order.
 LIMIT_NAMES = tuple(TOLERANCES)
@@ -54,11 +55,13 @@ class Verification:
     maxima : dict
         Largest realised value of each quantity, SI units (``"speed"`` [m/s], ``"accel"``
         and ``"decel"`` [m/s²], ``"lateral"`` [m/s²], ``"jerk"`` and ``"lateral_jerk"``
-        [m/s³], ``"yaw_rate"`` [rad/s]).
+        [m/s³], ``"yaw_rate"`` [rad/s]; ``"grip"``, with ``grip="ellipse"``, the friction
+        ellipse's radius ``sqrt((a / a_max)² + (a_lat / a_lat_max)²)``, 1 on the ellipse).
     ratios : dict
         Each maximum divided by its limit (``"speed"`` against the local bound
         ``sqrt(mu+(s))``, which includes ``v_max``, lateral limits and zones); limits that are
-        ``inf`` give 0. A ratio above ``1 + TOLERANCES[name]`` is a violation.
+        ``inf`` give 0, and so does the grip without ``grip="ellipse"``. A ratio above
+        ``1 + TOLERANCES[name]`` is a violation.
     where : dict
         Arc length [m] at which each ratio is largest.
     max_speed, max_accel, max_decel, max_jerk, max_lateral : float
@@ -209,9 +212,15 @@ def check_law(law: TimeLaw, offset: float, path: Path,
         lat_jerk = np.abs(v * (rate * w + 2.0 * kappa * a))
     else:
         lat_jerk = np.zeros(1)  # no limit: nothing to evaluate, reported as 0
+    if limits.ellipse:  # the friction ellipse's radius, 1 on the ellipse
+        grip = np.hypot(a / np.where(a >= 0.0, limits.a_max, limits.a_decel),
+                        lateral / limits.a_lat_max)
+    else:
+        grip = np.zeros(1)  # not set: reported as 0
     per_sample = {"speed": (speed, v, 1.0), "lateral": (lateral, lateral, limits.a_lat_max),
                   "yaw_rate": (yaw, yaw, limits.yaw_rate_max),
-                  "lateral_jerk": (lat_jerk, lat_jerk, limits.j_lat_max)}
+                  "lateral_jerk": (lat_jerk, lat_jerk, limits.j_lat_max),
+                  "grip": (grip, grip, 1.0 if limits.ellipse else np.inf)}
     maxima: dict[str, float] = {}
     ratios: dict[str, float] = {}
     where: dict[str, float] = {}
