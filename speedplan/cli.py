@@ -29,7 +29,7 @@ from .core.errors import (
     SolverError,
     SpeedplanError,
 )
-from .core.limits import Limits
+from .core.limits import GRIP_MODELS, Limits
 from .core.log import logger
 from .solve import BACKENDS, REFINE_MODES
 
@@ -117,6 +117,9 @@ def _add_limits(p: argparse.ArgumentParser, defaults: dict[str, float] | None = 
                    help="lateral jerk limit [m/s³] (default: none)")
     g.add_argument("--yaw-rate-max", type=float, default=None, metavar="X",
                    help="yaw-rate limit [rad/s] (default: none)")
+    g.add_argument("--grip", choices=GRIP_MODELS, default="independent",
+                   help="'ellipse': acceleration and lateral acceleration share one friction "
+                        "ellipse (default: independent limits)")
 
 
 def _add_common(p: argparse.ArgumentParser, out: str | None = None,
@@ -331,7 +334,7 @@ def _read_input(args: argparse.Namespace, pathfile: str | FsPath) -> tuple[Any, 
 def _limits(args: argparse.Namespace) -> Limits:
     return Limits(v_max=args.v_max, a_max=args.a_max, a_lat_max=args.a_lat_max,
                   j_max=args.j_max, a_decel=args.a_decel, j_lat_max=args.j_lat_max,
-                  yaw_rate_max=args.yaw_rate_max)
+                  yaw_rate_max=args.yaw_rate_max, grip=args.grip)
 
 
 def _write_outputs(args: argparse.Namespace, traj: Trajectory, info: IO[str]) -> None:

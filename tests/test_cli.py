@@ -236,3 +236,15 @@ def test_comfort_limits_on_the_command_line(root):
     ratio = {line.split()[0]: float(line.split()[1]) for line in res.stdout.splitlines()
              if line.startswith("  ") and "of limit" in line}
     assert 0.5 < ratio["yaw_rate"] <= 1.001 and 0.5 < ratio["lateral_jerk"] <= 1.05
+
+
+def test_grip_ellipse_from_the_command_line(root, tmp_path):
+    res = run("plan", str(root / "paths" / "u_turn.json"), *LGV_ARGS, "--grip", "ellipse",
+              "-o", "t.json", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "grip" in res.stdout
+    meta = json.loads((tmp_path / "t.json").read_text())["metadata"]
+    assert meta["limits"]["grip"] == "ellipse" and meta["backend"] == "clarabel"
+    bad = run("plan", str(root / "paths" / "u_turn.json"), *LGV_ARGS, "--grip", "circle",
+              cwd=tmp_path)
+    assert bad.returncode == 2 and "ellipse" in bad.stderr
