@@ -25,8 +25,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 
 def save(out: str, label: str) -> None:
-    import speedplan as sp
     from test_comfort import CHATTER_LIMITS, CHATTER_PATH
+
+    import speedplan as sp
 
     prof = sp.plan(sp.Path.from_waypoints(CHATTER_PATH), CHATTER_LIMITS)
     tr = prof.sample(0.01)
