@@ -219,7 +219,13 @@ def test_lateral_rows_match_an_independent_relaxation_on_a_clothoid():
     rate = np.full(n - 2, k1 / length)
     w_max = np.minimum(lim.v_max**2, lim.a_lat_max / np.maximum(k1 * s / length, 1e-300))
     (leg,) = build_model(PlanRequest.create(path, lim, n=n, standstill="free")).legs
-    np.testing.assert_allclose(leg.problem.w_max, _node_min(w_max), rtol=1e-12)
+    # The speed the lateral-jerk rows allow where braking (at most 2 a_decel in w') eases the
+    # growing curvature: sqrt(w) (κ' w - κ 2 a_decel) <= j_lat_max, the largest root.
+    caps = np.array([max(np.roots([r, 0.0, -k * 2 * lim.a_decel, -lim.j_lat_max]).real) ** 2
+                     for k, r in zip(kappa, rate, strict=True)])
+    expected = _node_min(w_max)
+    expected[1:-1] = np.minimum(expected[1:-1], caps)
+    np.testing.assert_allclose(leg.problem.w_max, expected, rtol=1e-8)
     reference = _cvxpy_lateral_relaxation(s, leg.problem.w_max, lim.a_max, lim.j_max, kappa,
                                           rate, lim.j_lat_max)
     sol = solve_problem(leg.problem)  # the lateral rows bind: refined, with its bound

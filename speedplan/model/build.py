@@ -40,8 +40,8 @@ from .request import PlanRequest, within_limit
 from .standstill import calibrate_standstill_rows
 
 __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
-           "build_model", "coarsenable", "coarser_leg", "grid_anchors", "node_bounds",
-           "rest_points"]
+           "build_model", "coarsenable", "coarser_leg", "grid_anchors", "lateral_speed_caps",
+           "node_bounds", "rest_points"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
@@ -54,6 +54,11 @@ NO_JERK_BOUND_LOSS = 1e-3
 #: (``v - a²/(2 j)``) of zero comes to rest on the way: the gain of passing through at that
 #: speed is below any resolvable time, and the dip could not be gridded.
 TOUCH_ZERO = 1e-6
+#: Newton steps for :func:`lateral_speed_caps` (converged to rounding from its start within
+#: about 40 on the sample paths) and the relative margin added to each cap, so that rounding
+#: never cuts a feasible point.
+CAP_NEWTON_STEPS = 60
+CAP_MARGIN = 1e-9
 #: Nodes of the sampled forced motion of a :class:`ForcedLeg`.
 FORCED_NODES = 401
 
@@ -505,9 +510,12 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     jerk = np.full(m - 2, lim.J)
     if request.smooth_standstill:
         calibrate_standstill_rows(jerk, s, v0, a0, vf, af, lim.j_max)
+    accel, decel = np.full(m - 1, lim.A), np.full(m - 1, lim.A_decel)
+    if np.isfinite(lim.j_lat_max):
+        w_max[1:-1] = np.minimum(w_max[1:-1], lateral_speed_caps(
+            request.path, lo, s, lim.j_lat_max, accel, decel))
     problem = DiscreteProblem(
-        s=s, w_max=w_max,
-        accel=np.full(m - 1, lim.A), decel=np.full(m - 1, lim.A_decel),
+        s=s, w_max=w_max, accel=accel, decel=decel,
         jerk=jerk, w_start=v0 * v0, w_end=vf * vf, w_min=floor,
         lateral=lateral_jerk_rows(request.path, lo, s, lim.j_lat_max),
         grip=np.abs(request.path.curvature(lo + s)) / lim.a_lat_max if lim.ellipse else None,
@@ -562,18 +570,7 @@ def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float
     """
     if not np.isfinite(j_lat_max):
         return None
-    q = lo + s[1:-1]
-    kappa = path.curvature(q)
-    after = path.curvature_rate(q)
-    before = after.copy()
-    joins = path.offsets[1:-1]
-    if joins.size:
-        k = np.searchsorted(joins, q)  # nearest join to each node
-        for cand in (np.clip(k - 1, 0, joins.size - 1), np.clip(k, 0, joins.size - 1)):
-            on = np.abs(joins[cand] - q) <= 1e-12 * max(float(path.length), 1.0)
-            for i in np.flatnonzero(on):
-                piece = path.pieces[int(cand[i])]  # the piece ending at that join
-                before[i] = float(piece.curvature_rate(np.array(piece.length)))
+    kappa, after, before = _node_curvature(path, lo, s)
     h = np.diff(s)
     h0, h1 = h[:-1], h[1:]
     first = np.column_stack((-h1 / (h0 * (h0 + h1)), (h1 - h0) / (h0 * h1),
@@ -588,6 +585,60 @@ def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float
         families.append(StencilRows(coef=coef, bound=rows))
     families.extend(_midpoint_rows(path, lo, s, bound))
     return tuple(families)
+
+
+def _node_curvature(path: Path, lo: float, s: FloatArray
+                    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``κ``, and ``κ'`` after and before each interior node (they differ on piece joins)."""
+    q = lo + s[1:-1]
+    kappa = np.asarray(path.curvature(q), dtype=np.float64)
+    after = np.asarray(path.curvature_rate(q), dtype=np.float64)
+    before = after.copy()
+    joins = path.offsets[1:-1]
+    if joins.size:
+        k = np.searchsorted(joins, q)  # nearest join to each node
+        for cand in (np.clip(k - 1, 0, joins.size - 1), np.clip(k, 0, joins.size - 1)):
+            on = np.abs(joins[cand] - q) <= 1e-12 * max(float(path.length), 1.0)
+            for i in np.flatnonzero(on):
+                piece = path.pieces[int(cand[i])]  # the piece ending at that join
+                before[i] = float(piece.curvature_rate(np.array(piece.length)))
+    return kappa, after, before
+
+
+def lateral_speed_caps(path: Path, lo: float, s: FloatArray, j_lat_max: float,
+                       accel: FloatArray, decel: FloatArray) -> FloatArray:
+    """Upper bounds on interior ``w`` that the lateral-jerk and acceleration rows imply.
+
+    The node row ``|κ' w_i + κ w'_i| sqrt(w_i) <= j_lat_max`` (:func:`lateral_jerk_rows`) has
+    ``w'_i`` a convex combination of the slopes of the two adjacent cells, each within
+    ``[-D, A]`` by the acceleration rows. So ``|κ' w_i + κ w'_i| >= |κ'| w_i - |κ| M_i`` with
+    ``M_i`` the larger braking bound ``D`` of the two cells where ``κ' κ > 0`` (braking eases
+    a curvature that grows in magnitude), the larger ``A`` elsewhere, and every feasible ``w``
+    has ``sqrt(w_i) (|κ'| w_i - |κ| M_i) <= j_lat_max``: ``w_i <= x²``, with ``x`` the positive
+    root of ``|κ'| x³ - |κ| M_i x - j_lat_max``. The bound removes no feasible point of the
+    discrete problem (its optimum is unchanged), but the relaxation can no longer drive
+    ``w`` past it and pay for the lateral-jerk excess at one node: on comfort plans the
+    certified gap falls from a few per cent to about 0.1 % (``benchmarks/bench_comfort.py``).
+    ``inf`` where the curvature rate is 0.
+    """
+    kappa, after, before = _node_curvature(path, lo, s)
+    caps = np.full(s.size - 2, np.inf)
+    for rate in (after, before):
+        eases = rate * kappa > 0
+        m = np.where(eases, np.maximum(decel[:-1], decel[1:]),
+                     np.maximum(accel[:-1], accel[1:]))
+        a = np.abs(rate)
+        on = a > 0
+        if not on.any():
+            continue
+        a, km = a[on], np.abs(kappa[on]) * m[on]
+        # f(x) = a x³ - km x - B is convex and increasing right of its root: Newton from an
+        # upper bound of the root converges from the right, monotonically.
+        x = np.maximum(np.cbrt(2.0 * j_lat_max / a), np.sqrt(2.0 * km / a))
+        for _ in range(CAP_NEWTON_STEPS):
+            x = x - (a * x**3 - km * x - j_lat_max) / (3.0 * a * x * x - km)
+        caps[on] = np.minimum(caps[on], x * x * (1.0 + CAP_MARGIN))
+    return caps
 
 
 def _midpoint_rows(path: Path, lo: float, s: FloatArray, bound: FloatArray
