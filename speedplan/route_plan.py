@@ -2,18 +2,24 @@
 
 from __future__ import annotations
 
+import itertools
 from concurrent.futures import Executor
 from typing import Any
+
+import numpy as np
 
 from .batch import plan_many
 from .core.checks import as_scalar
 from .core.errors import InfeasibleError, InvalidInputError, SolverError, SpeedplanError
 from .core.limits import Limits
 from .geometry import SpanLimit
+from .geometry._checks import wrap_angle
 from .plan import plan
-from .route import Route, RouteProfile
+from .route import THETA_TOLERANCE, Route, RouteProfile
+from .route.profile import RouteTurn
+from .timing.rotation import Turn
 
-__all__ = ["plan_route", "route_jobs"]
+__all__ = ["plan_route", "route_jobs", "route_turns"]
 
 #: plan() options that plan_route() sets itself from the route.
 _FROM_ROUTE = ("v0", "a0", "vf", "af", "stops", "spans", "v_limit")
@@ -90,15 +96,83 @@ def _edge_spans(route: Route, lo: float, hi: float) -> list[SpanLimit]:
     return out
 
 
+def route_turns(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
+                heading0: float | None = None) -> tuple[RouteTurn, ...]:
+    """The turns on the spot of a route from ``start_s`` on (see :func:`plan_route`).
+
+    Each step of :attr:`Route.turn_headings` on a node at or after ``start_s`` is one
+    rest-to-rest :class:`~speedplan.timing.rotation.Turn` by the shorter way round, within
+    :meth:`Route.turn_rate_limit` and ``limits.yaw_rate_max`` and ``limits.yaw_acc_max``.
+    ``heading0`` [rad] replaces the arrival heading where the motion starts.
+
+    Examples
+    --------
+    A corner that may not be cut (no allowed deviation) at (10, 0), 0.3 rad/s on both edges:
+
+    >>> import numpy as np
+    >>> from speedplan import Limits
+    >>> from speedplan.geometry import Line, Path
+    >>> from speedplan.route import Route, RouteEdge, RouteNode
+    >>> nodes = [RouteNode("n0", 0, (0.0, 0.0)), RouteNode("n1", 2, (10.0, 0.0)),
+    ...          RouteNode("n2", 4, (10.0, 10.0))]
+    >>> edges = [RouteEdge("e0", 1, "n0", "n1", Path.from_segments([Line(10.0)]),
+    ...                    yaw_rate_max=0.3),
+    ...          RouteEdge("e1", 3, "n1", "n2", Path.from_segments(
+    ...              [Line(10.0)], start=(10, 0), heading=np.pi / 2), yaw_rate_max=0.3)]
+    >>> [(t.node, round(t.turn.angle, 6), round(t.duration, 3))
+    ...  for t in route_turns(Route(nodes, edges), Limits(2, 1, 1, 0.5))]
+    [(1, 1.570796, 5.536)]
+    """
+    start = float(start_s)
+    tol = 1e-9 * max(route.length, 1.0)
+    out: list[RouteTurn] = []
+    at_node = False
+    for k, heads in enumerate(route.turn_headings):
+        s = float(route.node_s[k])
+        if s < start - tol:
+            continue
+        here = abs(s - start) <= tol
+        at_node = at_node or here
+        if here and heading0 is not None and heads:
+            heads = route.node_headings(k, float(heading0))
+        out += _turns(heads, k, s, route.turn_rate_limit(k), limits)
+    if heading0 is not None and not at_node:  # between nodes: the vehicle faces the path
+        on_path = float(route.path.heading(start_s))
+        off = abs(float(wrap_angle(on_path - heading0)))
+        if off > THETA_TOLERANCE:
+            if v0 > 0:
+                raise InvalidInputError(
+                    f"`heading0`={heading0!r} rad is {off:.3g} rad off the path's heading "
+                    f"{on_path:.6g} rad at `start_s`={start_s!r} m; a vehicle moving along the "
+                    "path faces its tangent (or the opposite on an edge driven backwards)")
+            edge = route.base_edges[int(np.clip(np.searchsorted(route.node_s, start_s) - 1,
+                                                0, len(route.base_edges) - 1))]
+            rate = np.inf if edge.yaw_rate_max is None else edge.yaw_rate_max
+            out = _turns((float(heading0), on_path), -1, float(start_s), rate, limits) + out
+    return tuple(out)
+
+
+def _turns(heads: tuple[float, ...], node: int, s: float, rate: float,
+           limits: Limits) -> list[RouteTurn]:
+    rate = min(rate, limits.yaw_rate_max)
+    return [RouteTurn(node, s, Turn(a, float(wrap_angle(b - a)), rate, limits.yaw_acc_max), rate)
+            for a, b in itertools.pairwise(heads)]
+
+
 def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
-               a0: float = 0.0, executor: Executor | None = None,
-               **plan_options: Any) -> RouteProfile:
+               a0: float = 0.0, heading0: float | None = None,
+               executor: Executor | None = None, **plan_options: Any) -> RouteProfile:
     """Plan the minimum-time motion along a route's released base.
 
     The vehicle stops (v = 0, a = 0) at every :attr:`Route.stop_s` — the nodes with a
-    blocking action, changes of driving direction, heading jumps it cannot round — and at
-    the end of the released base, and drives through every other node without slowing
-    more than its limits ask. Each stop-to-stop leg is one :func:`speedplan.plan` (one
+    blocking action, changes of driving direction, heading jumps it cannot round, node
+    orientations (``theta``) the path does not meet — and at the end of the released base,
+    and drives through every other node without slowing more than its limits ask. Where its
+    heading must change on a node it turns on the spot (:attr:`Route.turn_headings`): a
+    minimum-time rest-to-rest rotation within the edges' ``maxRotationSpeed``,
+    ``limits.yaw_rate_max`` and ``limits.yaw_acc_max``, the shorter way round; the turns'
+    time is part of :attr:`RouteProfile.node_times` (arrival), ``node_leave_times`` and the
+    sampled trajectory. Each stop-to-stop leg is one :func:`speedplan.plan` (one
     discrete problem, certified on its own); the legs are independent, so ``executor``
     can plan them in parallel (:func:`speedplan.plan_many`).
 
@@ -114,6 +188,11 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
         the new plan continues from there); default the start.
     v0, a0 : float
         Its speed [m/s] and acceleration [m/s²] there.
+    heading0 : float, optional
+        Its heading [rad] there. Default: on the first node its ``theta`` (else the first
+        edge's heading), elsewhere the route's. Standing on a node, the vehicle turns from it
+        to the node's ``theta`` and the next edge's heading; between nodes it must face the
+        path (or stand, ``v0 = 0``, and turn onto it).
     executor : concurrent.futures.Executor, optional
         Plan the legs on it (``plan_many``); default: one after the other in this process.
     **plan_options
@@ -153,6 +232,9 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     ([0.0, 14.828], 'optimal')
     """
     jobs, starts = route_jobs(route, limits, start_s=start_s, v0=v0, a0=a0, **plan_options)
+    if heading0 is not None:
+        heading0 = as_scalar("heading0", heading0)
+    turns = route_turns(route, limits, start_s=start_s, v0=v0, heading0=heading0)
     if executor is None:
         legs = []
         for job, lo in zip(jobs, starts, strict=True):
@@ -172,7 +254,7 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
             assert result.profile is not None
             legs.append(result.profile)
     return RouteProfile(route=route, legs=tuple(legs), leg_starts=tuple(starts),
-                        start_s=float(start_s))
+                        start_s=float(start_s), turns=turns)
 
 
 def _on_leg(exc: SpeedplanError, lo: float, job: dict[str, Any]) -> SpeedplanError:

@@ -9,12 +9,18 @@ import numpy as np
 from .checks import as_scalar
 from .errors import InvalidInputError
 
-__all__ = ["LIMIT_RANGE", "Limits"]
+__all__ = ["DEFAULT_YAW_ACC", "LIMIT_RANGE", "Limits"]
 
 #: Finite limits lie within nine decades either side of 1 (SI units): from a stage moving
 #: nanometres per second to far beyond any vehicle. Outside it, the model's closed forms
 #: (``v³ / j²`` and the like) overflow or underflow in double precision.
 LIMIT_RANGE = (1e-9, 1e9)
+
+#: Default yaw-acceleration limit [rad/s²] of a vehicle turning on the spot: a quarter turn
+#: takes at least ``2 sqrt((π/2) / 1) = 2.5`` s, within what differential-drive and
+#: omnidirectional AGVs/AMRs commonly reach (wheel accelerations of ``α b / 2`` for a track
+#: width ``b`` of about 1 m). Pass the vehicle's own value for real plans.
+DEFAULT_YAW_ACC = 1.0
 
 
 @dataclass(frozen=True)
@@ -38,7 +44,14 @@ class Limits:
         ``None`` or ``inf`` for none (the default). Finite only on curvature-continuous (G2)
         paths: where the curvature jumps the vehicle has to stop.
     yaw_rate_max : float, optional
-        Yaw-rate limit ``|κ| v`` [rad/s]; ``None`` or ``inf`` for none (the default).
+        Yaw-rate limit ``|κ| v`` [rad/s]; ``None`` or ``inf`` for none (the default). It also
+        bounds the yaw rate of a turn on the spot (see :func:`speedplan.plan_route`).
+    yaw_acc_max : float, optional
+        Yaw-acceleration limit of a turn on the spot [rad/s²], where a route makes the vehicle
+        stop and rotate (a corner it may not cut, a node orientation): > 0, default
+        :data:`DEFAULT_YAW_ACC` (1 rad/s²; ``inf`` is refused, no vehicle turns in no time).
+        While driving, the yaw acceleration ``d(κ v)/dt`` is bounded through ``j_lat_max``
+        and the path's curvature instead.
 
     Notes
     -----
@@ -60,6 +73,7 @@ class Limits:
     a_decel: float = field(default=None)  # type: ignore[assignment]
     j_lat_max: float = field(default=None)  # type: ignore[assignment]
     yaw_rate_max: float = field(default=None)  # type: ignore[assignment]
+    yaw_acc_max: float = DEFAULT_YAW_ACC
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -74,6 +88,7 @@ class Limits:
             value = getattr(self, name)
             set_(self, name, np.inf if value is None else as_scalar(name, value, positive=True,
                                                                      allow_inf=True))
+        set_(self, "yaw_acc_max", as_scalar("yaw_acc_max", self.yaw_acc_max, positive=True))
 
     def check_range(self) -> None:
         """Raise :class:`~speedplan.InvalidInputError` unless every finite limit is in range.
@@ -92,7 +107,7 @@ class Limits:
         `v_max`=1e+300 is outside [1e-09, 1e+09]
         """
         for name in ("v_max", "a_max", "a_lat_max", "j_max", "a_decel", "j_lat_max",
-                     "yaw_rate_max"):
+                     "yaw_rate_max", "yaw_acc_max"):
             value = getattr(self, name)
             if np.isfinite(value) and not LIMIT_RANGE[0] <= value <= LIMIT_RANGE[1]:
                 raise InvalidInputError(

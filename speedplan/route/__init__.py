@@ -11,8 +11,8 @@ This layer sits between ``timing`` and the top level; it imports ``core``, ``geo
 ``timing``.
 """
 
-from .profile import RouteProfile, RouteTrajectory
-from .route import HEADING_TOLERANCE, Route, RouteEdge, RouteNode
+from .profile import RouteProfile, RouteTrajectory, RouteTurn
+from .route import HEADING_TOLERANCE, THETA_TOLERANCE, Route, RouteEdge, RouteNode
 
-__all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode", "RouteProfile",
-           "RouteTrajectory"]
+__all__ = ["HEADING_TOLERANCE", "THETA_TOLERANCE", "Route", "RouteEdge", "RouteNode",
+           "RouteProfile", "RouteTrajectory", "RouteTurn"]

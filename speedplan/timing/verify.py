@@ -40,6 +40,7 @@ TOLERANCES: dict[str, float] = {
     "jerk": 0.05,
     "yaw_rate": 0.001,
     "lateral_jerk": 0.05,
+    "yaw_acc": 0.001,
 }
 #: Every checked limit, in report order.
 LIMIT_NAMES = tuple(TOLERANCES)
@@ -59,6 +60,8 @@ class Verification:
         Each maximum divided by its limit (``"speed"`` against the local bound
         ``sqrt(mu+(s))``, which includes ``v_max``, lateral limits and zones); limits that are
         ``inf`` give 0. A ratio above ``1 + TOLERANCES[name]`` is a violation.
+        ``"yaw_acc"`` [rad/s²], the yaw acceleration of turns on the spot, appears in the
+        checks of routes that turn (:meth:`speedplan.RouteProfile.verify`).
     where : dict
         Arc length [m] at which each ratio is largest.
     max_speed, max_accel, max_decel, max_jerk, max_lateral : float
@@ -108,12 +111,16 @@ class Verification:
 
     @staticmethod
     def merged(parts: list[Verification]) -> Verification:
-        """The worst of several verifications (legs of one profile)."""
-        maxima = {k: max(p.maxima[k] for p in parts) for k in LIMIT_NAMES}
+        """The worst of several verifications (legs of one profile).
+
+        A quantity only some parts check (``"yaw_acc"`` of turns) is merged over those.
+        """
+        keys = [k for k in LIMIT_NAMES if any(k in p.ratios for p in parts)]
+        maxima = {k: max(p.maxima[k] for p in parts if k in p.maxima) for k in keys}
         ratios, where = {}, {}
-        for k in LIMIT_NAMES:
-            worst = max(parts, key=lambda p: (p.ratios[k] if np.isfinite(p.ratios[k])
-                                              else np.inf))
+        for k in keys:
+            worst = max((p for p in parts if k in p.ratios),
+                        key=lambda p: (p.ratios[k] if np.isfinite(p.ratios[k]) else np.inf))
             ratios[k] = worst.ratios[k]
             if k in worst.where:
                 where[k] = worst.where[k]
