@@ -45,7 +45,7 @@ class Turn:
     (5.536, 0.3)
     >>> heading, rate, acc = turn.at([0.0, turn.duration])
     >>> heading.round(6).tolist(), rate.tolist()
-    [0.0, 1.570796], [0.0, 0.0]
+    ([0.0, 1.570796], [0.0, 0.0])
     """
 
     start: float
