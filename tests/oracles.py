@@ -229,3 +229,14 @@ def ipopt_plain(p, w0, options=None):
     return IpoptAnswer(w=np.concatenate(([p.w_start], x_opt, [p.w_end])),
                        success=bool(stats["success"]), status=str(stats["return_status"]),
                        violation_price=float(bought / float(sol["f"])))
+
+
+def ruckig_turn(angle, rate_max, acc_max):
+    """ruckig's time-optimal rest-to-rest rotation by ``angle`` [rad] (no jerk limit)."""
+    otg = Ruckig(1)
+    inp = InputParameter(1)
+    inp.current_position, inp.target_position = [0.0], [abs(angle)]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [rate_max], [acc_max], [np.inf]
+    traj = Trajectory(1)
+    assert otg.calculate(inp, traj) == Result.Working
+    return traj.duration

@@ -349,6 +349,9 @@ class Route:
         ``len(nodes) - 1`` edges, at least the first released.
     order_id, order_update_id, version : optional
         The order's ``orderId``, ``orderUpdateId`` and protocol ``version`` when read from one.
+    notes : tuple of str
+        What of the order the planner does not honour as written, one line per field naming
+        its node or edge and why (:meth:`from_vda5050` also warns them, once per order).
 
     Raises
     ------
@@ -379,6 +382,7 @@ class Route:
     order_id: str | None = None
     order_update_id: int | None = None
     version: str | None = None
+    notes: tuple[str, ...] = ()
     _stops: tuple[tuple[int, str], ...] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -404,6 +408,8 @@ class Route:
                 string(value, name)
         if self.order_update_id is not None:
             integer(self.order_update_id, "order_update_id")
+        object.__setattr__(self, "notes", tuple(string(note, f"notes[{i}]")
+                                                for i, note in enumerate(self.notes)))
         object.__setattr__(self, "_stops", self._find_stops())
 
     def _check_ends(self, i: int, edge: RouteEdge) -> None:
