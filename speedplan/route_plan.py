@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from concurrent.futures import Executor
 from typing import Any
@@ -19,7 +20,7 @@ from .route import THETA_TOLERANCE, Route, RouteProfile
 from .route.profile import RouteTurn
 from .timing.rotation import Turn
 
-__all__ = ["plan_route", "route_jobs", "route_turns"]
+__all__ = ["plan_route", "plan_route_update", "route_jobs", "route_turns"]
 
 #: plan() options that plan_route() sets itself from the route.
 _FROM_ROUTE = ("v0", "a0", "vf", "af", "stops", "spans", "v_limit")
@@ -255,6 +256,141 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
             legs.append(result.profile)
     return RouteProfile(route=route, legs=tuple(legs), leg_starts=tuple(starts),
                         start_s=float(start_s), turns=turns)
+
+
+def plan_route_update(profile: RouteProfile, route: Route, t: float, limits: Limits | None = None,
+                      *, executor: Executor | None = None,
+                      **plan_options: Any) -> RouteProfile:
+    """Plan an order update from where the vehicle is at time ``t`` of the current plan.
+
+    ``route`` is the update (VDA 5050: the same ``orderId``, a larger ``orderUpdateId``), whose
+    first node is a node of the current base — the last node of the old base, with the
+    horizon released and the route extended; an update that repeats nodes the vehicle has
+    passed is joined the same way, provided its geometry passes where the vehicle is. The update
+    is joined to the part of the current route before that node, and planned from the
+    vehicle's state on ``profile`` at ``t``: position, speed, acceleration and heading.
+    The new motion continues the old one (the same position, ``v`` and ``a`` at the switch);
+    its time 0 is ``t`` of the old plan.
+
+    Where the vehicle is already past the start of a corner the update would round on the
+    joining node, it is too late to cut it: the node is then passed as a square corner (the
+    vehicle stops on it and turns).
+
+    Parameters
+    ----------
+    profile : RouteProfile
+        The plan being driven (from :func:`plan_route` or this function).
+    route : Route
+        The order update.
+    t : float
+        When the update takes over [s on ``profile``'s clock], not during a turn on the spot.
+    limits : Limits, optional
+        The vehicle's limits; default those ``profile`` was planned with.
+    executor, **plan_options
+        As for :func:`plan_route`.
+
+    Returns
+    -------
+    RouteProfile
+        Over the joined route, from the vehicle's position (its :attr:`RouteProfile.start_s`).
+
+    Raises
+    ------
+    InvalidInputError
+        Another order, an ``orderUpdateId`` that is not larger, an update that does not start
+        on a node of the current base, a ``t`` during a turn on the spot, or an update whose
+        geometry does not pass the vehicle's position.
+
+    Examples
+    --------
+    A base ``A - B`` (horizon ``B - C``), updated 3 s in with the horizon released: the
+    vehicle no longer stops on B.
+
+    >>> from dataclasses import replace
+    >>> from speedplan import Limits, plan_route
+    >>> from speedplan.geometry import Line, Path
+    >>> from speedplan.route import Route, RouteEdge, RouteNode
+    >>> a, b = RouteNode("A", 0, (0.0, 0.0)), RouteNode("B", 2, (8.0, 0.0))
+    >>> ab = RouteEdge("AB", 1, "A", "B", Path.from_segments([Line(8.0)]))
+    >>> def bc(released):
+    ...     return RouteEdge("BC", 3, "B", "C", Path.from_segments([Line(8.0)], start=(8, 0)),
+    ...                      released=released)
+    >>> c = RouteNode("C", 4, (16.0, 0.0))
+    >>> old = plan_route(Route([a, b, replace(c, released=False)], [ab, bc(False)],
+    ...                        order_id="o", order_update_id=0), Limits(2, 1, 1, 0.5))
+    >>> update = Route([b, c], [bc(True)], order_id="o", order_update_id=1)
+    >>> new = plan_route_update(old, update, 3.0)
+    >>> before, after = old.at(3.0), new.at(0.0)
+    >>> bool(abs(before.s[0] - after.s[0]) < 1e-9 and abs(before.v[0] - after.v[0]) < 1e-6)
+    True
+    >>> len(new.route.stop_s), round(new.route.length, 6)
+    (2, 16.0)
+    """
+    if not isinstance(profile, RouteProfile):
+        raise InvalidInputError(
+            f"`profile` must be a RouteProfile (from plan_route); got {type(profile).__name__}")
+    if not isinstance(route, Route):
+        raise InvalidInputError(f"`route` must be a speedplan.Route; got {type(route).__name__}")
+    old = profile.route
+    if old.order_id is not None and route.order_id is not None \
+            and route.order_id != old.order_id:
+        raise InvalidInputError(
+            f"`route` is order {route.order_id!r}, the plan drives {old.order_id!r}; an order "
+            "update keeps the orderId (plan a new order with plan_route)")
+    if old.order_update_id is not None and route.order_update_id is not None \
+            and not route.order_update_id > old.order_update_id:
+        raise InvalidInputError(
+            f"`route.order_update_id` {route.order_update_id} must be larger than the current "
+            f"plan's {old.order_update_id}")
+    when = as_scalar("t", t, nonnegative=True)
+    for turn, start in zip(profile.turns, profile.turn_times, strict=True):
+        if start < when < start + turn.duration:
+            raise InvalidInputError(
+                f"at `t`={when!r} s the vehicle is turning on the spot on node "
+                f"{old.base_nodes[turn.node].node_id!r} until t={start + turn.duration:.6g} s; "
+                "take the update over before or after the turn")
+    first = route.nodes[0]
+    k = next((k for k, n in enumerate(old.base_nodes)
+              if n.sequence_id == first.sequence_id and n.node_id == first.node_id), None)
+    if k is None:
+        raise InvalidInputError(
+            f"`route` starts on node {first.node_id!r} (sequenceId {first.sequence_id}), which "
+            "is not a node of the current base; an order update starts on one (VDA 5050: the "
+            "last node of the previous base)")
+    state = profile.at(np.array([when]))
+    s_old = float(state.s[0])
+    joined = _joined(old, route, k)
+    if not _same_place(old, joined, s_old):  # too late to round the joining node
+        node = route.nodes[0]
+        square = dataclasses.replace(node, allowed_deviation_xy=0.0, deviation_ellipse=None)
+        joined = _joined(old, dataclasses.replace(route, nodes=(square, *route.nodes[1:])), k)
+        if not _same_place(old, joined, s_old):
+            raise InvalidInputError(
+                f"the update's geometry does not pass the vehicle's position at s={s_old:.6g} m "
+                "of the current route; an update keeps the base the vehicle is on")
+    return plan_route(joined, profile.legs[0].limits if limits is None else limits,
+                      start_s=s_old, v0=max(float(state.v[0]), 0.0), a0=float(state.a[0]),
+                      heading0=float(state.heading[0]), executor=executor, **plan_options)
+
+
+def _joined(old: Route, update: Route, k: int) -> Route:
+    """The current route's nodes and edges before its base node ``k``, then the update."""
+    return Route(old.nodes[:k] + update.nodes, old.edges[:k] + update.edges,
+                 order_id=update.order_id, order_update_id=update.order_update_id,
+                 version=update.version, notes=update.notes)
+
+
+def _same_place(old: Route, new: Route, s: float) -> bool:
+    """Whether both routes put the vehicle at ``s``, and just behind it, on the same points.
+
+    Two points fix position and heading (the heading at a node itself belongs to the edge
+    after it).
+    """
+    if s > new.length:
+        return False
+    at = np.array([max(s - 1e-3, 0.0), s])
+    gap = np.asarray(old.path.point(at)) - np.asarray(new.path.point(at))
+    return bool(np.max(np.hypot(gap[:, 0], gap[:, 1])) <= 1e-6)
 
 
 def _on_leg(exc: SpeedplanError, lo: float, job: dict[str, Any]) -> SpeedplanError:
