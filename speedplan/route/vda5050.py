@@ -10,7 +10,7 @@ edge speed limit [m/s]        ``maxSpeed``                    ``maximumSpeed``
 edge's nodes                  ``startNodeId``, ``endNodeId``  none (implied by the sequence)
                               (required)
 node deviation [m]            ``allowedDeviationXY`` number   ``allowedDeviationXY`` ellipse
-                              (2.0 schema: ``...Xy``)         ``{a, b, theta}``
+                              (``...Xy`` read too)            ``{a, b, theta}``
 ``trajectory``                ``degree``, ``knotVector``,     ``controlPoints`` only;
                               ``controlPoints`` required      ``degree`` 1, uniform clamped
                                                               knots by default
@@ -19,12 +19,21 @@ action ``blockingType``       NONE, SOFT, HARD                NONE, SOFT, SINGLE
 
 Both: header ``version`` (required here: it selects the names above), ``orderId``,
 ``orderUpdateId`` (``headerId``, ``timestamp``, ``manufacturer``, ``serialNumber``: type
-checked when present); nodes ``nodeId``, ``sequenceId``, ``released``, ``nodePosition{x, y,
-theta, mapId}``, ``actions[]{actionType, actionId, blockingType}``; edges ``edgeId``,
-``sequenceId``, ``released``, ``maxRotationSpeed``, ``orientation``, ``orientationType``
-(GLOBAL or TANGENTIAL, default TANGENTIAL), ``trajectory``, ``length``, ``actions``. A field
-of the other version (``maximumSpeed`` in a 2.0 order) is refused rather than ignored. Missing
-``actions`` lists count as empty; other fields are not read.
+checked); nodes ``nodeId``, ``sequenceId``, ``released``, ``nodePosition{x, y, theta,
+allowedDeviationTheta, mapId}``, ``actions[]{actionType, actionId, blockingType}``; edges
+``edgeId``, ``sequenceId``, ``released``, ``maxRotationSpeed``, ``orientation``,
+``orientationType`` (GLOBAL or TANGENTIAL, default TANGENTIAL), ``rotationAllowed``,
+``reachOrientationBeforeEntering``, ``corridor{leftWidth, rightWidth}``, ``trajectory``,
+``length``, ``actions``. A field of the other version (``maximumSpeed`` in a 2.0 order) is
+refused rather than ignored.
+
+Nothing is dropped without a word: every field the planner does not honour as written —
+``direction`` (a line-guided vehicle's branch at a junction, not the driving direction), the
+height fields, ``zoneSetId``, an ``orientation`` at an angle to the path (crabbing), a
+``CONTOUR`` corridor, ``rotationAllowed`` false on an edge whose geometry turns, an unknown
+field name, a field the schema requires but the order lacks (``actions`` lists, header
+fields, ``mapId``; planned without) — is one line of :attr:`Route.notes`, and the reader warns
+them once per order (:class:`OrderWarning`). ``docs/vda5050.md`` lists every field.
 
 What is derived:
 
@@ -33,9 +42,15 @@ What is derived:
 * an edge without one runs straight between its nodes' positions (both needed);
 * ``stop`` on a node or an edge: an action with ``blockingType`` SOFT or HARD (driving not
   allowed while it runs);
-* ``reverse``: ``orientationType`` TANGENTIAL and ``|orientation| > π/2`` (GLOBAL orientations
-  do not tie the vehicle to the path's tangent: not reverse);
-* 3.0 ellipse deviations become their semi-minor axis ``min(a, b)``.
+* ``reverse``: ``orientationType`` TANGENTIAL and ``|orientation| > π/2``, or GLOBAL with an
+  ``orientation`` opposite to a straight edge's direction;
+* a node's deviation bounds how far a rounded corner passes from it: the 2.x radius, or the
+  3.0 ellipse's radius along the corner's bisector (``allowed_deviation_xy`` keeps its
+  semi-minor axis ``min(a, b)``); the edges' corridors bound it too;
+* ``rotationAllowed`` false on either edge, or ``reachOrientationBeforeEntering`` on the next,
+  keeps a corner from being rounded: the vehicle stops on the node and turns there;
+* a node ``theta`` (within ``allowedDeviationTheta``) is met on the node: where the path's
+  heading differs, the vehicle stops and turns to it.
 
 The edge's ``length`` is checked for type only (the geometry gives the length). Consecutive
 node positions must be on the same ``mapId``.
@@ -239,6 +254,10 @@ def _route(doc: Any) -> Route:
     dialect = _dialect(doc)
     notes: list[str] = []
     _unknown(doc, "order", "order", notes)
+    if "zoneSetId" in doc:
+        string(doc["zoneSetId"], "zoneSetId")
+        notes.append("`order.zoneSetId`: the zone set's zones (speed limits among them) are "
+                     "not read; pass them to plan_route as `zones`")
     missing = [key for key in _HEADER if key not in doc]
     if missing:
         notes.append(f"`order`: {', '.join(missing)} missing (the schema requires them); "
