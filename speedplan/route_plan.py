@@ -103,7 +103,8 @@ def route_turns(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float
 
     Each step of :attr:`Route.turn_headings` on a node at or after ``start_s`` is one
     rest-to-rest :class:`~speedplan.timing.rotation.Turn` by the shorter way round, within
-    :meth:`Route.turn_rate_limit` and ``limits.yaw_rate_max`` and ``limits.yaw_acc_max``.
+    :meth:`Route.turn_rate_limit` and ``limits.yaw_rate_max``, ``limits.yaw_acc_max`` and
+    ``limits.yaw_jerk_max``.
     ``heading0`` [rad] replaces the arrival heading where the motion starts.
 
     Examples
@@ -156,7 +157,8 @@ def route_turns(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float
 def _turns(heads: tuple[float, ...], node: int, s: float, rate: float,
            limits: Limits) -> list[RouteTurn]:
     rate = min(rate, limits.yaw_rate_max)
-    return [RouteTurn(node, s, Turn(a, float(wrap_angle(b - a)), rate, limits.yaw_acc_max), rate)
+    return [RouteTurn(node, s, Turn(a, float(wrap_angle(b - a)), rate, limits.yaw_acc_max,
+                                    limits.yaw_jerk_max), rate)
             for a, b in itertools.pairwise(heads)]
 
 
@@ -171,7 +173,8 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     and drives through every other node without slowing more than its limits ask. Where its
     heading must change on a node it turns on the spot (:attr:`Route.turn_headings`): a
     minimum-time rest-to-rest rotation within the edges' ``maxRotationSpeed``,
-    ``limits.yaw_rate_max`` and ``limits.yaw_acc_max``, the shorter way round; the turns'
+    ``limits.yaw_rate_max``, ``limits.yaw_acc_max`` and ``limits.yaw_jerk_max``, the shorter
+    way round; the turns'
     time is part of :attr:`RouteProfile.node_times` (arrival), ``node_leave_times`` and the
     sampled trajectory. Each stop-to-stop leg is one :func:`speedplan.plan` (one
     discrete problem, certified on its own); the legs are independent, so ``executor``

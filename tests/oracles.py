@@ -231,12 +231,12 @@ def ipopt_plain(p, w0, options=None):
                        violation_price=float(bought / float(sol["f"])))
 
 
-def ruckig_turn(angle, rate_max, acc_max):
-    """ruckig's time-optimal rest-to-rest rotation by ``angle`` [rad] (no jerk limit)."""
+def ruckig_turn(angle, rate_max, acc_max, jerk_max=np.inf):
+    """ruckig's time-optimal rest-to-rest rotation by ``angle`` [rad] (default: no jerk limit)."""
     otg = Ruckig(1)
     inp = InputParameter(1)
     inp.current_position, inp.target_position = [0.0], [abs(angle)]
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [rate_max], [acc_max], [np.inf]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [rate_max], [acc_max], [jerk_max]
     traj = Trajectory(1)
     assert otg.calculate(inp, traj) == Result.Working
     return traj.duration

@@ -173,3 +173,50 @@ def test_a_start_heading_off_the_first_edge_turns_before_leaving():
 def test_yaw_acc_max_must_be_positive_and_finite(bad):
     with pytest.raises(InvalidInputError, match="yaw_acc_max"):
         Limits(2, 1, 1, 0.5, yaw_acc_max=bad)
+
+
+@pytest.mark.parametrize(("angle", "rate", "acc", "jerk"), [
+    (math.pi / 2, 0.3, 1.0, np.inf), (math.pi / 2, 0.3, 1.0, 2.0), (0.1, 0.3, 1.0, 2.0),
+    (0.01, 0.3, 1.0, 2.0), (3.0, 1.0, 0.5, 0.3), (3.0, np.inf, 0.5, 0.3),
+    (-2.0, 0.8, 0.5, 5.0), (math.pi, np.inf, 1.0, np.inf),
+])
+def test_turns_take_the_time_optimal_rest_to_rest_time(angle, rate, acc, jerk):
+    turn = Turn(0.3, angle, rate, acc, jerk)
+    assert turn.duration == pytest.approx(ruckig_turn(angle, rate, acc, jerk), rel=1e-9)
+    t = np.linspace(0.0, turn.duration, 40_001)
+    heading, yaw_rate, yaw_acc = turn.at(t)
+    assert heading[0] == 0.3 and heading[-1] == 0.3 + angle and yaw_rate[-1] == 0
+    step = t[1] - t[0]
+    fd_rate = np.diff(heading) / step
+    assert np.max(np.abs(fd_rate)) <= min(rate, 1e300) * (1 + 1e-9)
+    fd_acc = np.diff(fd_rate) / step
+    assert np.max(np.abs(fd_acc)) <= acc * (1 + 1e-6)
+    # The returned rate and acceleration are the heading's derivatives ...
+    np.testing.assert_allclose(fd_rate, 0.5 * (yaw_rate[1:] + yaw_rate[:-1]), atol=acc * step)
+    if np.isfinite(jerk):  # ... and the acceleration changes no faster than the jerk limit
+        np.testing.assert_allclose(np.diff(yaw_rate) / step, 0.5 * (yaw_acc[1:] + yaw_acc[:-1]),
+                                   atol=jerk * step)
+        assert np.max(np.abs(np.diff(yaw_acc) / step)) <= jerk * (1 + 1e-9)
+
+
+def test_a_yaw_jerk_limit_makes_the_turns_s_curves():
+    lim = Limits(2, 1, 1, 0.5, yaw_acc_max=1.0, yaw_jerk_max=0.5)
+    profile = plan_route(Route.from_vda5050(square_corner()), lim)
+    (turn,) = profile.turns
+    assert turn.duration == pytest.approx(ruckig_turn(math.pi / 2, 0.3, 1.0, 0.5), rel=1e-9)
+    assert turn.duration > ruckig_turn(math.pi / 2, 0.3, 1.0)
+    traj = assert_turns_physically(profile, 0.3, 1.0)
+    dt = np.diff(traj.t)
+    rate = np.diff(traj.heading) / dt
+    acc = np.diff(rate) / dt[1:]
+    on = (traj.t[2:-1] > profile.turn_times[0]) & (traj.t[2:-1] < profile.node_leave_times[1])
+    assert np.max(np.abs(np.diff(acc) / dt[2:])[on]) <= 0.5 * (1 + 1e-2)  # 10 ms samples
+    check = profile.verify()
+    assert check.ok and check.ratios["yaw_jerk"] == pytest.approx(1.0, rel=1e-3)
+    assert "yaw_jerk" not in plan_route(Route.from_vda5050(square_corner()), LGV).verify().ratios
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, np.nan])
+def test_yaw_jerk_max_must_be_positive(bad):
+    with pytest.raises(InvalidInputError, match="yaw_jerk_max"):
+        Limits(2, 1, 1, 0.5, yaw_jerk_max=bad)

@@ -52,6 +52,11 @@ class Limits:
         :data:`DEFAULT_YAW_ACC` (1 rad/s²; ``inf`` is refused, no vehicle turns in no time).
         While driving, the yaw acceleration ``d(κ v)/dt`` is bounded through ``j_lat_max``
         and the path's curvature instead.
+    yaw_jerk_max : float, optional
+        Limit on the rate of change of the yaw acceleration in a turn on the spot [rad/s³];
+        ``None`` or ``inf`` for none (the default: the yaw acceleration steps between
+        ``±yaw_acc_max`` and 0). Finite, the turn is an S-curve whose yaw acceleration is
+        continuous.
 
     Notes
     -----
@@ -74,6 +79,7 @@ class Limits:
     j_lat_max: float = field(default=None)  # type: ignore[assignment]
     yaw_rate_max: float = field(default=None)  # type: ignore[assignment]
     yaw_acc_max: float = DEFAULT_YAW_ACC
+    yaw_jerk_max: float = field(default=None)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -84,7 +90,7 @@ class Limits:
         set_(self, "j_max", as_scalar("j_max", self.j_max, positive=True, allow_inf=True))
         decel = self.a_max if self.a_decel is None else self.a_decel
         set_(self, "a_decel", as_scalar("a_decel", decel, positive=True))
-        for name in ("j_lat_max", "yaw_rate_max"):  # None: no limit, stored as inf
+        for name in ("j_lat_max", "yaw_rate_max", "yaw_jerk_max"):  # None: no limit, inf
             value = getattr(self, name)
             set_(self, name, np.inf if value is None else as_scalar(name, value, positive=True,
                                                                      allow_inf=True))
@@ -107,7 +113,7 @@ class Limits:
         `v_max`=1e+300 is outside [1e-09, 1e+09]
         """
         for name in ("v_max", "a_max", "a_lat_max", "j_max", "a_decel", "j_lat_max",
-                     "yaw_rate_max", "yaw_acc_max"):
+                     "yaw_rate_max", "yaw_acc_max", "yaw_jerk_max"):
             value = getattr(self, name)
             if np.isfinite(value) and not LIMIT_RANGE[0] <= value <= LIMIT_RANGE[1]:
                 raise InvalidInputError(

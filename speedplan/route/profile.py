@@ -236,8 +236,9 @@ class RouteProfile:
         """The legs' checks of the continuous trajectory against every limit, and the turns'.
 
         Each turn on the spot is checked for its yaw rate (against
-        :attr:`RouteTurn.rate_limit`) and yaw acceleration (``"yaw_acc"``, against
-        ``Limits.yaw_acc_max``), sampled at :data:`TURN_SAMPLES` times.
+        :attr:`RouteTurn.rate_limit`), yaw acceleration (``"yaw_acc"``, against
+        ``Limits.yaw_acc_max``) and, with a ``Limits.yaw_jerk_max``, yaw jerk (``"yaw_jerk"``),
+        sampled at :data:`TURN_SAMPLES` times and the ends of its pieces.
         """
         return Verification.merged([leg.verify() for leg in self.legs] + self._turn_checks())
 
@@ -248,19 +249,34 @@ class RouteProfile:
                                    + self._turn_checks())
 
     def _turn_checks(self) -> list[Verification]:
-        """One :class:`Verification` per turn: its yaw rate and yaw acceleration, sampled."""
+        """One :class:`Verification` per turn: its yaw rate, acceleration and jerk.
+
+        Rate and acceleration sampled (the ends of every piece included), the jerk from
+        differences of the sampled acceleration.
+        """
         out = []
-        acc_max = self.legs[0].limits.yaw_acc_max
+        limits = self.legs[0].limits
         for turn in self.turns:
-            t = np.linspace(0.0, turn.duration, TURN_SAMPLES)
+            t0 = turn.turn.breaks
+            t = np.unique(np.concatenate((np.linspace(0.0, turn.duration, TURN_SAMPLES), t0,
+                                          np.nextafter(t0, np.inf))))
+            t = t[t <= turn.duration]
             _, rate, acc = turn.turn.at(t)
             peak_rate, peak_acc = float(np.max(np.abs(rate))), float(np.max(np.abs(acc)))
             maxima = dict.fromkeys(LIMIT_NAMES, 0.0)
             ratios = dict.fromkeys(LIMIT_NAMES, 0.0)
-            maxima["yaw_rate"], maxima["yaw_acc"] = peak_rate, peak_acc
+            maxima.update(yaw_rate=peak_rate, yaw_acc=peak_acc)
             if np.isfinite(turn.rate_limit):
                 ratios["yaw_rate"] = peak_rate / turn.rate_limit
-            ratios["yaw_acc"] = peak_acc / acc_max
+            ratios["yaw_acc"] = peak_acc / limits.yaw_acc_max
+            if np.isfinite(limits.yaw_jerk_max):  # without a limit the acceleration steps
+                step = np.diff(t)
+                wide = step > 1e-9
+                jerk = float(np.max(np.abs(np.diff(acc)[wide] / step[wide]), initial=0.0))
+                maxima["yaw_jerk"] = jerk
+                ratios["yaw_jerk"] = jerk / limits.yaw_jerk_max
+            else:
+                del maxima["yaw_jerk"], ratios["yaw_jerk"]
             out.append(Verification(maxima=maxima, ratios=ratios,
                                     where=dict.fromkeys(ratios, turn.s)))
         return out

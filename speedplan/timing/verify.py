@@ -41,6 +41,7 @@ TOLERANCES: dict[str, float] = {
     "yaw_rate": 0.001,
     "lateral_jerk": 0.05,
     "yaw_acc": 0.001,
+    "yaw_jerk": 0.001,
 }
 #: Every checked limit, in report order.
 LIMIT_NAMES = tuple(TOLERANCES)
@@ -60,7 +61,7 @@ class Verification:
         Each maximum divided by its limit (``"speed"`` against the local bound
         ``sqrt(mu+(s))``, which includes ``v_max``, lateral limits and zones); limits that are
         ``inf`` give 0. A ratio above ``1 + TOLERANCES[name]`` is a violation.
-        ``"yaw_acc"`` [rad/s²], the yaw acceleration of turns on the spot, appears in the
+        ``"yaw_acc"`` [rad/s²] and ``"yaw_jerk"`` [rad/s³] of turns on the spot appear in the
         checks of routes that turn (:meth:`speedplan.RouteProfile.verify`).
     where : dict
         Arc length [m] at which each ratio is largest.
