@@ -432,7 +432,7 @@ class Route:
     def _find_stops(self) -> tuple[tuple[int, str], ...]:
         """``(base node index, reason)`` of every stop, in order along the base."""
         edges, nodes = self.base_edges, self.base_nodes
-        stops = [(0, "start")]
+        stops = [(0, "; ".join(filter(None, ("start", self._turn_reason(0)))))]
         for i in range(1, len(edges)):
             node, before, after = nodes[i], edges[i - 1], edges[i]
             reasons = []
@@ -445,16 +445,25 @@ class Route:
             if _join_at_node(before, node, after):
                 turn = _heading_change(before.path, after.path)
                 reasons.append(f"the heading changes by {turn:.3g} rad")
-            elif len(self.turn_headings[i]) > 1:
-                heads = self.turn_headings[i]
-                why = (f"to theta = {node.theta:.6g} rad" if node.theta is not None
-                       and abs(float(wrap_angle(node.theta - heads[1]))) <= node.theta_tolerance
-                       else f"by {float(wrap_angle(heads[-1] - heads[0])):.3g} rad")
-                reasons.append(f"the vehicle turns on the spot {why}")
+            elif (why := self._turn_reason(i)) is not None:
+                reasons.append(why)
             if reasons:
                 stops.append((i, "; ".join(reasons)))
-        stops.append((len(edges), "end of the released base"))
+        end = len(edges)
+        stops.append((end, "; ".join(filter(None, ("end of the released base",
+                                                   self._turn_reason(end))))))
         return tuple(stops)
+
+    def _turn_reason(self, k: int) -> str | None:
+        """Why the vehicle turns on the spot on released node ``k`` (``None``: it does not)."""
+        heads, node = self.turn_headings[k], self.base_nodes[k]
+        if len(heads) < 2:
+            return None
+        if node.theta is not None and any(
+                abs(float(wrap_angle(node.theta - h))) <= node.theta_tolerance
+                for h in heads[1:]):
+            return f"the vehicle turns on the spot to theta = {node.theta:.6g} rad"
+        return f"the vehicle turns on the spot by {float(wrap_angle(heads[-1] - heads[0])):.3g} rad"
 
     @cached_property
     def _round_set(self) -> frozenset[int]:
