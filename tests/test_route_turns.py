@@ -220,3 +220,18 @@ def test_a_yaw_jerk_limit_makes_the_turns_s_curves():
 def test_yaw_jerk_max_must_be_positive(bad):
     with pytest.raises(InvalidInputError, match="yaw_jerk_max"):
         Limits(2, 1, 1, 0.5, yaw_jerk_max=bad)
+
+
+def test_standing_between_nodes_off_the_path_the_vehicle_turns_onto_it_first():
+    route = Route.from_vda5050(square_corner())
+    profile = plan_route(route, LGV, start_s=4.0, heading0=0.5)
+    first = profile.turns[0]
+    assert first.node == -1 and first.s == 4.0 and first.turn.angle == pytest.approx(-0.5)
+    arrive = profile.node_times
+    assert np.isnan(arrive[0])
+    assert arrive[1] == pytest.approx(first.duration + ruckig_duration(6.0, LGV), rel=1e-3)
+    assert arrive[2] == pytest.approx(profile.node_leave_times[1] + ruckig_duration(10.0, LGV),
+                                      rel=1e-3)
+    assert_turns_physically(profile, 0.3, DEFAULT_YAW_ACC)
+    with pytest.raises(InvalidInputError, match="heading0"):
+        plan_route(route, LGV, start_s=4.0, v0=0.5, heading0=0.5)

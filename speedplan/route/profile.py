@@ -32,7 +32,8 @@ class RouteTurn:
     Attributes
     ----------
     node : int
-        Index of the node in ``route.base_nodes``.
+        Index of the node in ``route.base_nodes``; -1 for a turn where the motion starts
+        between two nodes (``plan_route(..., heading0=...)`` with the vehicle standing).
     s : float
         Its position along the route [m].
     turn : Turn
@@ -177,7 +178,8 @@ class RouteProfile:
         leave = arrive.copy()
         at_node: dict[int, list[int]] = {}
         for i, turn in enumerate(self.turns):
-            at_node.setdefault(turn.node, []).append(i)
+            if turn.node >= 0:  # -1: a turn where the motion starts between two nodes
+                at_node.setdefault(turn.node, []).append(i)
         for k, idx in at_node.items():
             arrive[k] = min(self.turn_times[i] for i in idx)
             leave[k] = max(self.turn_times[i] + self.turns[i].duration for i in idx)
