@@ -141,9 +141,9 @@ def test_a_node_theta_rounds_the_corner_only_if_the_corner_meets_it(theta, round
         heading = float(route.path.heading(route.node_s[1]))
         assert heading == pytest.approx(theta, abs=1e-3)
     else:
-        # The vehicle stops, turns to theta, then to the next edge.
+        # The vehicle stops on n1; arriving at theta 0, it turns once, to the next edge.
         angles = [t.turn.angle for t in plan_route(route, LGV).turns]
-        assert angles == pytest.approx([math.pi / 2]) if theta == 0.0 else True
+        assert angles == pytest.approx([math.pi / 2])
 
 
 def test_a_global_orientation_against_a_straight_edge_drives_it_backwards():
