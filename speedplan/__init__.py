@@ -20,7 +20,7 @@ from .core import (
 from .geometry import Path, SpanLimit, SpeedZone, speed_bounds
 from .plan import plan
 from .route import Route, RouteProfile
-from .route_plan import plan_route
+from .route_plan import plan_route, plan_route_update
 from .solve import DiscreteProblem, DiscreteSolution, solve_discrete
 from .timing import SpeedProfile, Trajectory, Verification
 from .waypoints import profile_from_waypoints
@@ -48,6 +48,7 @@ __all__ = [
     "plan",
     "plan_many",
     "plan_route",
+    "plan_route_update",
     "profile_from_waypoints",
     "solve_discrete",
     "speed_bounds",

@@ -2,18 +2,25 @@
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 from concurrent.futures import Executor
 from typing import Any
+
+import numpy as np
 
 from .batch import plan_many
 from .core.checks import as_scalar
 from .core.errors import InfeasibleError, InvalidInputError, SolverError, SpeedplanError
 from .core.limits import Limits
 from .geometry import SpanLimit
+from .geometry._checks import wrap_angle
 from .plan import plan
-from .route import Route, RouteProfile
+from .route import THETA_TOLERANCE, Route, RouteProfile
+from .route.profile import RouteTurn
+from .timing.rotation import Turn
 
-__all__ = ["plan_route", "route_jobs"]
+__all__ = ["plan_route", "plan_route_update", "route_jobs", "route_turns"]
 
 #: plan() options that plan_route() sets itself from the route.
 _FROM_ROUTE = ("v0", "a0", "vf", "af", "stops", "spans", "v_limit")
@@ -90,15 +97,86 @@ def _edge_spans(route: Route, lo: float, hi: float) -> list[SpanLimit]:
     return out
 
 
+def route_turns(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
+                heading0: float | None = None) -> tuple[RouteTurn, ...]:
+    """The turns on the spot of a route from ``start_s`` on (see :func:`plan_route`).
+
+    Each step of :attr:`Route.turn_headings` on a node at or after ``start_s`` is one
+    rest-to-rest :class:`~speedplan.timing.rotation.Turn` by the shorter way round, within
+    :meth:`Route.turn_rate_limit` and ``limits.yaw_rate_max``, ``limits.yaw_acc_max`` and
+    ``limits.yaw_jerk_max``.
+    ``heading0`` [rad] replaces the arrival heading where the motion starts.
+
+    Examples
+    --------
+    A corner that may not be cut (no allowed deviation) at (10, 0), 0.3 rad/s on both edges:
+
+    >>> import numpy as np
+    >>> from speedplan import Limits
+    >>> from speedplan.geometry import Line, Path
+    >>> from speedplan.route import Route, RouteEdge, RouteNode
+    >>> nodes = [RouteNode("n0", 0, (0.0, 0.0)), RouteNode("n1", 2, (10.0, 0.0)),
+    ...          RouteNode("n2", 4, (10.0, 10.0))]
+    >>> edges = [RouteEdge("e0", 1, "n0", "n1", Path.from_segments([Line(10.0)]),
+    ...                    yaw_rate_max=0.3),
+    ...          RouteEdge("e1", 3, "n1", "n2", Path.from_segments(
+    ...              [Line(10.0)], start=(10, 0), heading=np.pi / 2), yaw_rate_max=0.3)]
+    >>> [(t.node, round(t.turn.angle, 6), round(t.duration, 3))
+    ...  for t in route_turns(Route(nodes, edges), Limits(2, 1, 1, 0.5))]
+    [(1, 1.570796, 5.536)]
+    """
+    start = float(start_s)
+    tol = 1e-9 * max(route.length, 1.0)
+    out: list[RouteTurn] = []
+    at_node = False
+    for k, heads in enumerate(route.turn_headings):
+        s = float(route.node_s[k])
+        if s < start - tol:
+            continue
+        here = abs(s - start) <= tol
+        at_node = at_node or here
+        if here and heading0 is not None and heads:
+            heads = route.node_headings(k, float(heading0))
+        out += _turns(heads, k, s, route.turn_rate_limit(k), limits)
+    if heading0 is not None and not at_node:  # between nodes: the vehicle faces the path
+        on_path = float(route.path.heading(start_s))
+        off = abs(float(wrap_angle(on_path - heading0)))
+        if off > THETA_TOLERANCE:
+            if v0 > 0:
+                raise InvalidInputError(
+                    f"`heading0`={heading0!r} rad is {off:.3g} rad off the path's heading "
+                    f"{on_path:.6g} rad at `start_s`={start_s!r} m; a vehicle moving along the "
+                    "path faces its tangent (or the opposite on an edge driven backwards)")
+            edge = route.base_edges[int(np.clip(np.searchsorted(route.node_s, start_s) - 1,
+                                                0, len(route.base_edges) - 1))]
+            rate = np.inf if edge.yaw_rate_max is None else edge.yaw_rate_max
+            out = _turns((float(heading0), on_path), -1, float(start_s), rate, limits) + out
+    return tuple(out)
+
+
+def _turns(heads: tuple[float, ...], node: int, s: float, rate: float,
+           limits: Limits) -> list[RouteTurn]:
+    rate = min(rate, limits.yaw_rate_max)
+    return [RouteTurn(node, s, Turn(a, float(wrap_angle(b - a)), rate, limits.yaw_acc_max,
+                                    limits.yaw_jerk_max), rate)
+            for a, b in itertools.pairwise(heads)]
+
+
 def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
-               a0: float = 0.0, executor: Executor | None = None,
-               **plan_options: Any) -> RouteProfile:
+               a0: float = 0.0, heading0: float | None = None,
+               executor: Executor | None = None, **plan_options: Any) -> RouteProfile:
     """Plan the minimum-time motion along a route's released base.
 
     The vehicle stops (v = 0, a = 0) at every :attr:`Route.stop_s` — the nodes with a
-    blocking action, changes of driving direction, heading jumps it cannot round — and at
-    the end of the released base, and drives through every other node without slowing
-    more than its limits ask. Each stop-to-stop leg is one :func:`speedplan.plan` (one
+    blocking action, changes of driving direction, heading jumps it cannot round, node
+    orientations (``theta``) the path does not meet — and at the end of the released base,
+    and drives through every other node without slowing more than its limits ask. Where its
+    heading must change on a node it turns on the spot (:attr:`Route.turn_headings`): a
+    minimum-time rest-to-rest rotation within the edges' ``maxRotationSpeed``,
+    ``limits.yaw_rate_max``, ``limits.yaw_acc_max`` and ``limits.yaw_jerk_max``, the shorter
+    way round; the turns'
+    time is part of :attr:`RouteProfile.node_times` (arrival), ``node_leave_times`` and the
+    sampled trajectory. Each stop-to-stop leg is one :func:`speedplan.plan` (one
     discrete problem, certified on its own); the legs are independent, so ``executor``
     can plan them in parallel (:func:`speedplan.plan_many`).
 
@@ -114,6 +192,11 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
         the new plan continues from there); default the start.
     v0, a0 : float
         Its speed [m/s] and acceleration [m/s²] there.
+    heading0 : float, optional
+        Its heading [rad] there. Default: on the first node its ``theta`` (else the first
+        edge's heading), elsewhere the route's. Standing on a node, the vehicle turns from it
+        to the node's ``theta`` and the next edge's heading; between nodes it must face the
+        path (or stand, ``v0 = 0``, and turn onto it).
     executor : concurrent.futures.Executor, optional
         Plan the legs on it (``plan_many``); default: one after the other in this process.
     **plan_options
@@ -153,6 +236,9 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     ([0.0, 14.828], 'optimal')
     """
     jobs, starts = route_jobs(route, limits, start_s=start_s, v0=v0, a0=a0, **plan_options)
+    if heading0 is not None:
+        heading0 = as_scalar("heading0", heading0)
+    turns = route_turns(route, limits, start_s=start_s, v0=v0, heading0=heading0)
     if executor is None:
         legs = []
         for job, lo in zip(jobs, starts, strict=True):
@@ -172,7 +258,142 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
             assert result.profile is not None
             legs.append(result.profile)
     return RouteProfile(route=route, legs=tuple(legs), leg_starts=tuple(starts),
-                        start_s=float(start_s))
+                        start_s=float(start_s), turns=turns)
+
+
+def plan_route_update(profile: RouteProfile, route: Route, t: float, limits: Limits | None = None,
+                      *, executor: Executor | None = None,
+                      **plan_options: Any) -> RouteProfile:
+    """Plan an order update from where the vehicle is at time ``t`` of the current plan.
+
+    ``route`` is the update (VDA 5050: the same ``orderId``, a larger ``orderUpdateId``), whose
+    first node is a node of the current base — the last node of the old base, with the
+    horizon released and the route extended; an update that repeats nodes the vehicle has
+    passed is joined the same way, provided its geometry passes where the vehicle is. The update
+    is joined to the part of the current route before that node, and planned from the
+    vehicle's state on ``profile`` at ``t``: position, speed, acceleration and heading.
+    The new motion continues the old one (the same position, ``v`` and ``a`` at the switch);
+    its time 0 is ``t`` of the old plan.
+
+    Where the vehicle is already past the start of a corner the update would round on the
+    joining node, it is too late to cut it: the node is then passed as a square corner (the
+    vehicle stops on it and turns).
+
+    Parameters
+    ----------
+    profile : RouteProfile
+        The plan being driven (from :func:`plan_route` or this function).
+    route : Route
+        The order update.
+    t : float
+        When the update takes over [s on ``profile``'s clock], not during a turn on the spot.
+    limits : Limits, optional
+        The vehicle's limits; default those ``profile`` was planned with.
+    executor, **plan_options
+        As for :func:`plan_route`.
+
+    Returns
+    -------
+    RouteProfile
+        Over the joined route, from the vehicle's position (its :attr:`RouteProfile.start_s`).
+
+    Raises
+    ------
+    InvalidInputError
+        Another order, an ``orderUpdateId`` that is not larger, an update that does not start
+        on a node of the current base, a ``t`` during a turn on the spot, or an update whose
+        geometry does not pass the vehicle's position.
+
+    Examples
+    --------
+    A base ``A - B`` (horizon ``B - C``), updated 3 s in with the horizon released: the
+    vehicle no longer stops on B.
+
+    >>> from dataclasses import replace
+    >>> from speedplan import Limits, plan_route
+    >>> from speedplan.geometry import Line, Path
+    >>> from speedplan.route import Route, RouteEdge, RouteNode
+    >>> a, b = RouteNode("A", 0, (0.0, 0.0)), RouteNode("B", 2, (8.0, 0.0))
+    >>> ab = RouteEdge("AB", 1, "A", "B", Path.from_segments([Line(8.0)]))
+    >>> def bc(released):
+    ...     return RouteEdge("BC", 3, "B", "C", Path.from_segments([Line(8.0)], start=(8, 0)),
+    ...                      released=released)
+    >>> c = RouteNode("C", 4, (16.0, 0.0))
+    >>> old = plan_route(Route([a, b, replace(c, released=False)], [ab, bc(False)],
+    ...                        order_id="o", order_update_id=0), Limits(2, 1, 1, 0.5))
+    >>> update = Route([b, c], [bc(True)], order_id="o", order_update_id=1)
+    >>> new = plan_route_update(old, update, 3.0)
+    >>> before, after = old.at(3.0), new.at(0.0)
+    >>> bool(abs(before.s[0] - after.s[0]) < 1e-9 and abs(before.v[0] - after.v[0]) < 1e-6)
+    True
+    >>> len(new.route.stop_s), round(new.route.length, 6)
+    (2, 16.0)
+    """
+    if not isinstance(profile, RouteProfile):
+        raise InvalidInputError(
+            f"`profile` must be a RouteProfile (from plan_route); got {type(profile).__name__}")
+    if not isinstance(route, Route):
+        raise InvalidInputError(f"`route` must be a speedplan.Route; got {type(route).__name__}")
+    old = profile.route
+    if old.order_id is not None and route.order_id is not None \
+            and route.order_id != old.order_id:
+        raise InvalidInputError(
+            f"`route` is order {route.order_id!r}, the plan drives {old.order_id!r}; an order "
+            "update keeps the orderId (plan a new order with plan_route)")
+    if old.order_update_id is not None and route.order_update_id is not None \
+            and not route.order_update_id > old.order_update_id:
+        raise InvalidInputError(
+            f"`route.order_update_id` {route.order_update_id} must be larger than the current "
+            f"plan's {old.order_update_id}")
+    when = as_scalar("t", t, nonnegative=True)
+    for turn, start in zip(profile.turns, profile.turn_times, strict=True):
+        if start < when < start + turn.duration:
+            raise InvalidInputError(
+                f"at `t`={when!r} s the vehicle is turning on the spot on node "
+                f"{old.base_nodes[turn.node].node_id!r} until t={start + turn.duration:.6g} s; "
+                "take the update over before or after the turn")
+    first = route.nodes[0]
+    k = next((k for k, n in enumerate(old.base_nodes)
+              if n.sequence_id == first.sequence_id and n.node_id == first.node_id), None)
+    if k is None:
+        raise InvalidInputError(
+            f"`route` starts on node {first.node_id!r} (sequenceId {first.sequence_id}), which "
+            "is not a node of the current base; an order update starts on one (VDA 5050: the "
+            "last node of the previous base)")
+    state = profile.at(np.array([when]))
+    s_old = float(state.s[0])
+    joined = _joined(old, route, k)
+    if not _same_place(old, joined, s_old):  # too late to round the joining node
+        node = route.nodes[0]
+        square = dataclasses.replace(node, allowed_deviation_xy=0.0, deviation_ellipse=None)
+        joined = _joined(old, dataclasses.replace(route, nodes=(square, *route.nodes[1:])), k)
+        if not _same_place(old, joined, s_old):
+            raise InvalidInputError(
+                f"the update's geometry does not pass the vehicle's position at s={s_old:.6g} m "
+                "of the current route; an update keeps the base the vehicle is on")
+    return plan_route(joined, profile.legs[0].limits if limits is None else limits,
+                      start_s=s_old, v0=max(float(state.v[0]), 0.0), a0=float(state.a[0]),
+                      heading0=float(state.heading[0]), executor=executor, **plan_options)
+
+
+def _joined(old: Route, update: Route, k: int) -> Route:
+    """The current route's nodes and edges before its base node ``k``, then the update."""
+    return Route(old.nodes[:k] + update.nodes, old.edges[:k] + update.edges,
+                 order_id=update.order_id, order_update_id=update.order_update_id,
+                 version=update.version, notes=update.notes)
+
+
+def _same_place(old: Route, new: Route, s: float) -> bool:
+    """Whether both routes put the vehicle at ``s``, and just behind it, on the same points.
+
+    Two points fix position and heading (the heading at a node itself belongs to the edge
+    after it).
+    """
+    if s > new.length:
+        return False
+    at = np.array([max(s - 1e-3, 0.0), s])
+    gap = np.asarray(old.path.point(at)) - np.asarray(new.path.point(at))
+    return bool(np.max(np.hypot(gap[:, 0], gap[:, 1])) <= 1e-6)
 
 
 def _on_leg(exc: SpeedplanError, lo: float, job: dict[str, Any]) -> SpeedplanError:

@@ -249,3 +249,12 @@ def corner_reversals(traj, j_max, threshold=0.25):
         signs = np.sign(j[np.abs(j) >= threshold * j_max])
         counts.append(int(np.count_nonzero(np.diff(signs))))
     return counts
+def ruckig_turn(angle, rate_max, acc_max, jerk_max=np.inf):
+    """ruckig's time-optimal rest-to-rest rotation by ``angle`` [rad] (default: no jerk limit)."""
+    otg = Ruckig(1)
+    inp = InputParameter(1)
+    inp.current_position, inp.target_position = [0.0], [abs(angle)]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [rate_max], [acc_max], [jerk_max]
+    traj = Trajectory(1)
+    assert otg.calculate(inp, traj) == Result.Working
+    return traj.duration

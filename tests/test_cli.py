@@ -92,7 +92,7 @@ def test_json_output_carries_the_metadata(root, tmp_path):
     assert meta["dt"] == 0.02
     assert meta["limits"] == {"v_max": 2.0, "a_max": 1.0, "a_lat_max": 1.0, "j_max": 0.5,
                               "a_decel": 0.8, "j_lat_max": None, "yaw_rate_max": None,
-                              "grip": "independent"}
+                              "yaw_acc_max": 1.0, "yaw_jerk_max": None, "grip": "independent"}
     t = np.array(doc["columns"]["t"])
     assert meta["duration"] == pytest.approx(t[-1], abs=1e-12)
     assert 0 <= meta["gap"] < 1e-6 and meta["lower_bound"] <= meta["objective"]

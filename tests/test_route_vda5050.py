@@ -233,7 +233,9 @@ def test_blocking_edge_action_stops_at_the_edges_start_node():
     ({}, False), ({"orientation": 0.0}, False), ({"orientation": math.pi / 2}, False),
     ({"orientation": math.pi}, True), ({"orientation": -2.0}, True),
     ({"orientation": math.pi, "orientationType": "TANGENTIAL"}, True),
-    ({"orientation": math.pi, "orientationType": "GLOBAL"}, False),
+    # GLOBAL: the map heading; on this edge along +x, π faces against the travel direction.
+    ({"orientation": math.pi, "orientationType": "GLOBAL"}, True),
+    ({"orientation": 0.0, "orientationType": "GLOBAL"}, False),
 ])
 def test_edge_orientation_gives_the_driving_direction(fields, reverse):
     doc = straight_order()

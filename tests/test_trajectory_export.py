@@ -75,7 +75,8 @@ def test_csv_metadata_lines_before_the_header(loop_traj):
     assert float(meta["duration"]) == 1.5
     assert json.loads(meta["limits"]) == {"v_max": 2.0, "a_max": 1.0, "a_lat_max": 1.0,
                                           "j_max": 0.5, "a_decel": 1.0, "j_lat_max": None,
-                                          "yaw_rate_max": None, "grip": "independent"}
+                                          "yaw_rate_max": None, "yaw_acc_max": 1.0,
+                                          "yaw_jerk_max": None, "grip": "independent"}
     assert meta["speedplan_version"] == sp.__version__
     assert meta["heading_range"] == "[-pi, pi)"
 

@@ -9,7 +9,7 @@ import numpy as np
 from .checks import as_scalar, choice
 from .errors import InvalidInputError
 
-__all__ = ["GRIP_MODELS", "LIMIT_RANGE", "Limits"]
+__all__ = ["DEFAULT_YAW_ACC", "GRIP_MODELS", "LIMIT_RANGE", "Limits"]
 
 #: How the tangential and the lateral acceleration share the tyres' (or wheels') grip:
 #: ``"independent"``, each within its own limit; ``"ellipse"``, the friction ellipse
@@ -21,6 +21,12 @@ GRIP_MODELS = ("independent", "ellipse")
 #: nanometres per second to far beyond any vehicle. Outside it, the model's closed forms
 #: (``v³ / j²`` and the like) overflow or underflow in double precision.
 LIMIT_RANGE = (1e-9, 1e9)
+
+#: Default yaw-acceleration limit [rad/s²] of a vehicle turning on the spot: a quarter turn
+#: takes at least ``2 sqrt((π/2) / 1) = 2.5`` s, within what differential-drive and
+#: omnidirectional AGVs/AMRs commonly reach (wheel accelerations of ``α b / 2`` for a track
+#: width ``b`` of about 1 m). Pass the vehicle's own value for real plans.
+DEFAULT_YAW_ACC = 1.0
 
 
 @dataclass(frozen=True)
@@ -44,7 +50,19 @@ class Limits:
         ``None`` or ``inf`` for none (the default). Finite only on curvature-continuous (G2)
         paths: where the curvature jumps the vehicle has to stop.
     yaw_rate_max : float, optional
-        Yaw-rate limit ``|κ| v`` [rad/s]; ``None`` or ``inf`` for none (the default).
+        Yaw-rate limit ``|κ| v`` [rad/s]; ``None`` or ``inf`` for none (the default). It also
+        bounds the yaw rate of a turn on the spot (see :func:`speedplan.plan_route`).
+    yaw_acc_max : float, optional
+        Yaw-acceleration limit of a turn on the spot [rad/s²], where a route makes the vehicle
+        stop and rotate (a corner it may not cut, a node orientation): > 0, default
+        :data:`DEFAULT_YAW_ACC` (1 rad/s²; ``inf`` is refused, no vehicle turns in no time).
+        While driving, the yaw acceleration ``d(κ v)/dt`` is bounded through ``j_lat_max``
+        and the path's curvature instead.
+    yaw_jerk_max : float, optional
+        Limit on the rate of change of the yaw acceleration in a turn on the spot [rad/s³];
+        ``None`` or ``inf`` for none (the default: the yaw acceleration steps between
+        ``±yaw_acc_max`` and 0). Finite, the turn is an S-curve whose yaw acceleration is
+        continuous.
     grip : {"independent", "ellipse"}
         ``"independent"`` (default): the tangential and the lateral acceleration each within
         its own limit. ``"ellipse"``: they share one friction ellipse,
@@ -73,6 +91,8 @@ class Limits:
     a_decel: float = field(default=None)  # type: ignore[assignment]
     j_lat_max: float = field(default=None)  # type: ignore[assignment]
     yaw_rate_max: float = field(default=None)  # type: ignore[assignment]
+    yaw_acc_max: float = DEFAULT_YAW_ACC
+    yaw_jerk_max: float = field(default=None)  # type: ignore[assignment]
     grip: str = "independent"
 
     def __post_init__(self) -> None:
@@ -84,10 +104,11 @@ class Limits:
         set_(self, "j_max", as_scalar("j_max", self.j_max, positive=True, allow_inf=True))
         decel = self.a_max if self.a_decel is None else self.a_decel
         set_(self, "a_decel", as_scalar("a_decel", decel, positive=True))
-        for name in ("j_lat_max", "yaw_rate_max"):  # None: no limit, stored as inf
+        for name in ("j_lat_max", "yaw_rate_max", "yaw_jerk_max"):  # None: no limit, inf
             value = getattr(self, name)
             set_(self, name, np.inf if value is None else as_scalar(name, value, positive=True,
                                                                      allow_inf=True))
+        set_(self, "yaw_acc_max", as_scalar("yaw_acc_max", self.yaw_acc_max, positive=True))
         choice("grip", self.grip, GRIP_MODELS)
         if self.grip == "ellipse" and not np.isfinite(self.a_lat_max):
             raise InvalidInputError(
@@ -116,7 +137,7 @@ class Limits:
         `v_max`=1e+300 is outside [1e-09, 1e+09]
         """
         for name in ("v_max", "a_max", "a_lat_max", "j_max", "a_decel", "j_lat_max",
-                     "yaw_rate_max"):
+                     "yaw_rate_max", "yaw_acc_max", "yaw_jerk_max"):
             value = getattr(self, name)
             if np.isfinite(value) and not LIMIT_RANGE[0] <= value <= LIMIT_RANGE[1]:
                 raise InvalidInputError(

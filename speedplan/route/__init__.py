@@ -3,7 +3,8 @@
 * :mod:`~speedplan.route.route` — :class:`Route`, :class:`RouteNode`, :class:`RouteEdge`: the
   released base's length, node positions ``node_s``, edge spans, stops and stop-to-stop legs;
 * :mod:`~speedplan.route.profile` — :class:`RouteProfile` (what :func:`speedplan.plan_route`
-  returns: the legs' profiles stitched, node times) and :class:`RouteTrajectory`;
+  returns: the legs' profiles and the turns on the spot between them, stitched; node arrival
+  and leave times), :class:`RouteTurn` and :class:`RouteTrajectory`;
 * :mod:`~speedplan.route.vda5050` — reading VDA 5050 2.0, 2.1 and 3.0 orders
   (:meth:`Route.from_vda5050`), trajectories included.
 
@@ -11,8 +12,8 @@ This layer sits between ``timing`` and the top level; it imports ``core``, ``geo
 ``timing``.
 """
 
-from .profile import RouteProfile, RouteTrajectory
-from .route import HEADING_TOLERANCE, Route, RouteEdge, RouteNode
+from .profile import RouteProfile, RouteTrajectory, RouteTurn
+from .route import HEADING_TOLERANCE, THETA_TOLERANCE, Route, RouteEdge, RouteNode
 
-__all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode", "RouteProfile",
-           "RouteTrajectory"]
+__all__ = ["HEADING_TOLERANCE", "THETA_TOLERANCE", "Route", "RouteEdge", "RouteNode",
+           "RouteProfile", "RouteTrajectory", "RouteTurn"]

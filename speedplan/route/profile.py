@@ -13,10 +13,46 @@ from ..core.checks import FloatArray, as_array
 from ..core.errors import InvalidInputError
 from ..timing import SpeedProfile, Trajectory, Verification
 from ..timing.profile import sample_times
+from ..timing.rotation import Turn
 from ..timing.trajectory import COLUMNS
+from ..timing.verify import LIMIT_NAMES
 from .route import Route
 
-__all__ = ["RouteProfile", "RouteTrajectory"]
+__all__ = ["RouteProfile", "RouteTrajectory", "RouteTurn"]
+
+#: Samples per turn where :meth:`RouteProfile.verify` evaluates its yaw rate and acceleration
+#: (the ends of the speed-up and slow-down included).
+TURN_SAMPLES = 64
+
+
+@dataclass(frozen=True)
+class RouteTurn:
+    """A turn on the spot on a released node of a route (the vehicle stands, v = 0).
+
+    Attributes
+    ----------
+    node : int
+        Index of the node in ``route.base_nodes``; -1 for a turn where the motion starts
+        between two nodes (``plan_route(..., heading0=...)`` with the vehicle standing).
+    s : float
+        Its position along the route [m].
+    turn : Turn
+        The rotation (:class:`~speedplan.timing.rotation.Turn`: ``start``, ``angle``,
+        ``duration``, ``at(t)``).
+    rate_limit : float
+        The yaw-rate limit it was planned under [rad/s]: the smaller of ``Limits.yaw_rate_max``
+        and the adjacent edges' ``maxRotationSpeed`` (``inf``: none).
+    """
+
+    node: int
+    s: float
+    turn: Turn
+    rate_limit: float
+
+    @property
+    def duration(self) -> float:
+        """Time of the turn [s]."""
+        return self.turn.duration
 
 
 @dataclass(frozen=True)
@@ -55,12 +91,18 @@ class RouteProfile:
         Where each leg starts along ``route.path`` [m]; the last leg ends at the route's end.
     start_s : float
         Where the motion starts along the route [m] (0, or where an order update took over).
+    turns : tuple of RouteTurn
+        The turns on the spot, in order: where the heading must change on a node the vehicle
+        stands still and rotates (a corner it may not cut, a node ``theta``, a change of edge
+        orientation); their time is in :attr:`node_times`, :attr:`node_leave_times`, every
+        later time and :meth:`sample`.
     """
 
     route: Route
     legs: tuple[SpeedProfile, ...]
     leg_starts: tuple[float, ...]
     start_s: float = 0.0
+    turns: tuple[RouteTurn, ...] = ()
 
     def __post_init__(self) -> None:
         if not self.legs or len(self.legs) != len(self.leg_starts):
@@ -68,26 +110,63 @@ class RouteProfile:
 
     @property
     def duration(self) -> float:
-        """Time from :attr:`start_s` to the end of the route [s]."""
-        return float(self.leg_times[-1])
+        """Time from :attr:`start_s` to the end of the route [s], the last turn included."""
+        return float(self._phases[1][-1])
+
+    @cached_property
+    def _phases(self) -> tuple[tuple[tuple[str, int], ...], FloatArray, FloatArray]:
+        """The motion's phases, their start times and their heading offsets.
+
+        Phases in order (``("leg", j)`` or ``("turn", i)``); start times then the end [s];
+        per phase the multiple of 2π added to its heading so that it continues the previous.
+        """
+        keyed = [((self.leg_starts[j], 1, j), ("leg", j)) for j in range(len(self.legs))]
+        keyed += [((t.s, 0, i), ("turn", i)) for i, t in enumerate(self.turns)]
+        order = tuple(p for _, p in sorted(keyed))
+        times = [0.0]
+        offsets = []
+        heading: float | None = None
+        for kind, i in order:
+            if kind == "leg":
+                leg = self.legs[i]
+                ends = leg.at(np.array([0.0, leg.duration])).heading
+                first, last, span = float(ends[0]), float(ends[-1]), leg.duration
+            else:
+                turn = self.turns[i].turn
+                first, last, span = turn.start, turn.end, turn.duration
+            shift = 0.0 if heading is None else 2 * np.pi * round((heading - first) / (2 * np.pi))
+            offsets.append(shift)
+            heading = last + shift
+            times.append(times[-1] + span)
+        out_t, out_o = np.array(times), np.array(offsets)
+        out_t.flags.writeable = False
+        out_o.flags.writeable = False
+        return order, out_t, out_o
 
     @cached_property
     def leg_times(self) -> FloatArray:
-        """Start time of each leg, then the duration [s]."""
-        out = np.concatenate(([0.0], np.cumsum([leg.duration for leg in self.legs])))
+        """Start time of each leg, then the duration [s] (turns on the spot included)."""
+        order, times, _ = self._phases
+        out = np.array([times[p] for p, (kind, _) in enumerate(order) if kind == "leg"]
+                       + [times[-1]])
         out.flags.writeable = False
         return out
 
     @cached_property
-    def node_times(self) -> FloatArray:
-        """When the vehicle is on each released node [s from the start], in order.
+    def turn_times(self) -> FloatArray:
+        """Start time of each of :attr:`turns` [s]."""
+        order, times, _ = self._phases
+        out = np.zeros(len(self.turns))
+        for p, (kind, i) in enumerate(order):
+            if kind == "turn":
+                out[i] = times[p]
+        out.flags.writeable = False
+        return out
 
-        ``NaN`` for the nodes behind :attr:`start_s` (already passed when an order update
-        took over); increasing from there to :attr:`duration` at the last node. At a stop,
-        the time of arrival.
-        """
+    @cached_property
+    def _node_arrive_leave(self) -> tuple[FloatArray, FloatArray]:
         node_s = self.route.node_s
-        out = np.full(node_s.size, np.nan)
+        arrive = np.full(node_s.size, np.nan)
         tol = 1e-9 * max(self.route.length, 1.0)
         for k, s in enumerate(node_s):
             if s < self.start_s - tol:
@@ -95,9 +174,37 @@ class RouteProfile:
             j = self._leg_holding(float(s))
             leg = self.legs[j]
             local = np.clip(float(s) - self.leg_starts[j], 0.0, leg.path.length)
-            out[k] = self.leg_times[j] + float(leg.law.time_at(np.array([local]))[0])
-        out.flags.writeable = False
-        return out
+            arrive[k] = self.leg_times[j] + float(leg.law.time_at(np.array([local]))[0])
+        leave = arrive.copy()
+        at_node: dict[int, list[int]] = {}
+        for i, turn in enumerate(self.turns):
+            if turn.node >= 0:  # -1: a turn where the motion starts between two nodes
+                at_node.setdefault(turn.node, []).append(i)
+        for k, idx in at_node.items():
+            arrive[k] = min(self.turn_times[i] for i in idx)
+            leave[k] = max(self.turn_times[i] + self.turns[i].duration for i in idx)
+        arrive.flags.writeable = False
+        leave.flags.writeable = False
+        return arrive, leave
+
+    @property
+    def node_times(self) -> FloatArray:
+        """When the vehicle arrives on each released node [s from the start], in order.
+
+        ``NaN`` for the nodes behind :attr:`start_s` (already passed when an order update
+        took over); non-decreasing from there. Where the vehicle turns on the spot on a node,
+        it leaves at :attr:`node_leave_times`; every later time includes the turn.
+        """
+        return self._node_arrive_leave[0]
+
+    @property
+    def node_leave_times(self) -> FloatArray:
+        """When the vehicle leaves each released node [s].
+
+        Its arrival plus its turns on the spot (the time of blocking actions is not known to
+        the planner and not included); the last entry is :attr:`duration`.
+        """
+        return self._node_arrive_leave[1]
 
     def _leg_holding(self, s: float) -> int:
         """The leg whose stretch holds ``s`` (the earlier at a stop between two legs)."""
@@ -128,13 +235,53 @@ class RouteProfile:
         return float((upper - lower) / lower) if lower > 0 else 0.0
 
     def verify(self) -> Verification:
-        """The legs' checks of the continuous trajectory against every limit, merged."""
-        return Verification.merged([leg.verify() for leg in self.legs])
+        """The legs' checks of the continuous trajectory against every limit, and the turns'.
+
+        Each turn on the spot is checked for its yaw rate (against
+        :attr:`RouteTurn.rate_limit`), yaw acceleration (``"yaw_acc"``, against
+        ``Limits.yaw_acc_max``) and, with a ``Limits.yaw_jerk_max``, yaw jerk (``"yaw_jerk"``),
+        sampled at :data:`TURN_SAMPLES` times and the ends of its pieces.
+        """
+        return Verification.merged([leg.verify() for leg in self.legs] + self._turn_checks())
 
     @property
     def verification(self) -> Verification:
-        """The checks :func:`speedplan.plan` made of each leg, merged."""
-        return Verification.merged([leg.verification or leg.verify() for leg in self.legs])
+        """The checks :func:`speedplan.plan` made of each leg, merged with the turns'."""
+        return Verification.merged([leg.verification or leg.verify() for leg in self.legs]
+                                   + self._turn_checks())
+
+    def _turn_checks(self) -> list[Verification]:
+        """One :class:`Verification` per turn: its yaw rate, acceleration and jerk.
+
+        Rate and acceleration sampled (the ends of every piece included), the jerk from
+        differences of the sampled acceleration.
+        """
+        out = []
+        limits = self.legs[0].limits
+        for turn in self.turns:
+            t0 = turn.turn.breaks
+            t = np.unique(np.concatenate((np.linspace(0.0, turn.duration, TURN_SAMPLES), t0,
+                                          np.nextafter(t0, np.inf))))
+            t = t[t <= turn.duration]
+            _, rate, acc = turn.turn.at(t)
+            peak_rate, peak_acc = float(np.max(np.abs(rate))), float(np.max(np.abs(acc)))
+            maxima = dict.fromkeys(LIMIT_NAMES, 0.0)
+            ratios = dict.fromkeys(LIMIT_NAMES, 0.0)
+            maxima.update(yaw_rate=peak_rate, yaw_acc=peak_acc)
+            if np.isfinite(turn.rate_limit):
+                ratios["yaw_rate"] = peak_rate / turn.rate_limit
+            ratios["yaw_acc"] = peak_acc / limits.yaw_acc_max
+            if np.isfinite(limits.yaw_jerk_max):  # without a limit the acceleration steps
+                step = np.diff(t)
+                wide = step > 1e-9
+                jerk = float(np.max(np.abs(np.diff(acc)[wide] / step[wide]), initial=0.0))
+                maxima["yaw_jerk"] = jerk
+                ratios["yaw_jerk"] = jerk / limits.yaw_jerk_max
+            else:
+                del maxima["yaw_jerk"], ratios["yaw_jerk"]
+            out.append(Verification(maxima=maxima, ratios=ratios,
+                                    where=dict.fromkeys(ratios, turn.s)))
+        return out
 
     # ---- sampling in time -------------------------------------------------------------------
     def edge_at(self, s: Any) -> FloatArray:
@@ -147,27 +294,50 @@ class RouteProfile:
         return out
 
     def at(self, t: Any) -> RouteTrajectory:
-        """States at times ``t`` [s from the start] (clipped to ``[0, duration]``)."""
+        """States at times ``t`` [s from the start] (clipped to ``[0, duration]``).
+
+        During a turn on the spot the vehicle stands on its node (``v``, ``a``, ``j`` and the
+        lateral columns 0) while ``heading`` and ``yaw_rate`` follow the turn; the heading is
+        continuous over the whole motion.
+        """
+        order, starts_t, offsets = self._phases
         times = np.clip(np.atleast_1d(as_array("t", t)), 0.0, self.duration)
-        j = np.clip(np.searchsorted(self.leg_times, times, side="right") - 1, 0,
-                    len(self.legs) - 1)
+        p = np.clip(np.searchsorted(starts_t, times, side="right") - 1, 0, len(order) - 1)
         parts: dict[str, list[FloatArray]] = {}
-        order = np.argsort(j, kind="stable")
-        for k in np.unique(j):
-            sel = order[j[order] == k]
-            leg_traj = self.legs[k].at(times[sel] - self.leg_times[k])
-            for name, values in leg_traj.to_dict().items():
-                parts.setdefault(name, []).append(values)
-            parts.setdefault("_index", []).append(sel.astype(np.float64))
-        index = np.concatenate(parts.pop("_index")).astype(np.intp)
-        inverse = np.empty_like(index)
-        inverse[index] = np.arange(index.size)
-        cols = {name: np.concatenate(values)[inverse] for name, values in parts.items()}
-        starts = np.asarray(self.leg_starts)[j]
-        cols["t"] = times
-        cols["s"] = cols["s"] + starts
-        return RouteTrajectory(**cols, edge=self.edge_at(cols["s"]),
-                               metadata=self._metadata())
+        index = []
+        for k in np.unique(p):
+            sel = np.flatnonzero(p == k)
+            kind, i = order[k]
+            local = times[sel] - starts_t[k]
+            if kind == "leg":
+                cols = self.legs[i].at(local).to_dict()
+                cols["s"] = cols["s"] + self.leg_starts[i]
+            else:
+                cols = self._turn_columns(i, local)
+            cols["heading"] = cols["heading"] + offsets[k]
+            for name, values in cols.items():
+                parts.setdefault(name, []).append(np.asarray(values, dtype=np.float64))
+            index.append(sel)
+        flat = np.concatenate(index)
+        inverse = np.empty_like(flat)
+        inverse[flat] = np.arange(flat.size)
+        out = {name: np.concatenate(values)[inverse] for name, values in parts.items()}
+        out["t"] = times
+        return RouteTrajectory(**out, edge=self.edge_at(out["s"]), metadata=self._metadata())
+
+    def _turn_columns(self, i: int, local: FloatArray) -> dict[str, FloatArray]:
+        """The trajectory's columns during turn ``i`` at its own times ``local`` [s]."""
+        turn = self.turns[i]
+        heading, rate, _ = turn.turn.at(local)
+        path = self.route.path
+        point = np.asarray(path.point(turn.s), dtype=np.float64).reshape(2)
+        zero = np.zeros(local.size)
+        # The driving direction of the edge the vehicle leaves on (the one it came on at the end).
+        direction = float(np.asarray(path.direction(turn.s)).ravel()[0])
+        return {"t": local, "s": np.full(local.size, turn.s), "x": np.full(local.size, point[0]),
+                "y": np.full(local.size, point[1]), "heading": heading,
+                "curvature": zero, "v": zero, "a": zero, "j": zero, "a_lat": zero,
+                "yaw_rate": rate, "j_lat": zero, "direction": np.full(local.size, direction)}
 
     def sample(self, dt: float = 0.01) -> RouteTrajectory:
         """The motion sampled every ``dt`` seconds from 0; the last sample is at the end.
@@ -193,6 +363,8 @@ class RouteProfile:
             "node_ids": [n.node_id for n in route.base_nodes],
             "node_s": route.node_s.tolist(),
             "node_times": [None if np.isnan(x) else float(x) for x in self.node_times],
+            "node_leave_times": [None if np.isnan(x) else float(x)
+                                 for x in self.node_leave_times],
             "stop_s": route.stop_s.tolist(),
             "edge_ids": [e.edge_id for e in route.base_edges],
             "limits": self.legs[0].limits,

@@ -20,10 +20,13 @@ from ..geometry.primitives import ClothoidPiece
 from . import _checks
 from ._checks import boolean, integer, number, positive, string
 
-__all__ = ["HEADING_TOLERANCE", "Route", "RouteEdge", "RouteNode"]
+__all__ = ["HEADING_TOLERANCE", "THETA_TOLERANCE", "Route", "RouteEdge", "RouteNode"]
 
 #: A heading change [rad] larger than this where two edges meet makes the vehicle stop there.
 HEADING_TOLERANCE = 1e-6
+#: How closely [rad] the vehicle meets a node's ``theta`` when the node gives no (or a zero)
+#: ``allowedDeviationTheta``: 0.001 rad (0.06°), below what AGV localisation resolves.
+THETA_TOLERANCE = 1e-3
 
 
 def _limit(value: Any, where: str) -> float | None:
@@ -56,8 +59,9 @@ class RouteNode:
         Node position [m] (``nodePosition``); ``None`` when the order gives none (allowed only
         between two edges with trajectories).
     theta : float or None
-        Orientation the vehicle shall have on the node [rad] (``nodePosition.theta``); stored,
-        not used by the route's stops.
+        Heading the vehicle shall have on the node [rad] (``nodePosition.theta``): where the
+        path's heading there differs by more than :attr:`theta_tolerance`, the vehicle stops
+        on the node and turns to ``theta`` (and then to the next edge's heading).
     allowed_deviation_xy : float
         How far [m] the vehicle may pass from ``position`` (VDA 5050 2.x ``allowedDeviationXY``;
         for 3.0's ellipse the semi-minor axis, the largest circle inside it). 0 when not given.
@@ -66,12 +70,21 @@ class RouteNode:
         while it runs, so the vehicle stops on the node (v = 0, a = 0).
     released : bool
         Part of the base (``True``) or of the horizon.
+    allowed_deviation_theta : float or None
+        How far [rad] the heading may differ from ``theta`` (``allowedDeviationTheta``);
+        ``None`` or 0: :data:`THETA_TOLERANCE`.
+    deviation_ellipse : (a, b, angle) or None
+        VDA 5050 3.0's ``allowedDeviationXY`` ellipse: semi-axes ``a``, ``b`` [m] and the
+        angle [rad] of the ``a`` axis to the map's x axis. A corner on the node is rounded
+        so that its point nearest the node lies inside the ellipse.
 
     Examples
     --------
     >>> from speedplan.route import RouteNode
     >>> RouteNode("N1", 2, position=(3.0, 4.0), stop=True).stop
     True
+    >>> RouteNode("N2", 4, position=(3.0, 9.0), theta=1.0).theta_tolerance
+    0.001
     """
 
     node_id: str
@@ -81,9 +94,22 @@ class RouteNode:
     allowed_deviation_xy: float = 0.0
     stop: bool = False
     released: bool = True
+    allowed_deviation_theta: float | None = None
+    deviation_ellipse: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         _set_checked(self, node_id=string, sequence_id=integer)
+        if self.allowed_deviation_theta is not None:
+            _set_checked(self, allowed_deviation_theta=_distance)
+        if self.deviation_ellipse is not None:
+            ell = self.deviation_ellipse
+            if isinstance(ell, str) or not hasattr(ell, "__len__") or len(ell) != 3:
+                raise InvalidInputError(
+                    f"`deviation_ellipse` must be (a, b, angle) or None; got {ell!r}")
+            object.__setattr__(self, "deviation_ellipse", (
+                _distance(ell[0], "deviation_ellipse[0]"),
+                _distance(ell[1], "deviation_ellipse[1]"),
+                number(ell[2], "deviation_ellipse[2]")))
         if self.position is not None:
             pos = self.position
             if isinstance(pos, str) or not hasattr(pos, "__len__") or len(pos) != 2:
@@ -93,6 +119,24 @@ class RouteNode:
         if self.theta is not None:
             _set_checked(self, theta=number)
         _set_checked(self, allowed_deviation_xy=_distance, stop=boolean, released=boolean)
+
+    @property
+    def theta_tolerance(self) -> float:
+        """How far [rad] the heading on the node may differ from :attr:`theta`."""
+        return max(self.allowed_deviation_theta or 0.0, THETA_TOLERANCE)
+
+    def deviation_towards(self, direction: float) -> float:
+        """Allowed deviation [m] from the node in the map direction ``direction`` [rad].
+
+        The ellipse's radius in that direction, else :attr:`allowed_deviation_xy`.
+        """
+        if self.deviation_ellipse is None:
+            return self.allowed_deviation_xy
+        a, b, angle = self.deviation_ellipse
+        if a == 0.0 or b == 0.0:
+            return 0.0
+        phi = direction - angle
+        return float(a * b / np.hypot(b * np.cos(phi), a * np.sin(phi)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -125,6 +169,18 @@ class RouteEdge:
         The edge carries an action with ``blockingType`` SOFT or HARD: it starts when the
         vehicle enters the edge and forbids driving while it runs, so the vehicle stops at
         the edge's start node.
+    rotation_allowed : bool
+        Whether the vehicle may rotate while on the edge (VDA 5050 2.x ``rotationAllowed``,
+        default ``True``). ``False``: no corner is rounded into or out of the edge; the vehicle
+        stops on the nodes and turns there.
+    turn_before_entering : bool
+        The vehicle must have the edge's heading before it enters the edge (VDA 5050 3.0
+        ``reachOrientationBeforeEntering``): no corner is rounded into it.
+    corridor : (left, right) or None
+        How far [m] the vehicle may leave the edge's geometry to its left and right, seen in
+        the travel direction (VDA 5050 ``corridor`` ``leftWidth``, ``rightWidth``); a corner
+        rounded on a node stays inside the corridors of both edges. ``None``: no corridor,
+        only the nodes' allowed deviations bound a rounded corner.
 
     Examples
     --------
@@ -145,16 +201,33 @@ class RouteEdge:
     reverse: bool = False
     released: bool = True
     stop: bool = False
+    rotation_allowed: bool = True
+    turn_before_entering: bool = False
+    corridor: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         _set_checked(self, edge_id=string, sequence_id=integer, start_node=string,
-                     end_node=string)
+                     end_node=string, rotation_allowed=boolean, turn_before_entering=boolean)
+        if self.corridor is not None:
+            c = self.corridor
+            if isinstance(c, str) or not hasattr(c, "__len__") or len(c) != 2:
+                raise InvalidInputError(f"`corridor` must be (left, right) or None; got {c!r}")
+            object.__setattr__(self, "corridor", (_distance(c[0], "corridor[0]"),
+                                                  _distance(c[1], "corridor[1]")))
         if not isinstance(self.path, Path):
             raise InvalidInputError(
                 f"`path` must be a speedplan.Path; got {type(self.path).__name__}"
             )
         _set_checked(self, v_max=_limit, yaw_rate_max=_limit, reverse=boolean, released=boolean,
                      stop=boolean)
+
+    def heading(self, at_end: bool) -> float:
+        """The vehicle's heading [rad] at the edge's start (or end).
+
+        The path's tangent, turned by π when the edge is driven backwards.
+        """
+        h = float(self.path.heading(self.path.length if at_end else 0.0))
+        return h + np.pi if self.reverse else h
 
 
 def _heading_change(incoming: Path, outgoing: Path) -> float:
@@ -173,16 +246,50 @@ def _is_straight(path: Path) -> bool:
         and piece.direction == 1
 
 
+def _turn(before: RouteEdge, after: RouteEdge) -> float:
+    """Signed change [rad] of the vehicle's heading from ``before``'s end to ``after``'s start."""
+    return float(wrap_angle(after.heading(True) - before.heading(False)))
+
+
+def corner_deviation(before: RouteEdge, node: RouteNode, after: RouteEdge) -> float:
+    """How far [m] a rounded corner on ``node`` may pass from it.
+
+    The corner's point nearest the node lies on the inner bisector of the two edges: it must
+    lie inside the node's allowed deviation (the 3.0 ellipse's radius in that direction) and,
+    at ``d cos(δ/2)`` from each edge's line for a turn ``δ``, inside the inner side of each
+    edge's :attr:`~RouteEdge.corridor`.
+    """
+    d_in = float(before.path.heading(before.path.length))
+    d_out = float(after.path.heading(0.0))
+    delta = float(wrap_angle(d_out - d_in))
+    inner = d_in + 0.5 * delta + (np.pi / 2 if delta > 0 else -np.pi / 2)
+    dev = node.deviation_towards(inner)
+    side = 0 if delta > 0 else 1  # a left turn cuts into the corridors' left sides
+    for edge in (before, after):
+        if edge.corridor is not None:
+            dev = min(dev, edge.corridor[side] / np.cos(0.5 * delta))
+    return float(dev)
+
+
 def _can_round(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
     """Whether the corner on ``node`` between two straight edges is rounded (G2).
 
-    Both edges run straight between node positions, the node allows a deviation, the turn is
-    not a reversal (:data:`~speedplan.geometry.corners.CUSP_ANGLE`) and the vehicle keeps
-    its driving direction.
+    Both edges run straight between node positions, the corner may pass the node at some
+    distance (:func:`corner_deviation`), the turn is not a reversal
+    (:data:`~speedplan.geometry.corners.CUSP_ANGLE`), the vehicle keeps its driving
+    direction, may rotate on both edges and need not reach the next edge's heading before
+    entering it, and the corner's heading on the node meets the node's ``theta``.
     """
-    return (_is_straight(before.path) and _is_straight(after.path)
-            and node.allowed_deviation_xy > 0.0 and before.reverse == after.reverse
-            and _heading_change(before.path, after.path) <= CUSP_ANGLE)
+    if not (_is_straight(before.path) and _is_straight(after.path)
+            and before.reverse == after.reverse and before.rotation_allowed
+            and after.rotation_allowed and not after.turn_before_entering
+            and _heading_change(before.path, after.path) <= CUSP_ANGLE
+            and corner_deviation(before, node, after) > 0.0):
+        return False
+    if node.theta is None:
+        return True
+    middle = before.heading(True) + 0.5 * _turn(before, after)
+    return abs(float(wrap_angle(node.theta - middle))) <= node.theta_tolerance
 
 
 def _join_at_node(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
@@ -190,13 +297,31 @@ def _join_at_node(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
 
     The one place that decides how a route passes a node between two edges: where the
     heading changes by more than :data:`HEADING_TOLERANCE`, the corner is rounded within
-    ``node.allowed_deviation_xy`` when both edges are straight (:func:`_can_round`: a G2
-    clothoid–arc–clothoid corner, as :meth:`Path.from_waypoints` builds them), else the
+    the node's allowed deviation and the edges' corridors when :func:`_can_round` allows it
+    (a G2 clothoid–arc–clothoid corner, as :meth:`Path.from_waypoints` builds them), else the
     vehicle stops there (it turns on the spot).
     """
     if _heading_change(before.path, after.path) <= HEADING_TOLERANCE:
         return False
     return not _can_round(before, node, after)
+
+
+def _turn_headings(node: RouteNode, arrive: float | None, leave: float | None) -> list[float]:
+    """Headings [rad] the vehicle stands at on ``node``: arriving, ``theta``, leaving.
+
+    Consecutive entries differ by more than their tolerance (a heading within
+    ``theta_tolerance`` of ``theta`` meets it); one entry: no turn.
+    """
+    first = arrive if arrive is not None else leave
+    if first is None:
+        return []
+    out = [first]
+    if node.theta is not None and abs(float(wrap_angle(node.theta - first))) \
+            > node.theta_tolerance:
+        out.append(node.theta)
+    if leave is not None and abs(float(wrap_angle(leave - out[-1]))) > HEADING_TOLERANCE:
+        out.append(leave)
+    return [float(h) for h in out]
 
 
 @dataclass(frozen=True, eq=False)
@@ -224,6 +349,9 @@ class Route:
         ``len(nodes) - 1`` edges, at least the first released.
     order_id, order_update_id, version : optional
         The order's ``orderId``, ``orderUpdateId`` and protocol ``version`` when read from one.
+    notes : tuple of str
+        What of the order the planner does not honour as written, one line per field naming
+        its node or edge and why (:meth:`from_vda5050` also warns them, once per order).
 
     Raises
     ------
@@ -254,6 +382,7 @@ class Route:
     order_id: str | None = None
     order_update_id: int | None = None
     version: str | None = None
+    notes: tuple[str, ...] = ()
     _stops: tuple[tuple[int, str], ...] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -279,6 +408,8 @@ class Route:
                 string(value, name)
         if self.order_update_id is not None:
             integer(self.order_update_id, "order_update_id")
+        object.__setattr__(self, "notes", tuple(string(note, f"notes[{i}]")
+                                                for i, note in enumerate(self.notes)))
         object.__setattr__(self, "_stops", self._find_stops())
 
     def _check_ends(self, i: int, edge: RouteEdge) -> None:
@@ -300,10 +431,10 @@ class Route:
 
     def _find_stops(self) -> tuple[tuple[int, str], ...]:
         """``(base node index, reason)`` of every stop, in order along the base."""
-        edges = self.base_edges
-        stops = [(0, "start")]
+        edges, nodes = self.base_edges, self.base_nodes
+        stops = [(0, "; ".join(filter(None, ("start", self._turn_reason(0)))))]
         for i in range(1, len(edges)):
-            node, before, after = self.nodes[i], edges[i - 1], edges[i]
+            node, before, after = nodes[i], edges[i - 1], edges[i]
             reasons = []
             if node.stop:
                 reasons.append(f"node {node.node_id!r} has a blocking (SOFT/HARD) action")
@@ -314,10 +445,66 @@ class Route:
             if _join_at_node(before, node, after):
                 turn = _heading_change(before.path, after.path)
                 reasons.append(f"the heading changes by {turn:.3g} rad")
+            elif (why := self._turn_reason(i)) is not None:
+                reasons.append(why)
             if reasons:
                 stops.append((i, "; ".join(reasons)))
-        stops.append((len(edges), "end of the released base"))
+        end = len(edges)
+        stops.append((end, "; ".join(filter(None, ("end of the released base",
+                                                   self._turn_reason(end))))))
         return tuple(stops)
+
+    def _turn_reason(self, k: int) -> str | None:
+        """Why the vehicle turns on the spot on released node ``k`` (``None``: it does not)."""
+        heads, node = self.turn_headings[k], self.base_nodes[k]
+        if len(heads) < 2:
+            return None
+        if node.theta is not None and any(
+                abs(float(wrap_angle(node.theta - h))) <= node.theta_tolerance
+                for h in heads[1:]):
+            return f"the vehicle turns on the spot to theta = {node.theta:.6g} rad"
+        return f"the vehicle turns on the spot by {float(wrap_angle(heads[-1] - heads[0])):.3g} rad"
+
+    @cached_property
+    def _round_set(self) -> frozenset[int]:
+        return frozenset(self.rounded_nodes)
+
+    @cached_property
+    def turn_headings(self) -> tuple[tuple[float, ...], ...]:
+        """Per released node, the headings [rad] the vehicle turns through on it, standing.
+
+        The heading it arrives with, the node's ``theta`` where that differs by more than
+        :attr:`RouteNode.theta_tolerance`, and the heading the next edge starts with
+        (the vehicle's: the tangent, plus π on an edge driven backwards); one entry where it
+        does not turn, none on a rounded node. On the first node the vehicle is taken to
+        stand at its ``theta`` (else at the first edge's heading); on the last it turns to
+        its ``theta``.
+        """
+        return tuple(() if k in self._round_set else self.node_headings(k)
+                     for k in range(len(self.base_nodes)))
+
+    def node_headings(self, k: int, arrive: float | None = None) -> tuple[float, ...]:
+        """:attr:`turn_headings` of released node ``k`` for a given arrival heading.
+
+        ``arrive`` [rad] defaults to the heading of the edge into the node; on the first node
+        to its ``theta``, else the first edge's heading.
+        """
+        edges, node = self.base_edges, self.base_nodes[k]
+        leave = edges[k].heading(False) if k < len(edges) else None
+        if arrive is None:
+            arrive = edges[k - 1].heading(True) if k > 0 else (
+                node.theta if node.theta is not None else leave)
+        return tuple(_turn_headings(node, arrive, leave))
+
+    def turn_rate_limit(self, k: int) -> float:
+        """Yaw-rate limit [rad/s] of a turn on released node ``k``.
+
+        The smaller ``yaw_rate_max`` (``maxRotationSpeed``) of the edges into and out of it;
+        ``inf`` when neither gives one.
+        """
+        edges = self.base_edges
+        near = [edges[j].yaw_rate_max for j in (k - 1, k) if 0 <= j < len(edges)]
+        return float(min((r for r in near if r is not None), default=np.inf))
 
     # ---- the released base ------------------------------------------------------------------
     @cached_property
@@ -348,7 +535,9 @@ class Route:
             if j > i:
                 pts = np.array([e.path.point(0.0) for e in edges[i:j + 1]]
                                + [edges[j].path.point(edges[j].path.length)])
-                dev = np.array([nodes[k].allowed_deviation_xy for k in range(i, j + 2)])
+                dev = np.zeros(j - i + 2)
+                for k in range(i + 1, j + 1):
+                    dev[k - i] = corner_deviation(edges[k - 1], nodes[k], edges[k])
                 chain, at = g2_chain(pts, dev)
                 run = Path(chain)
                 if edges[i].reverse:

@@ -10,7 +10,7 @@ edge speed limit [m/s]        ``maxSpeed``                    ``maximumSpeed``
 edge's nodes                  ``startNodeId``, ``endNodeId``  none (implied by the sequence)
                               (required)
 node deviation [m]            ``allowedDeviationXY`` number   ``allowedDeviationXY`` ellipse
-                              (2.0 schema: ``...Xy``)         ``{a, b, theta}``
+                              (``...Xy`` read too)            ``{a, b, theta}``
 ``trajectory``                ``degree``, ``knotVector``,     ``controlPoints`` only;
                               ``controlPoints`` required      ``degree`` 1, uniform clamped
                                                               knots by default
@@ -19,12 +19,21 @@ action ``blockingType``       NONE, SOFT, HARD                NONE, SOFT, SINGLE
 
 Both: header ``version`` (required here: it selects the names above), ``orderId``,
 ``orderUpdateId`` (``headerId``, ``timestamp``, ``manufacturer``, ``serialNumber``: type
-checked when present); nodes ``nodeId``, ``sequenceId``, ``released``, ``nodePosition{x, y,
-theta, mapId}``, ``actions[]{actionType, actionId, blockingType}``; edges ``edgeId``,
-``sequenceId``, ``released``, ``maxRotationSpeed``, ``orientation``, ``orientationType``
-(GLOBAL or TANGENTIAL, default TANGENTIAL), ``trajectory``, ``length``, ``actions``. A field
-of the other version (``maximumSpeed`` in a 2.0 order) is refused rather than ignored. Missing
-``actions`` lists count as empty; other fields are not read.
+checked); nodes ``nodeId``, ``sequenceId``, ``released``, ``nodePosition{x, y, theta,
+allowedDeviationTheta, mapId}``, ``actions[]{actionType, actionId, blockingType}``; edges
+``edgeId``, ``sequenceId``, ``released``, ``maxRotationSpeed``, ``orientation``,
+``orientationType`` (GLOBAL or TANGENTIAL, default TANGENTIAL), ``rotationAllowed``,
+``reachOrientationBeforeEntering``, ``corridor{leftWidth, rightWidth}``, ``trajectory``,
+``length``, ``actions``. A field of the other version (``maximumSpeed`` in a 2.0 order) is
+refused rather than ignored.
+
+Nothing is dropped without a word: every field the planner does not honour as written —
+``direction`` (a line-guided vehicle's branch at a junction, not the driving direction), the
+height fields, ``zoneSetId``, an ``orientation`` at an angle to the path (crabbing), a
+``CONTOUR`` corridor, ``rotationAllowed`` false on an edge whose geometry turns, an unknown
+field name, a field the schema requires but the order lacks (``actions`` lists, header
+fields, ``mapId``; planned without) — is one line of :attr:`Route.notes`, and the reader warns
+them once per order (:class:`OrderWarning`). ``docs/vda5050.md`` lists every field.
 
 What is derived:
 
@@ -33,9 +42,15 @@ What is derived:
 * an edge without one runs straight between its nodes' positions (both needed);
 * ``stop`` on a node or an edge: an action with ``blockingType`` SOFT or HARD (driving not
   allowed while it runs);
-* ``reverse``: ``orientationType`` TANGENTIAL and ``|orientation| > π/2`` (GLOBAL orientations
-  do not tie the vehicle to the path's tangent: not reverse);
-* 3.0 ellipse deviations become their semi-minor axis ``min(a, b)``.
+* ``reverse``: ``orientationType`` TANGENTIAL and ``|orientation| > π/2``, or GLOBAL with an
+  ``orientation`` opposite to a straight edge's direction;
+* a node's deviation bounds how far a rounded corner passes from it: the 2.x radius, or the
+  3.0 ellipse's radius along the corner's bisector (``allowed_deviation_xy`` keeps its
+  semi-minor axis ``min(a, b)``); the edges' corridors bound it too;
+* ``rotationAllowed`` false on either edge, or ``reachOrientationBeforeEntering`` on the next,
+  keeps a corner from being rounded: the vehicle stops on the node and turns there;
+* a node ``theta`` (within ``allowedDeviationTheta``) is met on the node: where the path's
+  heading differs, the vehicle stops and turns to it.
 
 The edge's ``length`` is checked for type only (the geometry gives the length). Consecutive
 node positions must be on the same ``mapId``.
@@ -46,13 +61,14 @@ from __future__ import annotations
 import itertools
 import json
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path as FsPath
 from typing import Any
 
 import numpy as np
 
-from ..core.errors import InvalidInputError
+from ..core.errors import InvalidInputError, SpeedplanWarning
 from ..geometry import Line, Path
 from ..geometry._checks import wrap_angle
 from ._checks import (
@@ -66,9 +82,51 @@ from ._checks import (
     positive,
     string,
 )
-from .route import Route, RouteEdge, RouteNode
+from .route import THETA_TOLERANCE, Route, RouteEdge, RouteNode
 
-__all__ = ["load_order", "route_from_vda5050", "trajectory_path", "uniform_clamped_knots"]
+__all__ = ["OrderWarning", "load_order", "route_from_vda5050", "trajectory_path",
+           "uniform_clamped_knots"]
+
+
+class OrderWarning(SpeedplanWarning):
+    """An order holds fields the planner does not honour as written.
+
+    One warning per order, one line per field naming its node or edge and why; the same
+    lines are in :attr:`Route.notes`.
+    """
+
+
+#: Fields read, per object; any other field is reported as unknown (a misspelt name would
+#: otherwise be ignored without a word).
+_KNOWN = {
+    "order": {"headerId", "timestamp", "version", "manufacturer", "serialNumber", "orderId",
+              "orderUpdateId", "orderDescription", "zoneSetId", "nodes", "edges"},
+    "node": {"nodeId", "sequenceId", "nodeDescription", "nodeDescriptor", "released",
+             "nodePosition", "actions"},
+    "nodePosition": {"x", "y", "theta", "allowedDeviationXY", "allowedDeviationXy",
+                     "allowedDeviationTheta", "mapId", "mapDescription"},
+    "edge": {"edgeId", "sequenceId", "edgeDescription", "edgeDescriptor", "released",
+             "startNodeId", "endNodeId", "maxSpeed", "maximumSpeed", "maxHeight", "minHeight",
+             "maximumHeight", "minimumHeight", "maximumMobileRobotHeight",
+             "minimumLoadHandlingDeviceHeight", "maximumLoadHandlingDeviceHeight",
+             "orientation", "orientationType", "direction", "rotationAllowed",
+             "reachOrientationBeforeEntering", "maxRotationSpeed", "length", "trajectory",
+             "corridor", "actions"},
+    "corridor": {"leftWidth", "rightWidth", "corridorRefPoint", "corridorReferencePoint",
+                 "releaseRequired", "releaseLossBehavior"},
+}
+#: Edge fields about heights: no motion limit the planner knows (it plans in the plane).
+_HEIGHTS = ("maxHeight", "minHeight", "maximumHeight", "minimumHeight",
+            "maximumMobileRobotHeight", "minimumLoadHandlingDeviceHeight",
+            "maximumLoadHandlingDeviceHeight")
+#: Header fields the schemas require; an order without them is planned, with a note.
+_HEADER = ("headerId", "timestamp", "manufacturer", "serialNumber", "orderId", "orderUpdateId")
+
+
+def _unknown(obj: dict[str, Any], kind: str, where: str, notes: list[str]) -> None:
+    for key in obj:
+        if key not in _KNOWN[kind]:
+            notes.append(f"`{where}.{key}`: not a field of a VDA 5050 {kind}; not read")
 
 
 @dataclass(frozen=True)
@@ -165,11 +223,16 @@ def route_from_vda5050(order: Any) -> Route:
     """
     name, doc = load_order(order)
     try:
-        return _route(doc)
+        route = _route(doc)
     except InvalidInputError as exc:
         if name:
             raise InvalidInputError(f"{name}: {exc}") from exc
         raise
+    if route.notes:
+        lines = "\n".join(f"  - {note}" for note in route.notes)
+        warnings.warn(f"{name or 'order'}: {len(route.notes)} field(s) not honoured as "
+                      f"written:\n{lines}", OrderWarning, stacklevel=3)
+    return route
 
 
 def _dialect(doc: dict[str, Any]) -> _Dialect:
@@ -189,6 +252,16 @@ def _dialect(doc: dict[str, Any]) -> _Dialect:
 def _route(doc: Any) -> Route:
     doc = _obj(doc, "order")
     dialect = _dialect(doc)
+    notes: list[str] = []
+    _unknown(doc, "order", "order", notes)
+    if "zoneSetId" in doc:
+        string(doc["zoneSetId"], "zoneSetId")
+        notes.append("`order.zoneSetId`: the zone set's zones (speed limits among them) are "
+                     "not read; pass them to plan_route as `zones`")
+    missing = [key for key in _HEADER if key not in doc]
+    if missing:
+        notes.append(f"`order`: {', '.join(missing)} missing (the schema requires them); "
+                     "planned without")
     # Header fields are not needed to plan; when present they must still have their types.
     if "headerId" in doc:
         integer(doc["headerId"], "headerId")
@@ -214,16 +287,40 @@ def _route(doc: Any) -> Route:
                     for i, n in enumerate(nodes_obj)],
                    [boolean(_required(e, "released", f"edges[{i}]"), f"edges[{i}].released")
                     for i, e in enumerate(edges_obj)])
-    nodes = [_node(n, i, dialect) for i, n in enumerate(nodes_obj)]
+    nodes = [_node(n, i, dialect, notes) for i, n in enumerate(nodes_obj)]
     _check_maps(nodes_obj)
     ids = {n.node_id for n in nodes}
-    edges = [_edge(e, i, nodes[i], nodes[i + 1], ids, dialect) for i, e in enumerate(edges_obj)]
+    edges = [_edge(e, i, nodes[i], nodes[i + 1], ids, dialect, notes)
+             for i, e in enumerate(edges_obj)]
+    _note_rotations(edges, notes)
     return Route(tuple(nodes), tuple(edges), order_id=order_id, order_update_id=update,
-                 version=string(doc["version"], "version"))
+                 version=string(doc["version"], "version"), notes=tuple(notes))
 
 
-def _stops_driving(obj: dict[str, Any], where: str, dialect: _Dialect) -> bool:
+def _turning(path: Path) -> float:
+    """How far [rad] the heading of ``path`` turns in all (its range, unwrapped)."""
+    heading = np.unwrap(np.asarray(path.heading(np.linspace(0.0, path.length, 257)),
+                                   dtype=np.float64))
+    return float(np.ptp(heading))
+
+
+def _note_rotations(edges: list[RouteEdge], notes: list[str]) -> None:
+    """Edges that forbid rotation but whose geometry turns the vehicle on them."""
+    for i, edge in enumerate(edges):
+        spread = 0.0 if edge.rotation_allowed else _turning(edge.path)
+        if spread > THETA_TOLERANCE:
+            notes.append(
+                f"`edges[{i}].rotationAllowed` is false, but the edge's geometry turns the "
+                f"vehicle by {spread:.3g} rad: the planner's vehicle faces the path's tangent, "
+                "so it rotates on this edge as it follows it")
+
+
+def _stops_driving(obj: dict[str, Any], where: str, dialect: _Dialect,
+                   notes: list[str]) -> bool:
     """Whether ``obj.actions`` holds an action that forbids driving (SOFT or HARD)."""
+    if "actions" not in obj:
+        notes.append(f"`{where}.actions` is missing (the schema requires the list, empty if "
+                     "there are no actions); taken as empty")
     actions = _list(obj.get("actions", []), f"{where}.actions")
     stop = False
     for j, raw in enumerate(actions):
@@ -241,11 +338,12 @@ def _stops_driving(obj: dict[str, Any], where: str, dialect: _Dialect) -> bool:
     return stop
 
 
-def _deviation(pos: dict[str, Any], where: str, dialect: _Dialect) -> float:
-    """The allowed deviation [m] of a node position (0 when not given)."""
+def _deviation(pos: dict[str, Any], where: str, dialect: _Dialect, notes: list[str],
+               ) -> tuple[float, tuple[float, float, float] | None]:
+    """The allowed deviation [m] of a node position (0 when not given), and 3.0's ellipse."""
     keys = [k for k in ("allowedDeviationXY", "allowedDeviationXy") if k in pos]
     if not keys:
-        return 0.0
+        return 0.0, None
     if dialect.ellipse:
         if keys != ["allowedDeviationXY"]:
             raise InvalidInputError(
@@ -261,36 +359,52 @@ def _deviation(pos: dict[str, Any], where: str, dialect: _Dialect) -> float:
         ellipse = pos[keys[0]]
         a, b = (number(_required(ellipse, k, at), f"{at}.{k}", minimum=0.0) for k in ("a", "b"))
         if "theta" in ellipse:
-            number(ellipse["theta"], f"{at}.theta")
-        return min(a, b)  # the largest circle inside the ellipse
-    # 2.0's schema spells it allowedDeviationXy, its specification allowedDeviationXY.
+            angle = number(ellipse["theta"], f"{at}.theta")
+        else:
+            angle = 0.0
+            notes.append(f"`{at}.theta` is missing (the schema requires it); taken as 0")
+        return min(a, b), (a, b, angle)  # min: the largest circle inside the ellipse
+    # Both spellings are read: VDA 5050 2.x specifies allowedDeviationXY, and orders written
+    # to an early 2.0 schema spell it allowedDeviationXy.
     values = {k: number(pos[k], f"{where}.{k}", minimum=0.0) for k in keys}
     if len(set(values.values())) > 1:
         raise InvalidInputError(
             f"`{where}` gives both allowedDeviationXY and allowedDeviationXy with different "
             "values; give one"
         )
-    return next(iter(values.values()))
+    return next(iter(values.values())), None
 
 
-def _node(raw: dict[str, Any], i: int, dialect: _Dialect) -> RouteNode:
+def _node(raw: dict[str, Any], i: int, dialect: _Dialect, notes: list[str]) -> RouteNode:
     where = f"nodes[{i}]"
+    _unknown(raw, "node", where, notes)
     node_id = string(_required(raw, "nodeId", where), f"{where}.nodeId")
     position: tuple[float, float] | None = None
-    theta = None
-    deviation = 0.0
+    theta = theta_dev = None
+    deviation: float = 0.0
+    ellipse = None
     if "nodePosition" in raw:
         at = f"{where}.nodePosition"
         pos = _obj(raw["nodePosition"], at)
+        _unknown(pos, "nodePosition", at, notes)
         position = (number(_required(pos, "x", at), f"{at}.x"),
                     number(_required(pos, "y", at), f"{at}.y"))
         if "theta" in pos:
             theta = number(pos["theta"], f"{at}.theta")
+        if "allowedDeviationTheta" in pos:
+            theta_dev = number(pos["allowedDeviationTheta"], f"{at}.allowedDeviationTheta",
+                               minimum=0.0)
+            if theta is None:
+                notes.append(f"`{at}.allowedDeviationTheta` is given without `theta`; "
+                             "nothing to deviate from, not used")
         if "mapId" in pos:
             string(pos["mapId"], f"{at}.mapId")
-        deviation = _deviation(pos, at, dialect)
+        else:
+            notes.append(f"`{at}.mapId` is missing (the schema requires it)")
+        deviation, ellipse = _deviation(pos, at, dialect, notes)
     return RouteNode(node_id, int(raw["sequenceId"]), position, theta, deviation,
-                     _stops_driving(raw, where, dialect), raw["released"])
+                     _stops_driving(raw, where, dialect, notes), raw["released"],
+                     allowed_deviation_theta=theta_dev, deviation_ellipse=ellipse)
 
 
 def _check_maps(nodes: list[dict[str, Any]]) -> None:
@@ -306,8 +420,9 @@ def _check_maps(nodes: list[dict[str, Any]]) -> None:
 
 
 def _edge(raw: dict[str, Any], i: int, start: RouteNode, end: RouteNode, ids: set[str],
-          dialect: _Dialect) -> RouteEdge:
+          dialect: _Dialect, notes: list[str]) -> RouteEdge:
     where = f"edges[{i}]"
+    _unknown(raw, "edge", where, notes)
     edge_id = string(_required(raw, "edgeId", where), f"{where}.edgeId")
     for key, node, j in (("startNodeId", start, i), ("endNodeId", end, i + 1)):
         if key not in raw:
@@ -338,12 +453,60 @@ def _edge(raw: dict[str, Any], i: int, start: RouteNode, end: RouteNode, ids: se
         if "maxRotationSpeed" in raw else None
     if "length" in raw:
         number(raw["length"], f"{where}.length", minimum=0.0)
-    return RouteEdge(edge_id, int(raw["sequenceId"]), start.node_id, end.node_id,
-                     _edge_path(raw, i, start, end, dialect), v_max, yaw,
-                     _reverse(raw, where), raw["released"], _stops_driving(raw, where, dialect))
+    for key in _HEIGHTS:
+        if key in raw:
+            number(raw[key], f"{where}.{key}")
+            notes.append(f"`{where}.{key}`: a height, no limit on the planar motion the "
+                         "planner plans; not checked")
+    if "direction" in raw:
+        string(raw["direction"], f"{where}.direction")
+        notes.append(f"`{where}.direction` {raw['direction']!r}: the branch a line-guided "
+                     "vehicle takes at a junction, not the driving direction; not used (to "
+                     "drive the edge backwards give `orientation` π with `orientationType` "
+                     "TANGENTIAL)")
+    rotation = boolean(raw["rotationAllowed"], f"{where}.rotationAllowed") \
+        if "rotationAllowed" in raw else True
+    before = boolean(raw["reachOrientationBeforeEntering"],
+                     f"{where}.reachOrientationBeforeEntering") \
+        if "reachOrientationBeforeEntering" in raw else False
+    path = _edge_path(raw, i, start, end, dialect)
+    return RouteEdge(edge_id, int(raw["sequenceId"]), start.node_id, end.node_id, path,
+                     v_max, yaw, _reverse(raw, where, path, notes), raw["released"],
+                     _stops_driving(raw, where, dialect, notes), rotation_allowed=rotation,
+                     turn_before_entering=before, corridor=_corridor(raw, where, notes))
 
 
-def _reverse(raw: dict[str, Any], where: str) -> bool:
+def _corridor(raw: dict[str, Any], where: str, notes: list[str]) -> tuple[float, float] | None:
+    """``(leftWidth, rightWidth)`` [m] of the edge's corridor, or ``None``."""
+    if "corridor" not in raw:
+        return None
+    at = f"{where}.corridor"
+    obj = _obj(raw["corridor"], at)
+    _unknown(obj, "corridor", at, notes)
+    left, right = (number(_required(obj, k, at), f"{at}.{k}", minimum=0.0)
+                   for k in ("leftWidth", "rightWidth"))
+    for key in ("corridorRefPoint", "corridorReferencePoint"):
+        if key in obj:
+            ref = string(obj[key], f"{at}.{key}")
+            if ref not in ("KINEMATICCENTER", "KINEMATIC_CENTER", "CONTOUR"):
+                raise InvalidInputError(
+                    f"`{at}.{key}` must be KINEMATICCENTER or CONTOUR; got {ref!r}")
+            if ref == "CONTOUR":
+                notes.append(f"`{at}.{key}` CONTOUR: the planner knows no vehicle contour; "
+                             "rounded corners keep the kinematic centre inside the corridor")
+    if obj.get("releaseRequired") is True:
+        notes.append(f"`{at}.releaseRequired`: the release is between fleet control and "
+                     "vehicle; the plan uses the corridor as if released")
+    return left, right
+
+
+def _reverse(raw: dict[str, Any], where: str, path: Path, notes: list[str]) -> bool:
+    """Whether the vehicle drives the edge backwards, from ``orientation``.
+
+    TANGENTIAL (the default): ``|orientation| > π/2``. GLOBAL, on an edge whose geometry
+    keeps one heading: backwards where the orientation points against it. Orientations the
+    planner's vehicle (facing the path's tangent, or its opposite) cannot take are noted.
+    """
     kind = raw.get("orientationType", "TANGENTIAL")
     if kind not in _ORIENTATION_TYPES:
         raise InvalidInputError(
@@ -353,7 +516,27 @@ def _reverse(raw: dict[str, Any], where: str) -> bool:
     if "orientation" not in raw:
         return False
     orientation = number(raw["orientation"], f"{where}.orientation")
-    return kind == "TANGENTIAL" and bool(abs(wrap_angle(orientation)) > np.pi / 2)
+    at = f"`{where}.orientation` {orientation:.6g} rad ({kind})"
+    if kind == "TANGENTIAL":
+        reverse = bool(abs(wrap_angle(orientation)) > np.pi / 2)
+        off = abs(float(wrap_angle(orientation - (np.pi if reverse else 0.0))))
+        if off > THETA_TOLERANCE:
+            notes.append(f"{at}: planned {'backwards' if reverse else 'forwards'} along the "
+                         f"path; the planner's vehicle faces the path's tangent (or its "
+                         f"opposite), it does not crab {off:.3g} rad off it")
+        return reverse
+    if _turning(path) > THETA_TOLERANCE:
+        notes.append(f"{at}: the edge's geometry turns, so a fixed map orientation cannot be "
+                     "kept by a vehicle facing the path's tangent; planned forwards")
+        return False
+    forward = abs(float(wrap_angle(orientation - float(path.heading(0.0)))))
+    if forward <= THETA_TOLERANCE:
+        return False
+    if abs(forward - np.pi) <= THETA_TOLERANCE:
+        return True
+    notes.append(f"{at}: {forward:.3g} rad off the edge's direction; the planner's vehicle "
+                 "faces the path's tangent (or its opposite); planned forwards")
+    return False
 
 
 def _edge_path(raw: dict[str, Any], i: int, start: RouteNode, end: RouteNode,

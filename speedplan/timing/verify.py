@@ -41,6 +41,8 @@ TOLERANCES: dict[str, float] = {
     "yaw_rate": 0.001,
     "lateral_jerk": 0.05,
     "grip": 0.01,
+    "yaw_acc": 0.001,
+    "yaw_jerk": 0.001,
 }
 #: Every checked limit, in report order.
 LIMIT_NAMES = tuple(TOLERANCES)
@@ -61,7 +63,8 @@ class Verification:
         Each maximum divided by its limit (``"speed"`` against the local bound
         ``sqrt(mu+(s))``, which includes ``v_max``, lateral limits and zones); limits that are
         ``inf`` give 0, and so does the grip without ``grip="ellipse"``. A ratio above
-        ``1 + TOLERANCES[name]`` is a violation.
+        ``1 + TOLERANCES[name]`` is a violation. ``"yaw_acc"`` [rad/s²] and ``"yaw_jerk"`` [rad/s³] of turns on the spot appear in the
+        checks of routes that turn (:meth:`speedplan.RouteProfile.verify`).
     where : dict
         Arc length [m] at which each ratio is largest.
     max_speed, max_accel, max_decel, max_jerk, max_lateral : float
@@ -111,12 +114,16 @@ class Verification:
 
     @staticmethod
     def merged(parts: list[Verification]) -> Verification:
-        """The worst of several verifications (legs of one profile)."""
-        maxima = {k: max(p.maxima[k] for p in parts) for k in LIMIT_NAMES}
+        """The worst of several verifications (legs of one profile).
+
+        A quantity only some parts check (``"yaw_acc"`` of turns) is merged over those.
+        """
+        keys = [k for k in LIMIT_NAMES if any(k in p.ratios for p in parts)]
+        maxima = {k: max(p.maxima[k] for p in parts if k in p.maxima) for k in keys}
         ratios, where = {}, {}
-        for k in LIMIT_NAMES:
-            worst = max(parts, key=lambda p: (p.ratios[k] if np.isfinite(p.ratios[k])
-                                              else np.inf))
+        for k in keys:
+            worst = max((p for p in parts if k in p.ratios),
+                        key=lambda p: (p.ratios[k] if np.isfinite(p.ratios[k]) else np.inf))
             ratios[k] = worst.ratios[k]
             if k in worst.where:
                 where[k] = worst.where[k]
