@@ -64,7 +64,8 @@ class Verification:
         ``sqrt(mu+(s))``, which includes ``v_max``, lateral limits and zones); limits that are
         ``inf`` give 0, and so does the grip without ``grip="ellipse"``. A ratio above
         ``1 + TOLERANCES[name]`` is a violation. ``"yaw_acc"`` [rad/s²] and ``"yaw_jerk"``
-        [rad/s³] of turns on the spot appear in the checks of routes that turn (:meth:`speedplan.RouteProfile.verify`).
+        [rad/s³] of turns on the spot appear in the checks of routes that turn
+        (:meth:`speedplan.RouteProfile.verify`).
     where : dict
         Arc length [m] at which each ratio is largest.
     max_speed, max_accel, max_decel, max_jerk, max_lateral : float
