@@ -427,7 +427,7 @@ def _cold_starts(env: dict[str, str], plans: int) -> None:
     for label, out in (("empty cache (fresh environment)", fresh),
                        ("the same cache, filled (warm)", warm)):
         print(f"  {label:<44} {float(out[0]):>7.2f} {float(out[1]):>9.2f}"
-              f" {float(out[2]):>9.2f} {out[3]:>9} {out[4]:>12}s")
+              f" {float(out[2]):>9.2f} {out[3]:>9} {out[4] + ('' if out[4] == '-' else ' s'):>13}")
     ratio = (float(fresh[1]) + float(fresh[2])) / (float(warm[1]) + float(warm[2]))
     print(f"  plans in the fresh environment / warm: {ratio:.2f}; `speedplan compile` into an "
           f"empty cache: {t_compile:.1f} s")
@@ -465,7 +465,7 @@ def section_startup(import_runs: int, plans: int = 200, busy: int = 4) -> None:
           f"subprocesses (min {times[0]:.3f}, max {times[-1]:.3f}); heavy modules loaded: "
           f"{sorted(loaded - {''}) or 'none'}")
     print(f"a new process planning paths/u_turn.json {plans + 1} times [s]; 'banded after': "
-          f"when the compiled kernel first answered (from the import's end)")
+          f"when the compiled kernel first answered (from the import's end; '-': never)")
     print(f"- machine as it is (load average {os.getloadavg()[0]:.1f}):")
     _cold_starts(env, plans)
     procs = _busy(busy)
