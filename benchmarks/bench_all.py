@@ -257,10 +257,47 @@ def plan_and_problem(path: sp.Path, lim: sp.Limits, kw: dict[str, Any],
     return prof, t_ours, legs[0].problem if single else None
 
 
+def copp2_time(s: np.ndarray, w_max: np.ndarray, lim: sp.Limits,
+               repeats: int) -> tuple[float, float]:
+    """copp-py's TOPP2-RA, the whole call (constraints, reachability pass, time integration).
+
+    1-DOF path ``q = s`` on the grid ``s`` with the speed bound ``sqrt(w_max)`` per node,
+    ``a_max`` and ``a_decel``, rest to rest: the same discrete problem as ``plan(j_max=inf)``
+    solves. Returns the median time and copp's duration (``s_to_t_topp2``).
+    """
+    import copp_py as copp
+
+    n = s.size
+    v = np.maximum(np.sqrt(w_max), 1e-9)[:, None]
+
+    def run() -> float:
+        robot = copp.Robot(1)
+        robot.append_s(s)
+        robot.set_q(s[:, None], np.ones((n, 1)), np.zeros((n, 1)), 0)
+        robot.add_velocity_limits(v, -v, start_idx_s=0, length=n)
+        robot.add_acceleration_limits(np.array([lim.a_max]), np.array([-lim.a_decel]),
+                                      start_idx_s=0, length=n)
+        problem = copp.solver.topp2_ra.Problem(robot.constraints, idx_s_interval=(0, n - 1),
+                                               a_boundary=(0.0, 0.0))
+        a = copp.solver.topp2_ra.solve(problem)
+        return float(copp.interpolation.s_to_t_topp2(s, np.asarray(a))[0])
+
+    duration = run()
+    return median_time(run, repeats), duration
+
+
 def section_toppra(repeats: int) -> None:
-    print(f"\n== 3. plan(j_max=inf) against TOPP-RA compute_trajectory, medians of {repeats} ==")
+    print(f"\n== 3. plan(j_max=inf) against TOPP-RA compute_trajectory and copp-py TOPP2-RA "
+          f"(whole calls), medians of {repeats} ==")
+    try:
+        import copp_py  # noqa: F401
+        have_copp = True
+    except ImportError:
+        have_copp = False
+        print("copp-py is not installed (pip install copp-py, or the bench extra): its "
+              "columns are skipped")
     print(f"{'case':<22} {'n':>5} {'ours [ms]':>10} {'toppra [ms]':>12} {'ratio':>7}"
-          f" {'T ours':>9} {'T toppra':>9}")
+          f" {'copp2 [ms]':>11} {'ratio':>7} {'T ours':>9} {'T toppra':>9} {'T copp2':>9}")
     for name, path, lim, kw in cases()[:-1]:
         nojerk = sp.Limits(v_max=lim.v_max, a_max=lim.a_max, a_lat_max=lim.a_lat_max,
                            j_max=math.inf)
@@ -269,8 +306,11 @@ def section_toppra(repeats: int) -> None:
             print(f"{name:<22} skipped: several legs")
             continue
         t_ta, dur_ta = toppra_time(p.s, p.w_max, lim.a_max, repeats)
+        t_c2, dur_c2 = copp2_time(p.s, p.w_max, nojerk, repeats) if have_copp else (
+            math.nan, math.nan)
         print(f"{name:<22} {p.n:>5} {1e3 * t_ours:>10.2f} {1e3 * t_ta:>12.2f}"
-              f" {t_ta / t_ours:>7.1f} {prof.duration:>9.3f} {dur_ta:>9.3f}")
+              f" {t_ta / t_ours:>7.1f} {1e3 * t_c2:>11.2f} {t_c2 / t_ours:>7.2f}"
+              f" {prof.duration:>9.3f} {dur_ta:>9.3f} {dur_c2:>9.3f}")
 
 
 # --- 4. copp-py ------------------------------------------------------------------------------
@@ -336,34 +376,82 @@ def section_copp(repeats: int) -> None:
 # --- 5. import and cold start --------------------------------------------------------------
 
 
-def _run(code: str, env: dict[str, str]) -> str:
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         env=env, cwd=str(ROOT), timeout=600)
+def _run(code: str, env: dict[str, str], *args: str) -> str:
+    res = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                         env=env, cwd=str(ROOT), timeout=900)
     if res.returncode != 0:
         raise RuntimeError(res.stderr)
     return res.stdout.strip()
 
 
 COLD = """
-import time
+import sys, time
 t0 = time.perf_counter()
 import speedplan as sp
 from speedplan.io import read_path
 t1 = time.perf_counter()
-prof = sp.plan(read_path("paths/u_turn.json"), sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+path = read_path("paths/u_turn.json")
+lim = sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
+prof = sp.plan(path, lim)
 t2 = time.perf_counter()
-prof = sp.plan(read_path("paths/u_turn.json"), sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+first = prof.legs[0].solution.backend
+n_plans, banded_at = int(sys.argv[1]), None
+for _ in range(n_plans):
+    prof = sp.plan(path, lim)
+    if banded_at is None and "banded" in prof.solution.backend:
+        banded_at = time.perf_counter() - t1
 t3 = time.perf_counter()
-print(f"{t1 - t0:.3f} {t2 - t1:.3f} {t3 - t2:.3f} {prof.legs[0].solution.backend}", end="")
-from speedplan.solve.banded import _Kernel
-if _Kernel.background is not None:  # wait for the background compilation, and say how long
-    _Kernel.background.wait()
-    print(f"  (background compilation done {time.perf_counter() - t3:.1f} s later)", end="")
-print()
+print(f"{t1 - t0:.3f} {t2 - t1:.3f} {t3 - t2:.3f} {first} "
+      f"{'-' if banded_at is None else f'{banded_at:.1f}'}")
 """
 
 
-def section_startup(import_runs: int) -> None:
+def _busy(count: int) -> list[subprocess.Popen[bytes]]:
+    """``count`` processes that keep a core busy each (a loaded machine), until killed."""
+    return [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(count)]
+
+
+def _cold_starts(env: dict[str, str], plans: int) -> None:
+    print(f"  {'':<44} {'import':>7} {'1st plan':>9} {f'{plans} more':>9} {'backend':>9}"
+          f" {'banded after':>13}")
+    with tempfile.TemporaryDirectory() as cache:
+        fresh = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache}, str(plans)).split()
+        _wait_for_cache_locks(cache)  # the background compilation the fresh process started
+        warm = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache}, str(plans)).split()
+    with tempfile.TemporaryDirectory() as cache:
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "speedplan", "compile"],
+                       env={**env, "NUMBA_CACHE_DIR": cache}, check=True,
+                       stdout=subprocess.DEVNULL)
+        t_compile = time.perf_counter() - t0
+    for label, out in (("empty cache (fresh environment)", fresh),
+                       ("the same cache, filled (warm)", warm)):
+        print(f"  {label:<44} {float(out[0]):>7.2f} {float(out[1]):>9.2f}"
+              f" {float(out[2]):>9.2f} {out[3]:>9} {out[4] + ('' if out[4] == '-' else ' s'):>13}")
+    ratio = (float(fresh[1]) + float(fresh[2])) / (float(warm[1]) + float(warm[2]))
+    print(f"  plans in the fresh environment / warm: {ratio:.2f}; `speedplan compile` into an "
+          f"empty cache: {t_compile:.1f} s")
+
+
+def _wait_for_cache_locks(cache: str) -> None:
+    """Wait until no background compilation into ``cache`` holds its lock (cache filled)."""
+    from speedplan.core.jit import FAMILIES
+
+    before = os.environ.get("NUMBA_CACHE_DIR")
+    os.environ["NUMBA_CACHE_DIR"] = cache  # the locks are per cache directory
+    try:
+        locks = [family.lock_path() for family in FAMILIES.values()]
+    finally:
+        if before is None:
+            del os.environ["NUMBA_CACHE_DIR"]
+        else:
+            os.environ["NUMBA_CACHE_DIR"] = before
+    deadline = time.time() + 900
+    while any(os.path.exists(lock) for lock in locks) and time.time() < deadline:
+        time.sleep(0.5)
+
+
+def section_startup(import_runs: int, plans: int = 200, busy: int = 4) -> None:
     print("\n== 5. import speedplan and the first plan() ==")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(
         p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)}
@@ -376,18 +464,20 @@ def section_startup(import_runs: int) -> None:
     print(f"import speedplan: median {statistics.median(times):.3f} s over {import_runs} "
           f"subprocesses (min {times[0]:.3f}, max {times[-1]:.3f}); heavy modules loaded: "
           f"{sorted(loaded - {''}) or 'none'}")
-    print("first plan() of paths/u_turn.json in a new process [s]: import, first plan, second plan")
-    with tempfile.TemporaryDirectory() as cache:
-        cold = {**env, "NUMBA_CACHE_DIR": cache, "SPEEDPLAN_BACKGROUND_COMPILE": "0"}
-        t0 = time.perf_counter()
-        out = _run(COLD, cold)
-        print(f"  empty cache, waiting for the compilation:  {out}"
-              f"  (process {time.perf_counter() - t0:.2f} s)")
-        out = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache})
-        print(f"  same cache, now filled:                    {out}")
-    with tempfile.TemporaryDirectory() as cache:
-        out = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache})  # waits for its compilation
-        print(f"  empty cache, default (compiles in the background): {out}")
+    print(f"a new process planning paths/u_turn.json {plans + 1} times [s]; 'banded after': "
+          f"when the compiled kernel first answered (from the import's end; '-': never)")
+    print(f"- machine as it is (load average {os.getloadavg()[0]:.1f}):")
+    _cold_starts(env, plans)
+    procs = _busy(busy)
+    try:
+        time.sleep(2.0)
+        print(f"- with {busy} busy processes started here (load average "
+              f"{os.getloadavg()[0]:.1f}):")
+        _cold_starts(env, plans)
+    finally:
+        for proc in procs:
+            proc.kill()
+            proc.wait()
 
 
 # --- 6. memory and scaling of solve_discrete -----------------------------------------------
@@ -427,6 +517,104 @@ def section_refine(limit: int | None) -> None:
           f"{slow[1].status}")
 
 
+# --- 8. straight moves and a 30-edge order ------------------------------------------------
+
+#: The slowest straight move of the trust fuzz's draws (rest to rest).
+SLOW_STRAIGHT = (27.337, sp.Limits(v_max=1.0903, a_max=0.3025, a_lat_max=1.0, j_max=1.9522))
+
+
+def thirty_edge_order() -> dict[str, Any]:
+    """A deterministic VDA 5050 order: 31 nodes on a gently winding line, 30 straight edges.
+
+    The nodes allow a deviation of 0.1 m, so the corners are rounded and driven through.
+    """
+    k = np.arange(31)
+    x = 4.9 * k
+    y = 1.5 * np.sin(k / 3.0)
+    nodes = [{"nodeId": f"N{i}", "sequenceId": 2 * i, "released": True,
+              "nodePosition": {"x": float(x[i]), "y": float(y[i]), "mapId": "hall",
+                               "allowedDeviationXy": 0.1},
+              "actions": []} for i in range(31)]
+    edges = [{"edgeId": f"E{i}", "sequenceId": 2 * i + 1, "released": True,
+              "startNodeId": f"N{i}", "endNodeId": f"N{i + 1}", "actions": []}
+             for i in range(30)]
+    return {"headerId": 1, "timestamp": "2026-01-01T00:00:00Z", "version": "2.0.0",
+            "manufacturer": "bench", "serialNumber": "1", "orderId": "thirty-edges",
+            "orderUpdateId": 0, "nodes": nodes, "edges": edges}
+
+
+def section_straight(repeats: int, count: int) -> None:
+    sys.path.insert(0, str(ROOT / "tests"))
+    from oracles import ruckig_move
+    from trust_fuzz import draw_case
+
+    print(f"\n== 8. straight moves (the trust fuzz's draws, seed 0, {count} moves, all "
+          f"states) and a 30-edge order, medians of {repeats} ==")
+    rng = np.random.default_rng(0)
+    rows = []
+    for case in [draw_case(rng) for _ in range(count)]:
+        path = sp.Path.from_segments([Line(case.length)])
+        kw = {"v0": case.v0, "a0": case.a0, "vf": case.vf, "af": case.af}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                prof = sp.plan(path, case.limits, **kw)
+            except sp.SpeedplanError:
+                continue  # refused or infeasible: not a timing
+            t = median_time(lambda p=path, c=case, k=kw: sp.plan(p, c.limits, **k), repeats)
+        ref = ruckig_move(case.length, case.limits, **kw).duration
+        rows.append((t, prof, ref, not any(kw.values())))
+    times = sorted(r[0] for r in rows)
+    rest = sorted(r[0] for r in rows if r[3])
+    ratio = [r[1].duration / r[2] - 1.0 for r in rows if r[2]]
+    print(f"plan() on {len(rows)} feasible moves: median {1e3 * statistics.median(times):.2f} "
+          f"ms, 90 % {1e3 * times[int(0.9 * (len(times) - 1))]:.2f} ms, max "
+          f"{1e3 * times[-1]:.2f} ms; duration / ruckig - 1: max {max(ratio):.1e}, "
+          f"min {min(ratio):.1e}")
+    if rest:
+        print(f"  of them {len(rest)} rest to rest: median {1e3 * statistics.median(rest):.2f} ms, "
+              f"max {1e3 * rest[-1]:.2f} ms")
+    length, lim = SLOW_STRAIGHT
+    path = sp.Path.from_segments([Line(length)])
+    prof = sp.plan(path, lim)
+    t = median_time(lambda: sp.plan(path, lim), repeats)
+    stages: dict[str, list[float]] = defaultdict(list)
+    from speedplan.model import build as build_mod  # adaptive_grid as plan() calls it
+
+    with _timed(build_mod, "adaptive_grid", stages):
+        sp.plan(path, lim)
+    t_grid = sum(stages["adaptive_grid"])
+    print(f"{length} m rest to rest (v_max={lim.v_max}, a_max={lim.a_max}, j_max={lim.j_max})"
+          f": {1e3 * t:.1f} ms on {prof.s.size} nodes (grid {1e3 * t_grid:.1f} ms), "
+          f"T = {prof.duration:.9f} s, ruckig {ruckig_move(length, lim).duration:.9f} s")
+    route = sp.Route.from_vda5050(thirty_edge_order())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rp = sp.plan_route(route, LGV)
+        t = median_time(lambda: sp.plan_route(route, LGV), repeats)
+    print(f"30-edge order ({route.length:.1f} m, {len(rp.legs)} legs), LGV limits: "
+          f"{1e3 * t:.1f} ms, T = {rp.duration:.3f} s")
+
+
+@contextmanager
+def _timed(module: Any, name: str, into: dict[str, list[float]]) -> Iterator[None]:
+    """Time every call of ``module.name`` (inclusive) into ``into[name]``."""
+    original = getattr(module, name)
+
+    def wrapped(*args: Any, **kwargs: Any) -> Any:
+        t0 = time.perf_counter()
+        try:
+            return original(*args, **kwargs)
+        finally:
+            into[name].append(time.perf_counter() - t0)
+
+    setattr(module, name, wrapped)
+    try:
+        yield
+    finally:
+        setattr(module, name, original)
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
@@ -435,12 +623,15 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seeds", type=int, nargs="+", default=[0],
                     help="section 6: one random draw per seed (the target's is seed 0)")
     ap.add_argument("--quick", action="store_true", help="3 repeats, sizes 1 k and 10 k")
-    ap.add_argument("--only", nargs="+", type=int, choices=range(1, 8),
+    ap.add_argument("--straight", type=int, default=40, help="section 8: straight moves")
+    ap.add_argument("--plans", type=int, default=200,
+                    help="section 5: plans per process in the cold-start runs")
+    ap.add_argument("--only", nargs="+", type=int, choices=range(1, 9),
                     help="run only these sections")
     args = ap.parse_args(argv)
     repeats = 3 if args.quick else args.repeats
     sizes = [1000, 10000] if args.quick else [10000, 100000]
-    only = set(args.only or range(1, 8))
+    only = set(args.only or range(1, 9))
     print(f"speedplan {sp.__version__} from {os.path.dirname(sp.__file__)}; "
           f"cores: {os.cpu_count()}; load average {os.getloadavg()[0]:.1f}")
     compile_kernel()
@@ -453,11 +644,13 @@ def main(argv: list[str] | None = None) -> None:
     if 4 in only:
         section_copp(repeats)
     if 5 in only:
-        section_startup(args.import_runs)
+        section_startup(args.import_runs, plans=20 if args.quick else args.plans)
     if 6 in only:
         section_memory(sizes, 3 if args.quick else args.rounds, args.seeds)
     if 7 in only:
         section_refine(20 if args.quick else None)
+    if 8 in only:
+        section_straight(repeats, 10 if args.quick else args.straight)
 
 
 if __name__ == "__main__":

@@ -177,7 +177,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     ap.add_argument("--version", action="version", version=f"speedplan {__version__}")
     _add_verbose(ap, False)
-    sub = ap.add_subparsers(dest="command", required=True, metavar="{plan,demo,bench}")
+    sub = ap.add_subparsers(dest="command", required=True, metavar="{plan,demo,bench,compile}")
     p = sub.add_parser(
         "plan", help="plan a path file (CSV waypoints, JSON segments, VDA 5050 edge or order)",
         description="Plan the minimum-time speed law along a path file and report it; a VDA "
@@ -210,7 +210,31 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--instances", type=_positive(int), default=3, help="instances per family")
     b.add_argument("--n", type=_positive(int), default=1000, help="grid size")
     _add_verbose(b, argparse.SUPPRESS)
+    c = sub.add_parser(
+        "compile", help="compile the solver's kernels into numba's cache (once per install)",
+        description="Compile every compiled kernel (relaxation, time law, refinement) into "
+        "numba's on-disk cache, in parallel processes, and wait for them. Run it once after "
+        "installing (in CI, a container build, a fresh virtual environment): the first plan "
+        "then runs the compiled kernels instead of their fallbacks. The cache is next to the "
+        "package, or under NUMBA_CACHE_DIR.",
+        formatter_class=_HelpFormatter)
+    c.add_argument("--serial", action="store_true",
+                   help="compile in this process, one family after the other")
+    _add_verbose(c, argparse.SUPPRESS)
     return ap
+
+
+def _run_compile(args: argparse.Namespace) -> int:
+    from .core.jit import compile_families
+
+    try:
+        seconds = compile_families(parallel=not args.serial)
+    except RuntimeError as exc:
+        print(f"speedplan: {exc}", file=sys.stderr)
+        return EXIT_CODES["solver"]
+    for name, sec in seconds.items():
+        print(f"{name}: ready after {sec:.1f} s")
+    return EXIT_CODES["ok"]
 
 
 # ---- checks done before planning ------------------------------------------------------------
@@ -526,6 +550,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _run_plan(args, args.pathfile)
         if args.command == "demo":
             return _run_plan(args, _bundled_paths_dir() / DEMO_PATH)
+        if args.command == "compile":
+            return _run_compile(args)
         return _run_bench(args)
     except BrokenPipeError:  # the reader of our output left (e.g. `| head`): stop quietly
         devnull = os.open(os.devnull, os.O_WRONLY)

@@ -11,6 +11,13 @@ from speedplan.solve.clarabel_ import solve_relaxation
 from speedplan.solve.paper import FAMILIES, paper_instance
 from speedplan.solve.problem import DiscreteProblem
 
+
+def _py(kernel):
+    """A kernel of the banded iteration, callable from Python."""
+    from speedplan.solve._banded_ipm import python_callable
+
+    return python_callable(kernel)
+
 N = 200
 EXACT_TOL = 1e-5  # the paper's exactness threshold on a jerk row
 
@@ -211,11 +218,11 @@ def _newton_state(seed: int):
     pt.ys[:] = rng.normal(size=(3, lay.nc))
     pt.ys[0] = np.hypot(pt.ys[1], pt.ys[2]) * (1.0 + 10.0 ** rng.uniform(-2, 0, lay.nc))
     sc = ipm.Scaling.identity(lay)
-    ipm.scaling_into(pt, sc)
+    _py(ipm.scaling_into)(pt, sc)
     fac = ipm.empty(ipm.Factor, lay)
-    assert ipm.factor_into(d, sc, pt.yl, pt.sl, fac)
+    assert _py(ipm.factor_into)(d, sc, pt.yl, pt.sl, fac)
     res = ipm.empty(ipm.Residual, lay)
-    ipm.dual_residual_into(d, pt, res)  # newton_into's bx is the iterate's dual residual
+    _py(ipm.dual_residual_into)(d, pt, res)  # newton_into's bx is the iterate's dual residual
     return ipm, d, sc, fac, pt, res, float(rng.normal())
 
 
@@ -229,13 +236,13 @@ def test_newton_refines_only_above_its_residual_threshold(seed):
     def direction(refine_above):
         dn = ipm.empty(ipm.Direction, lay)
         bx = [a.copy() for a in res]
-        ipm.newton_into(d, sc, fac, pt, res, rp, False, 0.0,
+        _py(ipm.newton_into)(d, sc, fac, pt, res, rp, False, 0.0,
                         refine_above, dn)
         # The refinement forms its right-hand side in res and puts bx back, bit for bit.
         for a, b in zip(res, bx, strict=True):
             np.testing.assert_array_equal(a, b)
         gx = (np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m))
-        ipm.g_adjoint_into(d, dn.dyl, dn.dys, *gx)
+        _py(ipm.g_adjoint_into)(d, dn.dyl, dn.dys, *gx)
         residual = np.sqrt(sum(float(np.sum((b - g) ** 2))
                                for b, g in zip((res.gw, res.gt, res.gz), gx, strict=True)))
         return dn, residual

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from speedplan.core import jit
 from speedplan.solve import banded, discrete
 from speedplan.solve.paper import paper_instance
 from speedplan.solve.problem import DiscreteProblem
@@ -41,14 +42,22 @@ class _FakeCompile:
 def cold(monkeypatch, tmp_path):
     """A process whose kernel is neither compiled nor cached; spawns are recorded."""
     state = {"cached": False, "spawned": [], "compiled": 0}
-    monkeypatch.setattr(banded, "_lock_path", lambda: str(tmp_path / "compile.lock"))
-    monkeypatch.setattr(banded._Kernel, "ready", False)
-    monkeypatch.setattr(banded._Kernel, "background", None)
-    monkeypatch.setattr(banded._Kernel, "spawn_failed", False)
-    monkeypatch.delenv(banded.BACKGROUND_COMPILE_ENV, raising=False)
-    monkeypatch.setattr(banded, "_load_from_disk_cache", lambda: state["cached"])
+    kernels = banded.KERNELS
+    module = kernels.compile()  # the real kernel module, compiled by the conftest
+    monkeypatch.setattr(kernels, "lock_path", lambda: str(tmp_path / "compile.lock"))
+    monkeypatch.setattr(kernels, "module", None)
+    monkeypatch.setattr(kernels, "background", None)
+    monkeypatch.setattr(kernels, "spawn_failed", False)
+    monkeypatch.setattr(kernels, "then", ())
+    monkeypatch.delenv(jit.BACKGROUND_COMPILE_ENV, raising=False)
 
-    def spawn():
+    def load():
+        if state["cached"]:
+            kernels.module = module
+        return state["cached"]
+
+    def spawn(names):
+        assert names == ["relaxation"]
         (tmp_path / "compile.lock").unlink()  # as the real process does when it is done
         proc = _FakeCompile()
         state["spawned"].append(proc)
@@ -56,10 +65,12 @@ def cold(monkeypatch, tmp_path):
 
     def compile_now():
         state["compiled"] += 1
-        banded._Kernel.ready = True
+        kernels.module = module
+        return module
 
-    monkeypatch.setattr(banded, "_spawn_compile", spawn)
-    monkeypatch.setattr(banded, "compile_kernel", compile_now)
+    monkeypatch.setattr(kernels, "load", load)
+    monkeypatch.setattr(jit, "spawn_compile", spawn)
+    monkeypatch.setattr(kernels, "compile", compile_now)
     return state
 
 
@@ -94,7 +105,7 @@ def test_auto_waits_for_the_kernel_on_large_grids(cold, monkeypatch):
 
 
 def test_background_compilation_can_be_switched_off(cold, monkeypatch):
-    monkeypatch.setenv(banded.BACKGROUND_COMPILE_ENV, "0")
+    monkeypatch.setenv(jit.BACKGROUND_COMPILE_ENV, "0")
     assert discrete.solve_problem(_problem(200), backend="auto").backend == "banded"
     assert cold["compiled"] == 1 and not cold["spawned"]
 
@@ -107,7 +118,7 @@ def test_only_one_process_compiles(cold, tmp_path, monkeypatch):
     p = _problem(200)
     assert discrete.solve_problem(p, backend="auto").backend == "clarabel"
     assert not cold["spawned"] and cold["compiled"] == 0
-    old = lock.stat().st_mtime - banded.COMPILE_LOCK_STALE - 1
+    old = lock.stat().st_mtime - jit.COMPILE_LOCK_STALE - 1
     os.utime(lock, (old, old))
     assert discrete.solve_problem(p, backend="auto").backend == "clarabel"
     assert len(cold["spawned"]) == 1

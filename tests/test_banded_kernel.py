@@ -13,6 +13,7 @@ import pytest
 import scipy.linalg
 
 from speedplan.solve import _banded_ipm as ipm
+from speedplan.solve._banded_ipm import python_callable as _py
 from speedplan.solve.banded import _prepare, unit_scales
 from speedplan.solve.nojerk import positive_feasible_w
 from speedplan.solve.paper import paper_instance
@@ -111,14 +112,14 @@ def test_constraint_map_matches_the_definition_and_its_adjoint(seed):
     x = rng.normal(size=3 * lay.m)
     w, t, z = np.split(x, 3)
     out_lin, out_soc = np.zeros(lay.n_lin), np.zeros((3, lay.nc))
-    ipm.g_lin_into(d, w, t, out_lin)
-    ipm.g_soc_into(w, t, z, out_soc)
+    _py(ipm.g_lin_into)(d, w, t, out_lin)
+    _py(ipm.g_soc_into)(w, t, z, out_soc)
     np.testing.assert_allclose(out_lin, g_lin @ x, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(out_soc, g_soc @ x, rtol=1e-12, atol=1e-12)
     # Adjoint: <G x, y> = <x, G' y>, and G' y is the dense transpose applied.
     yl, ys = rng.normal(size=lay.n_lin), rng.normal(size=(3, lay.nc))
     gw, gt, gz = np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m)
-    ipm.g_adjoint_into(d, yl, ys, gw, gt, gz)
+    _py(ipm.g_adjoint_into)(d, yl, ys, gw, gt, gz)
     gty = np.concatenate((gw, gt, gz))
     lhs = float(out_lin @ yl + np.sum(out_soc * ys))
     assert lhs == pytest.approx(float(x @ gty), rel=1e-12)
@@ -133,7 +134,7 @@ def test_constraint_map_matches_the_definition_and_its_adjoint(seed):
                        (ipm.ADJ_ADD, gty + np.concatenate(g0)),
                        (ipm.ADJ_DUAL_RESIDUAL, -(gty + ct))):
         got = [a.copy() for a in g0]
-        norms = ipm.g_adjoint_into(d, yl, ys, *got, mode)
+        norms = _py(ipm.g_adjoint_into)(d, yl, ys, *got, mode)
         np.testing.assert_array_equal(np.concatenate(got), want)
         assert norms == pytest.approx([float(a @ a) for a in got], rel=1e-13)
 
@@ -148,7 +149,7 @@ def test_max_step_is_the_step_to_the_cone_boundary(seed):
     nc = 40
     u = _interior_cones(rng, nc)
     du = rng.normal(size=(3, nc)) * 10.0 ** rng.uniform(-1, 1)
-    alpha = ipm.max_step_soc(u, du)
+    alpha = _py(ipm.max_step_soc)(u, du)
     # Per cone by bisection on membership; the kernel's step is the smallest one.
     steps = []
     for c in range(nc):
@@ -167,8 +168,8 @@ def test_max_step_is_the_step_to_the_cone_boundary(seed):
     ul = 10.0 ** rng.uniform(-2, 2, 50)
     dul = rng.normal(size=50)
     ref = min((-ul[dul < 0] / dul[dul < 0]), default=np.inf)
-    assert ipm.max_step_lin(ul, dul) == pytest.approx(ref, rel=1e-14)
-    assert ipm.max_step_lin(ul, np.abs(dul)) == np.inf
+    assert _py(ipm.max_step_lin)(ul, dul) == pytest.approx(ref, rel=1e-14)
+    assert _py(ipm.max_step_lin)(ul, np.abs(dul)) == np.inf
 
 
 @pytest.mark.parametrize("seed", range(3))
@@ -179,19 +180,19 @@ def test_nesterov_todd_scaling_identities(seed):
     lay = ipm.layout(nc // 2, 0, 0)
     sc = ipm.Scaling.identity(lay)
     for c in range(nc):
-        ipm.cone_scaling_into(sc, c, *s[:, c], *y[:, c])
+        _py(ipm.cone_scaling_into)(sc, c, *s[:, c], *y[:, c])
     for c in range(nc):
         w = _w_matrix(sc, c)
-        lam = np.array(ipm._lambda(sc, y, c))
+        lam = np.array(_py(ipm._lambda)(sc, y, c))
         np.testing.assert_allclose(w @ y[:, c], lam, rtol=1e-10, atol=1e-12)  # W y = λ
         np.testing.assert_allclose(np.linalg.solve(w, s[:, c]), lam, rtol=1e-9, atol=1e-12)
         np.testing.assert_allclose(w @ J @ w, sc.beta[c] ** 2 * J, rtol=1e-10, atol=1e-12)
         h = np.linalg.inv(w @ w)
         for k in range(3):
             e = np.eye(3)[k]
-            np.testing.assert_allclose(ipm._apply_h(sc, *e, c), h[:, k], rtol=1e-9,
+            np.testing.assert_allclose(_py(ipm._apply_h)(sc, *e, c), h[:, k], rtol=1e-9,
                                        atol=1e-12 * np.abs(h).max())
-            np.testing.assert_allclose(ipm._apply_winv(sc, *e, c), np.linalg.inv(w)[:, k],
+            np.testing.assert_allclose(_py(ipm._apply_winv)(sc, *e, c), np.linalg.inv(w)[:, k],
                                        rtol=1e-9, atol=1e-12 * np.abs(h).max())
 
 
@@ -220,9 +221,9 @@ def _random_state(seed: int):
     pt.sl[:], pt.yl[:] = 10.0 ** rng.uniform(-1, 1, (2, lay.n_lin))
     pt.ys[:] = _interior_cones(rng, lay.nc)
     sc = ipm.Scaling.identity(lay)
-    ipm.scaling_into(pt, sc)
+    _py(ipm.scaling_into)(pt, sc)
     fac = ipm.empty(ipm.Factor, lay)
-    assert ipm.factor_into(d, sc, pt.yl, pt.sl, fac)
+    assert _py(ipm.factor_into)(d, sc, pt.yl, pt.sl, fac)
     g_lin, g_soc = _dense_g(unit, d)
     # Dense H = W⁻²: diag(y / s) on the linear rows, inv(W_c)² per cone (cone-major order).
     g_cones = np.concatenate([g_soc[:, c, :] for c in range(lay.nc)])
@@ -242,8 +243,8 @@ def test_cone_slacks_are_b_minus_g_x(seed):
     s_ref, ds_ref = _b_soc(lay.m) - g_soc @ x, -(g_soc @ dx)
     dw, dt, dz = np.split(dx, 3)
     for c in range(lay.nc):
-        np.testing.assert_allclose(ipm._cone_s(pt.w, pt.t, pt.z, c), s_ref[:, c], rtol=1e-14)
-        np.testing.assert_allclose(ipm._cone_ds(dw, dt, dz, c), ds_ref[:, c], rtol=1e-14)
+        np.testing.assert_allclose(_py(ipm._cone_s)(pt.w, pt.t, pt.z, c), s_ref[:, c], rtol=1e-14)
+        np.testing.assert_allclose(_py(ipm._cone_ds)(dw, dt, dz, c), ds_ref[:, c], rtol=1e-14)
     # The scaling is the one of those slacks: W⁻¹ s = W y.
     for c in range(lay.nc):
         w = _w_matrix(sc, c)
@@ -264,7 +265,7 @@ def test_reduced_matrix_is_the_schur_complement_and_its_banded_solve(seed):
     assert np.all(np.abs(np.tril(schur, -3)) <= 1e-12 * np.abs(schur).max())
     b = rng.normal(size=m)
     x = b.copy()
-    ipm.solve_banded_inplace(fac, x)
+    _py(ipm.solve_banded_inplace)(fac, x)
     ab = np.zeros((3, m))  # upper banded form for solveh_banded
     for k in range(3):
         ab[2 - k, k:] = np.diag(schur, k)
@@ -278,7 +279,7 @@ def test_normal_equations_solve_matches_a_dense_solve(seed):
     m = d.lay.m
     r = rng.normal(size=3 * m)
     x = r.copy()
-    ipm.solve_normal_inplace(d, fac, x[:m], x[m : 2 * m], x[2 * m :])
+    _py(ipm.solve_normal_inplace)(d, fac, x[:m], x[m : 2 * m], x[2 * m :])
     np.testing.assert_allclose(x, np.linalg.solve(k_mat, r), rtol=1e-8,
                                atol=1e-10 * np.abs(x).max())
 
@@ -299,13 +300,13 @@ def test_newton_direction_solves_the_full_kkt_system(seed, refine_above, correct
     lay = d.lay
     m, nl, nc = lay.m, lay.n_lin, lay.nc
     res = ipm.empty(ipm.Residual, lay)
-    ipm.dual_residual_into(d, pt, res)  # newton_into's bx is the iterate's dual residual
+    _py(ipm.dual_residual_into)(d, pt, res)  # newton_into's bx is the iterate's dual residual
     rp, sigma_mu = float(rng.normal()), float(10.0 ** rng.uniform(-2, 0))
     dn = ipm.empty(ipm.Direction, lay)
     for arr in dn:  # the predictor's direction, read by the corrector
         arr[:] = rng.normal(size=arr.shape)
     pred = [np.copy(a) for a in dn]
-    ipm.newton_into(d, sc, fac, pt, res, rp, corrector, sigma_mu,
+    _py(ipm.newton_into)(d, sc, fac, pt, res, rp, corrector, sigma_mu,
                     refine_above, dn)
     # Unknowns: Δx (3m), Δs_lin (nl), Δs_soc (3 nc, cone-major), Δy_lin, Δy_soc.
     g_cones = np.concatenate([g_soc[:, c, :] for c in range(nc)])
@@ -364,7 +365,8 @@ def test_linear_rows_primal_residual_stays_one_number(seed, iterations):
     assert np.abs(r).max() > 1e-6  # the shift is not yet gone
     assert np.ptp(r) <= 1e-12 * max(1.0, float(np.abs(b).max()))
     # The logged primal residual of the last iteration is that of the iterate.
-    _, _, _, ry2, _ = ipm.residuals_into(d, pt, ipm.empty(ipm.Residual, lay), np.zeros(lay.n_lin))
+    _, _, _, ry2, _ = _py(ipm.residuals_into)(d, pt, ipm.empty(ipm.Residual, lay),
+                                              np.zeros(lay.n_lin))
     assert ry2 == pytest.approx(float(r @ r), rel=1e-9)
 
 

@@ -109,3 +109,17 @@ def test_an_accelerating_arrival_after_a_speed_dip_is_planned():
                       j_max=lim.j_max * max(m.jerk, 1.0))
     assert profile.duration >= ruckig_duration(length, reached, **states) * (1 - 1e-9)
     assert profile.duration <= ruckig_duration(length, lim, **states) * (1 + 1e-3)
+
+
+@given(st.floats(1e-3, 1e3), st.floats(1e-2, 1e2), st.floats(1e-2, 1e2))
+def test_the_max_jerk_start_from_rest_covers_its_distance(length, j, a_max):
+    # From rest with constant jerk j the distance is j t³ / 6 and the speed j t² / 2 until the
+    # acceleration reaches a_max (t1 = a_max / j), then w grows by 2 a_max per metre.
+    d = np.linspace(0.0, length, 257)
+    w = jerk_motion_w(d, 0.0, 0.0, j, a_max)
+    t1 = a_max / j
+    s1 = j * t1**3 / 6.0
+    t = np.cbrt(6.0 * np.minimum(d, s1) / j)
+    expected = np.where(d <= s1, (0.5 * j * t * t) ** 2,
+                        (0.5 * j * t1 * t1) ** 2 + 2.0 * a_max * (d - s1))
+    np.testing.assert_allclose(w, expected, rtol=1e-12, atol=1e-300)

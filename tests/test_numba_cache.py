@@ -4,7 +4,7 @@ Numba pickles every compiled signature, with its argument types, into one index 
 function. When a ``NamedTuple`` argument class is later removed (the banded kernel's
 ``Work`` went in the eighth session), an index left in ``__pycache__`` by the earlier
 version failed to unpickle and numba raised ``AttributeError`` from the first call
-(numba issue #6018). :func:`speedplan.core._numba_cache.tolerate_stale_indexes` makes it
+(numba issue #6018). :func:`speedplan.core.jit.tolerate_stale_indexes` makes it
 read as obsolete.
 """
 
@@ -37,7 +37,7 @@ _VERSIONS = {
     1: {"gone": "class Gone(NamedTuple):\n        a: np.ndarray", "arg": "Gone(np.ones(3))"},
     2: {"gone": "#\n    #", "arg": "Kept(np.ones(4))"},
 }
-_HARDEN = ("from speedplan.core._numba_cache import tolerate_stale_indexes; "
+_HARDEN = ("from speedplan.core.jit import tolerate_stale_indexes; "
            "tolerate_stale_indexes()")
 
 

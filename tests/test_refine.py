@@ -131,7 +131,7 @@ def _small_problem(rng) -> DiscreteProblem:
 def test_compiled_kernels_compute_what_the_numpy_path_computes(elastic):
     # Every step of an iteration, on a random point: same formulas, only the rounding of the
     # sums and of the banded factorisation may differ.
-    kn = banded_nlp._load_kernels(wait=True)
+    kn = banded_nlp.KERNELS.compile()
     rng = np.random.default_rng(1)
     p = _small_problem(rng)
     rows = banded_nlp._Rows(p)
@@ -190,20 +190,25 @@ def test_compiled_kernels_compute_what_the_numpy_path_computes(elastic):
 @pytest.fixture
 def cold_kernels(monkeypatch, tmp_path):
     """A process whose refinement kernels are neither loaded nor cached; spawns recorded."""
-    from speedplan.solve import banded
+    from speedplan.core import jit
 
-    kn = banded_nlp._load_kernels(wait=True)
+    kernels = banded_nlp.KERNELS
+    kn = kernels.compile()
     state = {"cached": False, "spawned": [], "compiled": 0}
-    monkeypatch.setattr(banded_nlp._KernelState, "module", None)
-    monkeypatch.setattr(banded_nlp._KernelState, "background", None)
-    monkeypatch.setattr(banded_nlp._KernelState, "spawn_failed", False)
-    monkeypatch.delenv(banded.BACKGROUND_COMPILE_ENV, raising=False)
+    monkeypatch.setattr(kernels, "module", None)
+    monkeypatch.setattr(kernels, "background", None)
+    monkeypatch.setattr(kernels, "spawn_failed", False)
+    monkeypatch.setattr(kernels, "lock_path", lambda: str(tmp_path / "nlp.lock"))
+    monkeypatch.delenv(jit.BACKGROUND_COMPILE_ENV, raising=False)
 
-    def load(*, wait):
-        if not (state["cached"] or wait):
-            return None
-        state["compiled"] += not state["cached"]
-        banded_nlp._KernelState.module = kn
+    def load():
+        if state["cached"]:
+            kernels.module = kn
+        return state["cached"]
+
+    def compile_now():
+        state["compiled"] += 1
+        kernels.module = kn
         return kn
 
     class Proc:
@@ -212,15 +217,15 @@ def cold_kernels(monkeypatch, tmp_path):
         def poll(self):
             return self.code
 
-    def spawn(module, function, lock):
-        assert (module, function) == ("speedplan.solve.banded_nlp", "compile_nlp_kernels")
-        os.remove(lock)  # as the real process does when it is done
+    def spawn(names):
+        assert names == ["refinement"]
+        os.remove(tmp_path / "nlp.lock")  # as the real process does when it is done
         state["spawned"].append(Proc())
         return state["spawned"][-1]
 
-    monkeypatch.setattr(banded_nlp, "_load_kernels", load)
-    monkeypatch.setattr(banded, "_kernel_lock_path", lambda f: str(tmp_path / "nlp.lock"))
-    monkeypatch.setattr(banded, "_spawn_compile_of", spawn)
+    monkeypatch.setattr(kernels, "load", load)
+    monkeypatch.setattr(kernels, "compile", compile_now)
+    monkeypatch.setattr(jit, "spawn_compile", spawn)
     return state, kn
 
 
@@ -234,10 +239,10 @@ def test_the_numpy_path_answers_while_the_kernels_compile_in_the_background(cold
 
 
 def test_without_background_compilation_the_kernels_compile_here(cold_kernels, monkeypatch):
-    from speedplan.solve import banded
+    from speedplan.core import jit
 
     state, kn = cold_kernels
-    monkeypatch.setenv(banded.BACKGROUND_COMPILE_ENV, "0")
+    monkeypatch.setenv(jit.BACKGROUND_COMPILE_ENV, "0")
     assert banded_nlp._kernels() is kn
     assert state["compiled"] == 1 and not state["spawned"]
 

@@ -1,9 +1,8 @@
 """Compiled quadrature, time inversion and kinematics of :class:`~speedplan.timing.law.TimeLaw`.
 
 Plain arrays in, plain arrays out (the law's chain of quadratic pieces in ``w`` or
-``u = w^{3/4}``); it lives in ``core`` so that :func:`speedplan.solve.banded.compile_kernel`
-(and with it the background compilation of a fresh environment) compiles it together with
-the banded kernel, without the solver layer importing the timing layer.
+``u = w^{3/4}``); it lives in ``core`` next to :mod:`speedplan.core.jit`, which compiles it
+(the ``"time law"`` family) without the core layer importing the timing layer.
 
 The time inversion: on a ``w``-piece moving at both ends whose time the quadrature gets to
 rounding (``TimeLaw._exact_inverse``), the offset reached at time ``τ`` is the exact solution
@@ -17,9 +16,10 @@ the piece's time), started from the third-order kinematic expansion at the left 
 agree with the numpy formulation to rounding (sampled states within 2e-15 of their scale on
 every sample path). Used by
 :mod:`speedplan.timing.law` once numba is loaded (before that, the same formulas in numpy:
-``speedplan.timing._law_numpy``): ``import speedplan`` stays free of numba. Explicit
-signatures, cached on disk: with numba's runtime loaded (the banded kernel) the module loads
-in ~20 ms; compiling it takes 1.5-5 s, once per installation.
+``speedplan.timing._law_numpy``): ``import speedplan`` stays free of numba. The entry points'
+explicit signatures are in :func:`signatures`; :mod:`speedplan.core.jit` loads them from
+numba's cache (~20 ms with numba's runtime loaded) or compiles them (1.5-5 s, once per
+installation).
 """
 
 from __future__ import annotations
@@ -30,8 +30,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from ._numba_cache import tolerate_stale_indexes
 from .checks import FloatArray, IntArray
+from .jit import tolerate_stale_indexes
 from .numerics import GAUSS_NODES, GAUSS_WEIGHTS
 
 tolerate_stale_indexes()  # before any kernel below is loaded from the cache
@@ -53,7 +53,7 @@ Pieces = tuple[FloatArray, FloatArray, FloatArray, FloatArray, np.ndarray, Float
                FloatArray]
 
 
-@njit(f"f8({_PIECES}, i8, f8, f8)", cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _speed(pieces: Pieces, j: int, dx: float, dr: float) -> float:
     """``v`` at offsets ``(dx, dr)`` of piece ``j``: ``TimeLaw._speed`` for one point."""
     _x, y, g, c, is_u, y_right, g_right = pieces
@@ -68,7 +68,7 @@ def _speed(pieces: Pieces, j: int, dx: float, dr: float) -> float:
     return math.sqrt(val)
 
 
-@njit(f"UniTuple(f8, 4)({_PIECES}, i8, f8, f8)", cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _state(pieces: Pieces, j: int, dx: float, dr: float) -> tuple[float, float, float, float]:
     """``w, v, a, jerk`` at offsets ``(dx, dr)`` of piece ``j``.
 
@@ -94,7 +94,7 @@ def _state(pieces: Pieces, j: int, dx: float, dr: float) -> tuple[float, float, 
     return val, v, 0.5 * dy, 0.5 * cj * v
 
 
-@njit(f"f8({_PIECES}, i8, f8, f8, b1, f8[:, ::1])", cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _integral(pieces: Pieces, j: int, lo: float, hi: float, right: bool,
               rule: FloatArray) -> float:
     """``TimeLaw._integral`` for one stretch ``[lo, hi]`` of piece ``j``."""
@@ -136,8 +136,7 @@ def _integral(pieces: Pieces, j: int, lo: float, hi: float, right: bool,
     return total
 
 
-@njit(f"void({_PIECES}, i8[::1], f8[::1], f8[::1], b1[::1], f8[:, ::1], f8[::1])",
-      cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _integrals_into(pieces: Pieces, j: IntArray, lo: FloatArray, hi: FloatArray,
                     right: BoolArray, rule: FloatArray, out: FloatArray) -> None:
     for k in range(j.size):
@@ -154,7 +153,7 @@ def integrals(pieces: Any, j: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     return out
 
 
-@njit("b1(f8, f8, f8, f8, f8, f8)", cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _step_settles(e: float, v: float, acc: float, jerk: float, ttol: float,
                   width: float) -> bool:
     """Whether a Newton step of length ``e`` [m] lands within the time tolerance ``ttol``.
@@ -173,7 +172,7 @@ def _step_settles(e: float, v: float, acc: float, jerk: float, ttol: float,
     return 10.0 * err <= 0.25 * ttol * v
 
 
-@njit("f8(f8, f8, f8, f8)", cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _moving_offset(tau: float, y0: float, g0: float, c0: float) -> float:
     """Offset reached at time ``tau`` from a knot where ``w = y0 > 0``: the exact solution.
 
@@ -194,8 +193,7 @@ def _moving_offset(tau: float, y0: float, g0: float, c0: float) -> float:
     return math.sqrt(y0) * tau * s_full + 0.25 * g0 * tau * tau * s_half * s_half
 
 
-@njit(f"void({_PIECES}, f8[::1], i8[::1], f8[::1], f8[:, ::1], b1[::1], f8[::1], f8[::1])",
-      cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _invert_into(pieces: Pieces, T: FloatArray, j: IntArray, t: FloatArray, rule: FloatArray,
                  exact: BoolArray, dx_out: FloatArray, dr_out: FloatArray) -> None:
     """Offsets reached at times ``t`` in pieces ``j`` (``TimeLaw._invert``).
@@ -301,8 +299,7 @@ def invert(pieces: Any, T: np.ndarray, j: np.ndarray, t: np.ndarray, exact: np.n
     return dx, dr
 
 
-@njit(f"void({_PIECES}, i8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])",
-      cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _kinematics_into(pieces: Pieces, j: IntArray, dx: FloatArray, dr: FloatArray,
                      w_out: FloatArray, v_out: FloatArray, a_out: FloatArray,
                      jerk_out: FloatArray) -> None:
@@ -331,3 +328,15 @@ def _arrays(p: Any) -> Pieces:
     return (np.ascontiguousarray(p.x), np.ascontiguousarray(p.y), np.ascontiguousarray(p.g),
             np.ascontiguousarray(p.c), np.ascontiguousarray(p.is_u),
             np.ascontiguousarray(p.y_right), np.ascontiguousarray(p.g_right))
+
+
+def signatures() -> dict[str, str]:
+    """Every kernel called from Python and its signature (see :mod:`speedplan.core.jit`)."""
+    return {
+        "_integrals_into":
+            f"void({_PIECES}, i8[::1], f8[::1], f8[::1], b1[::1], f8[:, ::1], f8[::1])",
+        "_invert_into":
+            f"void({_PIECES}, f8[::1], i8[::1], f8[::1], f8[:, ::1], b1[::1], f8[::1], f8[::1])",
+        "_kinematics_into":
+            f"void({_PIECES}, i8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])",
+    }

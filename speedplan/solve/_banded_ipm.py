@@ -25,17 +25,32 @@ The reduced Newton system is derived in ``docs/banded-ipm.md``.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 from numba import njit
 
-from ..core._numba_cache import tolerate_stale_indexes
 from ..core.checks import FloatArray, IntArray
+from ..core.jit import tolerate_stale_indexes
 
 tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 _T = TypeVar("_T")
+
+#: numba options of every kernel here but :func:`iterate`: called only from compiled code,
+#: they need no Python or C entry point, whose generation cost a sixth of the module's
+#: compile time (measured: 28 s of CPU instead of 34 s). :func:`python_callable` calls one
+#: from Python.
+_INNER: dict[str, Any] = {"cache": True, "error_model": "numpy", "no_cpython_wrapper": True,
+                          "no_cfunc_wrapper": True}
+_K = TypeVar("_K", bound=Callable[..., Any])
+
+
+def _inner(kernel: _K) -> _K:
+    """``njit(**_INNER)``: a kernel called only from other kernels."""
+    compiled: _K = njit(**_INNER)(kernel)
+    return compiled
 
 #: Fraction of the step to the cone boundary taken per iteration.
 STEP = 0.99
@@ -273,7 +288,7 @@ def check_sizes(d: Data, *parts: tuple[Any, ...]) -> None:
 # --- per-cone and per-node scalar kernels ------------------------------------------------------
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _pad(w: FloatArray, i: int) -> float:
     """``w[i]`` with zero outside ``0 <= i < len(w)`` (the eliminated end values)."""
     if i < 0 or i >= w.size:
@@ -281,7 +296,7 @@ def _pad(w: FloatArray, i: int) -> float:
     return float(w[i])
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _b_lin(d: Data, j: int) -> float:
     """Right-hand side of linear row ``j``.
 
@@ -291,13 +306,13 @@ def _b_lin(d: Data, j: int) -> float:
     return float(d.b_lin[j]) if j < d.lay.jm else -float(d.b_lin[j - d.lay.k])
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _stencil_dot(d: Data, w: FloatArray, i: int, r: int) -> float:
     """``jc_r · w_{i-1:i+2}`` for stencil row ``r`` at node ``i`` (zero outside the nodes)."""
     return float(d.jc[0, r] * _pad(w, i - 1) + d.jc[1, r] * w[i] + d.jc[2, r] * _pad(w, i + 1))
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _scatter_stencil(d: Data, i: int, r: int, value: float, out: FloatArray) -> None:
     """``out += value * jc_r`` at ``w_{i-1:i+2}`` (the adjoint of :func:`_stencil_dot`)."""
     if i > 0:
@@ -307,7 +322,7 @@ def _scatter_stencil(d: Data, i: int, r: int, value: float, out: FloatArray) -> 
         out[i + 1] += value * d.jc[2, r]
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _jnorm2(u0: float, u1: float, u2: float) -> float:
     """``u' J u`` with ``J = diag(1, -1, -1)``, computed as ``(u_0 - |u_a|)(u_0 + |u_a|) - u_b²``.
 
@@ -320,7 +335,7 @@ def _jnorm2(u0: float, u1: float, u2: float) -> float:
     return (u0 - big) * (u0 + big) - small * small
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _h_entries(sc: Scaling, c: int) -> tuple[float, float, float, float, float, float]:
     """Entries 00, 01, 02, 11, 12, 22 of cone ``c``'s ``H = W⁻² = (2 ŵ ŵ' - J) / β²``.
 
@@ -333,7 +348,7 @@ def _h_entries(sc: Scaling, c: int) -> tuple[float, float, float, float, float, 
             (2.0 * u1 * u1 + 1.0) * ib2, 2.0 * u1 * u2 * ib2, (2.0 * u2 * u2 + 1.0) * ib2)
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _apply_h(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[float, float, float]:
     """``H u`` for cone ``c``."""
     h00, h01, h02, h11, h12, h22 = _h_entries(sc, c)
@@ -341,7 +356,7 @@ def _apply_h(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[floa
             h02 * u0 + h12 * u1 + h22 * u2)
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _apply_w(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[float, float, float]:
     """``W u`` for cone ``c``: ``W = β (2 v v' - J)``."""
     v0, v1, v2, bt = sc.v[0, c], sc.v[1, c], sc.v[2, c], sc.beta[c]
@@ -349,7 +364,7 @@ def _apply_w(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[floa
     return bt * (2.0 * vu * v0 - u0), bt * (2.0 * vu * v1 + u1), bt * (2.0 * vu * v2 + u2)
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _apply_winv(
     sc: Scaling, u0: float, u1: float, u2: float, c: int
 ) -> tuple[float, float, float]:
@@ -359,7 +374,7 @@ def _apply_winv(
     return (2.0 * vu * j0 - u0) / bt, (2.0 * vu * j1 + u1) / bt, (2.0 * vu * j2 + u2) / bt
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _jordan_solve(
     l0: float, l1: float, l2: float, b0: float, b1: float, b2: float
 ) -> tuple[float, float, float]:
@@ -368,7 +383,7 @@ def _jordan_solve(
     return u0, (b1 - u0 * l1) / l0, (b2 - u0 * l2) / l0
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _b_soc(r: int, c: int, m: int) -> float:
     """Constant part of the cone rows: ``(1, 0, -1)`` for node cones, ``(0, 0, 2)`` for t-z."""
     if r == 1:
@@ -378,7 +393,7 @@ def _b_soc(r: int, c: int, m: int) -> float:
     return 0.0 if r == 0 else 2.0
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _cone_s(w: FloatArray, t: FloatArray, z: FloatArray, c: int) -> tuple[float, float, float]:
     """Cone ``c``'s slack ``b - G x``: ``(1 + w, 2 z, w - 1)`` (node) or ``(t + z, t - z, 2)``."""
     m = w.size
@@ -388,7 +403,7 @@ def _cone_s(w: FloatArray, t: FloatArray, z: FloatArray, c: int) -> tuple[float,
     return t[i] + z[i], t[i] - z[i], 2.0
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _cone_ds(
     dw: FloatArray, dt: FloatArray, dz: FloatArray, c: int
 ) -> tuple[float, float, float]:
@@ -403,7 +418,7 @@ def _cone_ds(
 # --- the constraint map G and its adjoint -------------------------------------------------
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
     """Linear rows of ``G x`` (no constants)."""
     lay = d.lay
@@ -424,7 +439,7 @@ def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
             out[lay.jm + r] = -jw - t[i]
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> None:
     """Cone rows of ``G x`` (no constants), shape ``(3, 2 m)``."""
     m = w.size
@@ -437,7 +452,7 @@ def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> 
         out[2, m + i] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def g_adjoint_into(
     d: Data, yl: FloatArray, ys: FloatArray, gw: FloatArray, gt: FloatArray, gz: FloatArray,
     mode: int = ADJ_SET,
@@ -488,7 +503,7 @@ def g_adjoint_into(
 # --- cones: steps, interiority, scaling --------------------------------------------------------
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _cone_step(
     u0: float, u1: float, u2: float, du0: float, du1: float, du2: float
 ) -> float:
@@ -516,7 +531,7 @@ def _cone_step(
     return root
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def max_step_soc(u: FloatArray, du: FloatArray) -> float:
     """Largest ``α`` with ``u + α du`` in every cone (``u`` interior); ``inf`` if unbounded."""
     best = np.inf
@@ -525,7 +540,7 @@ def max_step_soc(u: FloatArray, du: FloatArray) -> float:
     return best
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def max_step_slack_soc(pt: Point, dn: Direction) -> float:
     """:func:`max_step_soc` for the cones' slacks ``s = b - G x`` along ``Δs = -G Δx``."""
     best = np.inf
@@ -536,7 +551,7 @@ def max_step_slack_soc(pt: Point, dn: Direction) -> float:
     return best
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def max_step_lin(u: FloatArray, du: FloatArray) -> float:
     """Largest ``α`` with ``u + α du >= 0`` (``u > 0``); ``inf`` if unbounded."""
     worst = 0.0
@@ -545,13 +560,13 @@ def max_step_lin(u: FloatArray, du: FloatArray) -> float:
     return 1.0 / worst if worst > 0.0 else np.inf
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _interior(u0: float, u1: float, u2: float) -> bool:
     """Whether ``u`` is strictly inside the cone."""
     return u0 > 0.0 and _jnorm2(u0, u1, u2) > 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _interior_after_step(pt: Point, alpha: float, dn: Direction) -> bool:
     """Whether every cone of ``s`` and of ``y`` is strictly interior after the step ``α``."""
     for c in range(pt.ys.shape[1]):
@@ -565,7 +580,7 @@ def _interior_after_step(pt: Point, alpha: float, dn: Direction) -> bool:
     return True
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def cone_scaling_into(
     sc: Scaling, c: int, s0: float, s1: float, s2: float, y0: float, y1: float, y2: float
 ) -> None:
@@ -584,7 +599,7 @@ def cone_scaling_into(
     sc.v[0, c], sc.v[1, c], sc.v[2, c] = (wb0 + 1.0) / nv, wb1 / nv, wb2 / nv
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def scaling_into(pt: Point, sc: Scaling) -> None:
     """Nesterov–Todd scaling of every cone at the iterate's ``(s, y)``."""
     ys = pt.ys
@@ -593,7 +608,7 @@ def scaling_into(pt: Point, sc: Scaling) -> None:
         cone_scaling_into(sc, c, s0, s1, s2, ys[0, c], ys[1, c], ys[2, c])
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
     """The scaled point ``λ = W y`` of cone ``c`` (equal to ``W⁻¹ s``)."""
     return _apply_w(sc, ys[0, c], ys[1, c], ys[2, c], c)
@@ -602,7 +617,7 @@ def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
 # --- the reduced (pentadiagonal) Newton system --------------------------------------------
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _eliminate_tz(
     d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor, i: int
 ) -> tuple[float, float, float, float, float, float, float]:
@@ -667,7 +682,7 @@ def _eliminate_tz(
     return m00, m01, m02, m11, m12, m22, dg
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor) -> bool:
     """Assemble the Schur complement in ``w`` of ``G' H G`` and factor it.
 
@@ -728,7 +743,7 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
     return ok
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
     """Overwrite ``x`` with ``(L D L')⁻¹ x``."""
     m = x.size
@@ -744,7 +759,7 @@ def solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
             x[i] -= fac.l2[i + 2] * x[i + 2]
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def solve_normal_inplace(
     d: Data, fac: Factor, xw: FloatArray, xt: FloatArray, xz: FloatArray
 ) -> None:
@@ -772,7 +787,7 @@ def solve_normal_inplace(
         xz[i] -= fac.q[i] * ct + fac.r[i] * cz
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _v_into(
     sc: Scaling, pt: Point, rp: float, corrector: bool, sigma_mu: float, dn: Direction
 ) -> None:
@@ -805,7 +820,7 @@ def _v_into(
         dys[0, c], dys[1, c], dys[2, c] = -w0, -w1, -w2
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _recover_v_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
     """Put back the ``v`` of :func:`_v_into` into ``(dyl, dys)`` from the direction ``dn``.
 
@@ -822,7 +837,7 @@ def _recover_v_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
         dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
     """``Δs = by - G Δx`` (linear rows) and ``Δy = H G Δx - v``, with ``v`` in ``(dyl, dys)``."""
     g_lin_into(d, dn.dw, dn.dt, dn.dsl)  # G Δx, linear rows, kept in dsl until replaced
@@ -838,7 +853,7 @@ def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> No
         dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def newton_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     corrector: bool, sigma_mu: float, refine_above: float, dn: Direction,
@@ -855,7 +870,8 @@ def newton_into(
     """
     # With v = H by - W⁻¹ u (λ ∘ u = bs): (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
     _v_into(sc, pt, rp, corrector, sigma_mu, dn)
-    dn.dw[:], dn.dt[:], dn.dz[:] = res.gw, res.gt, res.gz
+    for i in range(dn.dw.size):  # loops, not slice assignments: they cost seconds to compile
+        dn.dw[i], dn.dt[i], dn.dz[i] = res.gw[i], res.gt[i], res.gz[i]
     g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz, ADJ_ADD)
     solve_normal_inplace(d, fac, dn.dw, dn.dt, dn.dz)
     _ds_dy_into(d, sc, pt, rp, dn)
@@ -884,25 +900,41 @@ def newton_into(
 # --- the iteration, step by step ------------------------------------------------------------
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _dot(a: FloatArray, b: FloatArray) -> float:
-    """``a · b`` over all entries, without a temporary."""
-    fa, fb = a.reshape(a.size), b.reshape(b.size)
+    """``a · b`` of two vectors, without a temporary."""
     acc = 0.0
-    for i in range(fa.size):
-        acc += fa[i] * fb[i]
+    for i in range(a.size):
+        acc += a[i] * b[i]
     return acc
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
+def _dot2(a: FloatArray, b: FloatArray) -> float:
+    """``a · b`` over all entries of two 2-D arrays, row by row (as :func:`_dot` of them flat)."""
+    acc = 0.0
+    for r in range(a.shape[0]):
+        for c in range(a.shape[1]):
+            acc += a[r, c] * b[r, c]
+    return acc
+
+
+@_inner
 def _axpy(alpha: float, x: FloatArray, y: FloatArray) -> None:
-    """``y += α x`` in place."""
-    fx, fy = x.reshape(x.size), y.reshape(y.size)
-    for i in range(fx.size):
-        fy[i] += alpha * fx[i]
+    """``y += α x`` in place, for vectors."""
+    for i in range(x.size):
+        y[i] += alpha * x[i]
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
+def _axpy2(alpha: float, x: FloatArray, y: FloatArray) -> None:
+    """``y += α x`` in place, for 2-D arrays."""
+    for r in range(x.shape[0]):
+        for c in range(x.shape[1]):
+            y[r, c] += alpha * x[r, c]
+
+
+@_inner
 def _shift(worst: float, nrm: float) -> float:
     """Return CVXOPT's initial-point shift along ``e``.
 
@@ -913,7 +945,7 @@ def _shift(worst: float, nrm: float) -> float:
     return 1.0 + ts if ts >= -1e-8 * max(nrm, 1.0) else 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
     """Add :func:`_shift` of ``(ul, us)`` to every linear entry and every cone's axis."""
     worst = np.inf
@@ -921,14 +953,14 @@ def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
         worst = min(worst, ul[i])
     for c in range(us.shape[1]):
         worst = min(worst, us[0, c] - math.hypot(us[1, c], us[2, c]))
-    shift = _shift(worst, math.sqrt(_dot(ul, ul) + _dot(us, us)))
+    shift = _shift(worst, math.sqrt(_dot(ul, ul) + _dot2(us, us)))
     for i in range(ul.size):
         ul[i] += shift
     for c in range(us.shape[1]):
         us[0, c] += shift
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def start_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, dn: Direction
 ) -> tuple[bool, float]:
@@ -946,8 +978,9 @@ def start_into(
         s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
         if not _interior(s0, s1, s2):
             return False, 0.0
-    pt.sl[:] = 1.0  # W = I on the linear rows: y / s = 1
-    pt.yl[:] = 1.0
+    for j in range(pt.sl.size):  # W = I on the linear rows: y / s = 1
+        pt.sl[j] = 1.0
+        pt.yl[j] = 1.0
     factor_into(d, sc, pt.yl, pt.sl, fac)
     g_lin_into(d, pt.w, pt.t, pt.sl)
     worst = np.inf
@@ -968,14 +1001,14 @@ def start_into(
     return True, -shift
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def dual_residual_into(d: Data, pt: Point, res: Residual) -> float:
     """The dual residual, negated, ``-(G'y + c)``, into ``res``; returns its squared norm."""
     sw, st, sz = g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz, ADJ_DUAL_RESIDUAL)
     return sw + st + sz
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def residuals_into(
     d: Data, pt: Point, res: Residual, scratch: FloatArray
 ) -> tuple[float, float, float, float, float]:
@@ -1007,14 +1040,14 @@ def residuals_into(
     return pcost, dcost, gap, ry2, rx2
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def _max_step(pt: Point, dn: Direction) -> float:
     """Largest step along ``dn`` keeping ``s`` and ``y`` in their cones."""
     return min(max_step_lin(pt.sl, dn.dsl), max_step_lin(pt.yl, dn.dyl),
                max_step_slack_soc(pt, dn), max_step_soc(pt.ys, dn.dys))
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def predictor_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     refine_above: float, dn: Direction,
@@ -1025,7 +1058,7 @@ def predictor_into(
     return float((1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT)
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def corrector_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     refine_above: float, sigma_mu: float, dn: Direction,
@@ -1037,7 +1070,7 @@ def corrector_into(
     newton_into(d, sc, fac, pt, res, rp, True, sigma_mu, refine_above, dn)
 
 
-@njit(cache=True, error_model="numpy")
+@_inner
 def step(pt: Point, dn: Direction) -> float:
     """Move ``pt`` a fraction ``STEP`` of the way to the cone boundary along ``dn``.
 
@@ -1056,7 +1089,7 @@ def step(pt: Point, dn: Direction) -> float:
         alpha *= 0.5
     if not inside:
         return 0.0
-    _axpy(alpha, dn.dys, pt.ys)
+    _axpy2(alpha, dn.dys, pt.ys)
     _axpy(alpha, dn.dw, pt.w)
     _axpy(alpha, dn.dt, pt.t)
     _axpy(alpha, dn.dz, pt.z)
@@ -1147,3 +1180,44 @@ def iterate(
             status = NUMERICAL_ERROR
             break
     return it, status
+
+
+def signatures() -> dict[str, Any]:
+    """The kernel called from Python and its signature (see :mod:`speedplan.core.jit`).
+
+    The types of :func:`iterate`'s arguments as :mod:`speedplan.solve.banded` builds them;
+    only their types matter, so the arrays here are of the smallest sizes.
+    """
+    import numba
+
+    lay = layout(1, 1, 0)
+    d = Data(jstart=np.zeros(2, dtype=np.intp), jc=np.zeros((3, 1)), cj=np.zeros(1),
+             lk=np.zeros(0, dtype=np.intp), ct=np.zeros(1), cw=np.zeros(1),
+             b_lin=np.zeros(lay.jm), lay=lay)
+    args = (d, empty(Point, lay), empty(Residual, lay), empty(Direction, lay),
+            Scaling.identity(lay), empty(Factor, lay), np.zeros((2, len(LOG_COLUMNS))), 1e-8, 1)
+    return {"iterate": tuple(numba.typeof(a) for a in args)}  # type: ignore[no-untyped-call]
+
+
+def python_callable(kernel: Any) -> Any:
+    """``kernel`` (any of this module's) callable from Python: for tests and diagnostics.
+
+    The kernels other than :func:`iterate` have no Python entry point (see ``_INNER``); this
+    wraps one in a compiled trampoline (compiled on first call, not cached).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> python_callable(max_step_lin)(np.ones(3), -np.ones(3))
+    1.0
+    """
+    if kernel not in _TRAMPOLINES:
+        @njit
+        def call(*args: Any) -> Any:  # pragma: no cover - compiled
+            return kernel(*args)
+
+        _TRAMPOLINES[kernel] = call
+    return _TRAMPOLINES[kernel]
+
+
+_TRAMPOLINES: dict[Any, Any] = {}

@@ -24,8 +24,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..core._numba_cache import tolerate_stale_indexes
 from ..core.checks import FloatArray, IntArray
+from ..core.jit import tolerate_stale_indexes
 
 tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
@@ -455,3 +455,8 @@ def tiny(
     for i in range(dv.size):
         out = max(out, abs(dv[i]) / (1.0 + g[i]))
     return out
+
+
+def signatures() -> dict[str, str]:
+    """Every kernel and its signature, :data:`SIGNATURES` (see :mod:`speedplan.core.jit`)."""
+    return dict(SIGNATURES)

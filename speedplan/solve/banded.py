@@ -51,33 +51,31 @@ closed form over the box ``w_min <= w <= w_max``, node by node. The ``primal_obj
 ``Σ max(τ_i / sqrt(w_i), max_f τ_i |c_fi · w| / B_fi)`` at the returned ``w``, i.e. the best
 ``t`` for it.
 
-The kernel is compiled on first use after installation; until then ``backend="auto"``
-answers with Clarabel while a background process compiles it (:func:`kernel_ready`).
+The kernel is compiled on first use after installation (or by ``speedplan compile``); until
+then ``backend="auto"`` answers with Clarabel while a background process compiles it
+(:func:`kernel_ready`, :mod:`speedplan.core.jit`).
 """
 
 from __future__ import annotations
 
-import hashlib
 import importlib.util
-import os
-import subprocess
 import sys
-import tempfile
 import time
 from dataclasses import replace
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
 from ..core.errors import InvalidInputError, SolverError
+from ..core.jit import FAMILIES
 from .clarabel_ import RelaxationResult
 from .nojerk import check_reachable, max_feasible_w, min_feasible_w, positive_feasible_w
 from .problem import DiscreteProblem
 
 __all__ = [
-    "ACCEPT_GAP", "COMPILE_LOCK_STALE", "MAX_ITERATIONS", "MAX_RAMP_STEPS",
+    "ACCEPT_GAP", "KERNELS", "MAX_ITERATIONS", "MAX_RAMP_STEPS",
     "check_grid_resolvable", "compile_kernel", "kernel_for_auto", "kernel_ready", "ramp_steps",
     "solve_relaxation_banded",
     "solve_unit_relaxation", "unit_scales",
@@ -330,28 +328,25 @@ def _run_kernel(
     args = _kernel_args(p, d)
     log = np.full((max_iter + 1, len(ipm.LOG_COLUMNS)), np.nan)
     iterations, code = ipm.iterate(*args, log, tol, max_iter)
-    _Kernel.last_log = log[: iterations + 1]
+    _Diagnostics.last_log = log[: iterations + 1]
     pt = args[1]
     return pt.w, pt.yl, iterations, code
 
 
 # --- first use: load, compile, or compile in the background ---------------------------------
 
-#: Environment variable: set to ``0`` to make ``backend="auto"`` wait for the kernel's first
-#: compilation instead of answering with Clarabel while a background process compiles it.
-BACKGROUND_COMPILE_ENV = "SPEEDPLAN_BACKGROUND_COMPILE"
+#: The compiled kernel's family (:mod:`speedplan.core.jit` loads, compiles or starts it).
+KERNELS = FAMILIES["relaxation"]
 
 
-class _Kernel:
-    """Whether this process can call the compiled kernel without compiling it."""
+class _Diagnostics:
+    """The iteration log of the last solve in this process, for diagnostics and benchmarks.
 
-    ready = False
-    #: The iteration log of the last solve in this process (rows: iterations; columns:
-    #: :data:`~speedplan.solve._banded_ipm.LOG_COLUMNS`), for diagnostics and benchmarks.
-    #: Empty (no columns) until the first solve: sizing it would import the kernel.
+    Rows: iterations; columns: :data:`~speedplan.solve._banded_ipm.LOG_COLUMNS`. Empty (no
+    columns) until the first solve: sizing it would import the kernel.
+    """
+
     last_log: FloatArray = np.zeros((0, 0))
-    background: subprocess.Popen[bytes] | None = None
-    spawn_failed = False
 
 
 def _example_problem() -> DiscreteProblem:
@@ -361,55 +356,12 @@ def _example_problem() -> DiscreteProblem:
                            jerk=np.full(n - 2, 0.1), w_min=np.full(n, 0.0))
 
 
-def _load_from_disk_cache() -> bool:
-    """Load the compiled kernel from numba's on-disk cache if it is there; never compiles.
-
-    Mirrors what :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's
-    dispatcher offers no public "load but do not compile"); any failure means "not loaded".
-    """
-    p = _example_problem()
-    d = _prepare(p, positive_feasible_w(p)[1:-1])
-    args = (*_kernel_args(p, d), np.zeros((2, len(ipm.LOG_COLUMNS))), 1e-8, 1)
-    import numba
-
-    try:
-        sig = tuple(numba.typeof(a) for a in args)  # type: ignore[no-untyped-call]
-    except Exception:  # pragma: no cover - numba internals changed: behave as "not cached"
-        return False
-    return load_cached_overload(ipm.iterate, sig)
-
-
-def load_cached_overload(disp: Any, sig: Any) -> bool:
-    """Load numba dispatcher ``disp``'s overload for ``sig`` from the on-disk cache; never compiles.
-
-    ``sig``: a signature string or a tuple of numba types. Mirrors what
-    :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's dispatcher
-    offers no public "load but do not compile"); any failure means "not loaded". Shared with
-    the refinement's kernels (:mod:`speedplan.solve.banded_nlp`).
-    """
-    from numba.core import sigutils
-    from numba.core.compiler_lock import global_compiler_lock
-
-    try:
-        args, _ = sigutils.normalize_signature(sig)  # type: ignore[no-untyped-call]
-        if tuple(args) in disp.overloads:
-            return True
-        with global_compiler_lock:
-            cres = disp._cache.load_overload(sig, disp.targetctx)
-            if cres is None:
-                return False
-            disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
-            disp.add_overload(cres)
-        return True
-    except Exception:  # pragma: no cover - numba internals changed: behave as "not cached"
-        return False
-
-
 def compile_kernel() -> None:
     """Make the compiled kernel available in this process now: load it, or compile it.
 
     ``backend="auto"`` answers with Clarabel while the kernel is not available (see
-    :func:`kernel_ready`); call this first for runs whose backend must not depend on timing.
+    :func:`kernel_ready`); call this first for runs whose backend must not depend on timing
+    (or run ``speedplan compile`` once after installing, which compiles every kernel).
 
     Examples
     --------
@@ -417,103 +369,18 @@ def compile_kernel() -> None:
     >>> kernel_ready()
     True
     """
-    if _Kernel.ready:
-        return
-    if _Kernel.background is not None:
-        _Kernel.background.wait()
-        _Kernel.background = None
-    solve_relaxation_banded(_example_problem())
-    from ..core import _law_kernel  # noqa: F401  # the time law's kernel, into the same cache
-
-    _Kernel.ready = True
+    KERNELS.compile()
 
 
 def kernel_ready(*, start: bool = True) -> bool:
     """Whether the banded kernel runs now without compiling; else compile it in the background.
 
-    The kernel is loaded from numba's on-disk cache when it is there (0.3-0.5 s). When it is
-    not (first use after installation, about 20-30 s to compile), and ``start`` is true, a
-    background Python process compiles it into the cache, unless the environment variable
-    ``SPEEDPLAN_BACKGROUND_COMPILE`` is ``0``; later calls load it once that process is done.
+    The kernel is loaded from numba's cache when it is there. When it is not (first use
+    after installation), and ``start`` is true, a background Python process compiles it into
+    the cache, unless the environment variable ``SPEEDPLAN_BACKGROUND_COMPILE`` is ``0``;
+    later calls load it once that process is done (:meth:`speedplan.core.jit.Kernels.ready`).
     """
-    if _Kernel.ready:
-        return True
-    if not background_done(_Kernel):
-        return False
-    if _load_from_disk_cache():
-        _Kernel.ready = True
-        return True
-    if start and _background_allowed() and _claim_compile_lock():
-        _Kernel.background = _spawn_compile()
-        _Kernel.spawn_failed = _Kernel.background is None
-    return False
-
-
-def background_done(state: Any) -> bool:
-    """Whether ``state``'s background compilation (``state.background``) is over, or none ran.
-
-    ``state`` is a class with ``background`` (the process or ``None``) and ``spawn_failed``
-    (set when the process failed: a failing compilation is never started twice), for the
-    relaxation's kernel (:class:`_Kernel`) and the refinement's.
-    """
-    if state.background is None:
-        return True
-    code = state.background.poll()
-    if code is None:
-        return False
-    state.background = None
-    state.spawn_failed = code != 0
-    return True
-
-
-#: A compile lock older than this [s] is taken to be left by a process that died.
-COMPILE_LOCK_STALE = 600.0
-
-
-def _lock_path() -> str:
-    """One lock per copy of speedplan, numba version, cache directory and interpreter."""
-    return _kernel_lock_path(ipm.__file__)
-
-
-def _kernel_lock_path(module_file: str) -> str:
-    """The compile lock of the kernel module ``module_file`` (see :func:`_lock_path`)."""
-    import numba
-
-    key = "|".join((os.path.abspath(module_file), numba.__version__,
-                    os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
-    digest = hashlib.sha256(key.encode()).hexdigest()[:16]
-    return os.path.join(tempfile.gettempdir(), f"speedplan-kernel-{digest}.lock")
-
-
-def _claim_compile_lock() -> bool:
-    """Whether this process may start the background compilation (no other one is running).
-
-    Worker processes of :func:`~speedplan.plan_many` all start cold; the lock file makes one
-    of them compile while the others answer with Clarabel until the cache has the kernel.
-    """
-    return _claim_lock(_lock_path())
-
-
-def _claim_lock(path: str) -> bool:
-    """Create the lock file ``path``; False if a fresh one exists (as _claim_compile_lock)."""
-    for _ in range(2):
-        try:
-            os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
-            return True
-        except FileExistsError:
-            try:
-                if time.time() - os.path.getmtime(path) < COMPILE_LOCK_STALE:
-                    return False
-                os.remove(path)  # stale: its compiling process died
-            except OSError:
-                return False
-        except OSError:
-            return True  # no usable temporary directory: compile without a lock
-    return False
-
-
-def _background_allowed() -> bool:
-    return not _Kernel.spawn_failed and os.environ.get(BACKGROUND_COMPILE_ENV) != "0"
+    return KERNELS.ready(start=start)
 
 
 def kernel_for_auto(*, wait: bool) -> bool:
@@ -523,41 +390,7 @@ def kernel_for_auto(*, wait: bool) -> bool:
     if needed), or after compiling it here when ``wait`` is true or background compilation
     is off (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could be started).
     """
-    if kernel_ready(start=not wait):
-        return True
-    if wait or not _background_allowed():
-        compile_kernel()
-        return True
-    return False
-
-
-def _spawn_compile() -> subprocess.Popen[bytes] | None:
-    """Start ``python -c "...compile_kernel()"`` on this very copy of speedplan."""
-    return _spawn_compile_of("speedplan.solve.banded", "compile_kernel", _lock_path())
-
-
-def _spawn_compile_of(module: str, function: str, lock: str) -> subprocess.Popen[bytes] | None:
-    """Start ``python -c "from module import function; function()"`` on this copy of speedplan.
-
-    At the lowest priority; the lock file ``lock`` is removed when it ends.
-    """
-    if not sys.executable:
-        return None
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
-    # Lowest priority: the compilation must not slow down the process that is waiting for
-    # answers (it uses Clarabel meanwhile).
-    code = ("import os, sys; hasattr(os, 'nice') and os.nice(19)\n"
-            f"from {module} import {function}\n"
-            f"try:\n    {function}()\nfinally:\n"
-            "    os.path.exists(sys.argv[1]) and os.remove(sys.argv[1])\n")
-    try:
-        return subprocess.Popen([sys.executable, "-c", code, lock], env=env,
-                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)
-    except OSError:
-        return None
+    return KERNELS.available(wait=wait) is not None
 
 
 #: Longest jerk-limited change of acceleration, in grid steps, that the relaxation resolves.

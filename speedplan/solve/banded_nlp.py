@@ -26,10 +26,6 @@ code for both.
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
-import os
-import subprocess
 from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import pairwise
@@ -39,9 +35,10 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
+from ..core.jit import FAMILIES
 from .problem import DiscreteProblem
 
-__all__ = ["LATERAL_STARTS", "STARTS", "BandedNlpResult", "Start", "compile_nlp_kernels",
+__all__ = ["KERNELS", "LATERAL_STARTS", "STARTS", "BandedNlpResult", "Start", "compile_nlp_kernels",
            "nlp_kernels_ready", "solve_banded_nlp"]
 
 #: Lower bound on interior ``w`` (unit scale) when the problem has none: keeps ``sqrt(w)``
@@ -826,35 +823,8 @@ def _elastic_split(r: FloatArray, a: float) -> tuple[FloatArray, FloatArray]:
 # --- the compiled kernels: load from numba's cache, or compile in the background ------------
 
 
-class _KernelState:
-    """The kernels module once its every kernel is loaded, and a background compilation."""
-
-    module: ModuleType | None = None
-    background: subprocess.Popen[bytes] | None = None
-    spawn_failed = False
-
-
-_KERNELS = f"{__package__}._banded_nlp_kernels"
-
-
-def _load_kernels(*, wait: bool) -> ModuleType | None:
-    """The kernels module if every kernel loads from the cache, or (``wait``) is compiled."""
-    if _KernelState.module is not None:
-        return _KernelState.module
-    from .banded import load_cached_overload
-
-    kn = importlib.import_module(_KERNELS)  # imports numba
-    loaded = all(load_cached_overload(getattr(kn, name), sig)
-                 for name, sig in kn.SIGNATURES.items())
-    if not loaded:
-        if not wait:
-            return None
-        for name, sig in kn.SIGNATURES.items():
-            getattr(kn, name).compile(sig)
-    for name in kn.SIGNATURES:
-        getattr(kn, name).disable_compile()  # a call with other types is a bug, not a compile
-    _KernelState.module = kn
-    return kn
+#: The compiled kernels' family (:mod:`speedplan.core.jit` loads, compiles or starts it).
+KERNELS = FAMILIES["refinement"]
 
 
 def compile_nlp_kernels() -> None:
@@ -868,19 +838,16 @@ def compile_nlp_kernels() -> None:
     >>> nlp_kernels_ready()
     True
     """
-    if _KernelState.background is not None:
-        _KernelState.background.wait()
-        _KernelState.background = None
-    _load_kernels(wait=True)
+    KERNELS.compile()
 
 
 def nlp_kernels_ready(*, start: bool = True) -> bool:
     """Whether the kernels run now without compiling; else compile them in the background.
 
     They load from numba's cache when they are there. When they are not (first use after
-    installation) and ``start`` is true, a background Python process at the lowest priority
-    compiles them into the cache (as for the relaxation's kernel, and unless
-    ``SPEEDPLAN_BACKGROUND_COMPILE=0``); later calls load them once it is done.
+    installation) and ``start`` is true, a background Python process compiles them into the
+    cache (as for the relaxation's kernel, and unless ``SPEEDPLAN_BACKGROUND_COMPILE=0``);
+    later calls load them once it is done.
 
     Parameters
     ----------
@@ -898,29 +865,7 @@ def nlp_kernels_ready(*, start: bool = True) -> bool:
     >>> nlp_kernels_ready(start=False)
     True
     """
-    from . import banded
-
-    if _KernelState.module is not None:
-        return True
-    if not banded.background_done(_KernelState):
-        return False
-    if _load_kernels(wait=False) is not None:
-        return True
-    if start and _background_allowed():
-        spec = importlib.util.find_spec(_KERNELS)
-        lock = banded._kernel_lock_path(spec.origin if spec and spec.origin else _KERNELS)
-        if banded._claim_lock(lock):
-            _KernelState.background = banded._spawn_compile_of(
-                __name__, "compile_nlp_kernels", lock)
-            _KernelState.spawn_failed = _KernelState.background is None
-    return False
-
-
-def _background_allowed() -> bool:
-    from . import banded
-
-    return (not _KernelState.spawn_failed
-            and os.environ.get(banded.BACKGROUND_COMPILE_ENV) != "0")
+    return KERNELS.ready(start=start)
 
 
 def _kernels() -> ModuleType | None:
@@ -929,11 +874,7 @@ def _kernels() -> ModuleType | None:
     Without background compilation (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could
     be started) they are compiled here, as the relaxation's kernel is.
     """
-    if nlp_kernels_ready():
-        return _KernelState.module
-    if _KernelState.background is None and not _background_allowed():
-        return _load_kernels(wait=True)
-    return None
+    return KERNELS.available(wait=False)
 
 
 def solve_banded_nlp(
@@ -996,7 +937,7 @@ def solve_banded_nlp(
         grad = _travel_time(tau).grad(x)
         tau = tau * min(1.0, SCALING_MAX_GRADIENT / float(np.abs(grad).max()))
         rows.scale(rows.evaluate(x), SCALING_MAX_GRADIENT)
-    kn = _kernels() if compiled is None else (_load_kernels(wait=True) if compiled else None)
+    kn = _kernels() if compiled is None else (KERNELS.compile() if compiled else None)
     prows: _Rows | _FastRows = rows if kn is None else _FastRows(rows, kn)
 
     def phase(objective: _Objective, mode: tuple[int, FloatArray, FloatArray],

@@ -4,8 +4,8 @@ The interface of :mod:`speedplan.core._law_kernel`, the compiled version.
 
 Used until numba's compiled code can run without compiling (:func:`backend`): the first
 ``plan()`` of a fresh environment answers with Clarabel while a background process compiles
-the banded kernel (``speedplan.solve.banded``), and compiling the time-law kernel in the
-foreground too would cost it seconds. The two agree to rounding (``tests/test_timing_law.py``
+the banded kernel, and compiling the time-law kernel in the foreground too would cost it
+seconds. The two agree to rounding (``tests/test_timing_law.py``
 compares them); durations and sampled states differ by a few units in the last place.
 """
 
@@ -23,18 +23,19 @@ __all__ = ["backend", "integrals", "invert", "kinematics"]
 
 
 def backend() -> ModuleType:
-    """The compiled kernel when the banded kernel is loaded in this process, else this module.
+    """The compiled kernel when it runs without compiling in this process, else this module.
 
-    Once numba has loaded the banded kernel, the time-law kernel loads from numba's cache in
-    ~20 ms (the background compilation, :func:`~speedplan.solve.banded.compile_kernel`,
-    compiles both); before that, numpy avoids a foreground compilation.
+    Only once numba is loaded for the relaxation's kernel (a process that plans only without
+    jerk never loads it); then the time law's kernel loads from numba's cache in ~20 ms, or
+    a background process compiles it (:mod:`speedplan.core.jit`, family ``"time law"``) and
+    numpy answers meanwhile.
     """
-    from ..solve.banded import _Kernel
+    from ..core.jit import FAMILIES
 
-    if _Kernel.ready:
-        from ..core import _law_kernel
-
-        return _law_kernel
+    if FAMILIES["relaxation"].module is not None:
+        law = FAMILIES["time law"].available(wait=False)
+        if law is not None:
+            return law
     import sys
 
     return sys.modules[__name__]

@@ -1,0 +1,394 @@
+"""Compiling, caching and fallback of every compiled (numba) kernel of the library.
+
+Three families of kernels are compiled with numba and cached on disk (``cache=True``: in
+``__pycache__`` next to the sources, or under ``NUMBA_CACHE_DIR``):
+
+``"relaxation"``
+    the banded interior-point iteration (:mod:`speedplan.solve._banded_ipm`); until it is
+    available, ``backend="auto"`` answers with Clarabel;
+``"time law"``
+    the time law's quadrature, inversion and kinematics (:mod:`speedplan.core._law_kernel`);
+    until it is available, the same formulas run in numpy (:mod:`speedplan.timing._law_numpy`);
+``"refinement"``
+    the banded refinement's array work (:mod:`speedplan.solve._banded_nlp_kernels`); until it
+    is available, the same steps run in numpy (:mod:`speedplan.solve.banded_nlp`).
+
+Each kernel module lists the entry points called from Python and their explicit signatures
+(``signatures()``); :class:`Kernels` loads each of them from numba's cache without ever
+compiling (:func:`load_cached_overload`), compiles them when asked to, and otherwise starts
+one background Python process that compiles the family into the cache while the fallback
+answers. A lock file per family (:meth:`Kernels.lock_path`) keeps the workers of
+:func:`~speedplan.plan_many`, which all start cold, from compiling the same family at once.
+``speedplan compile`` (:func:`compile_families`) compiles every family in parallel processes
+and waits: the step for CI jobs, containers and fresh virtual environments, after which the
+first ``plan()`` already runs the compiled kernels.
+
+Setting the environment variable ``SPEEDPLAN_BACKGROUND_COMPILE=0`` makes every fallback
+compile in the calling process instead (the results are then independent of timing).
+
+Numba keeps one index file per function and pickles into it every signature it has compiled
+for, with their argument types. Our kernels take ``NamedTuple`` arguments. When a later
+version of the package drops or renames one of those classes, an index left behind by the
+earlier version (``pip install -U`` leaves ``__pycache__`` in place) fails to unpickle, and
+numba raises that error from the first call instead of recompiling: ``AttributeError: Can't
+get attribute 'Work' on <module 'speedplan.solve._banded_ipm'>`` (numba issue #6018, still so
+in numba 0.68). :func:`tolerate_stale_indexes` makes such an index read as empty, which is how
+numba already treats an index written by another numba version or for an older source; the
+next compilation writes a fresh one.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import importlib.util
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Iterable
+from types import ModuleType
+from typing import Any
+
+__all__ = [
+    "BACKGROUND_COMPILE_ENV", "COMPILE_LOCK_STALE", "FAMILIES", "Kernels", "compile_families",
+    "load_cached_overload", "tolerate_stale_indexes",
+]
+
+#: Environment variable: set to ``0`` to make every fallback compile its kernels in the calling
+#: process instead of answering without them while a background process compiles them.
+BACKGROUND_COMPILE_ENV = "SPEEDPLAN_BACKGROUND_COMPILE"
+
+#: A compile lock older than this [s] is taken to be left by a process that died.
+COMPILE_LOCK_STALE = 600.0
+
+
+def tolerate_stale_indexes() -> None:
+    """Make numba read a cache index that fails to unpickle as empty (idempotent).
+
+    Called by every module of ours that defines cached kernels, before any of them runs.
+    If numba's internals ever differ from what this expects, nothing is changed.
+
+    Examples
+    --------
+    >>> tolerate_stale_indexes()
+    >>> from numba.core.caching import IndexDataCacheFile
+    >>> IndexDataCacheFile._load_index.__name__
+    '_load_index_or_empty'
+    """
+    try:
+        from numba.core.caching import IndexDataCacheFile
+    except ImportError:  # pragma: no cover - numba reorganised: leave it as it is
+        return
+    original = getattr(IndexDataCacheFile, "_load_index", None)
+    if original is None or getattr(original, "__name__", "") == "_load_index_or_empty":
+        return
+
+    def _load_index_or_empty(self: Any) -> dict[Any, Any]:
+        try:
+            index: dict[Any, Any] = original(self)
+        except Exception:  # an index pickled with types that no longer exist
+            return {}
+        return index
+
+    IndexDataCacheFile._load_index = _load_index_or_empty  # type: ignore[method-assign]
+
+
+def load_cached_overload(disp: Any, sig: Any) -> bool:
+    """Load numba dispatcher ``disp``'s overload for ``sig`` from the on-disk cache; never compiles.
+
+    ``sig``: a signature string or a tuple of numba types. Mirrors what
+    :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's dispatcher
+    offers no public "load but do not compile"); any failure means "not loaded".
+    """
+    from numba.core import sigutils
+    from numba.core.compiler_lock import global_compiler_lock
+
+    try:
+        args, _ = sigutils.normalize_signature(sig)  # type: ignore[no-untyped-call]
+        if tuple(args) in disp.overloads:
+            return True
+        with global_compiler_lock:
+            cres = disp._cache.load_overload(sig, disp.targetctx)
+            if cres is None:
+                return False
+            disp.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+            disp.add_overload(cres)
+        return True
+    except Exception:  # pragma: no cover - numba internals changed: behave as "not cached"
+        return False
+
+
+def background_allowed() -> bool:
+    """Whether fallbacks may compile in a background process (``SPEEDPLAN_BACKGROUND_COMPILE``)."""
+    return os.environ.get(BACKGROUND_COMPILE_ENV) != "0"
+
+
+class Kernels:
+    """One family of compiled kernels: loaded from the cache, compiled, or in the background.
+
+    Parameters
+    ----------
+    name : str
+        The family's name (a key of :data:`FAMILIES`).
+    module : str
+        The module defining the kernels. It calls :func:`tolerate_stale_indexes` and
+        defines ``signatures()``: ``{dispatcher name: signature}`` of every kernel called from
+        Python; nothing else of the family is ever compiled in a process that uses it.
+    then : tuple of str
+        Families that this family's background process compiles after it.
+    """
+
+    def __init__(self, name: str, module: str, then: tuple[str, ...] = ()) -> None:
+        self.name = name
+        self.module_name = module
+        #: Families its background process compiles next (when no other process does).
+        self.then = then
+        #: The kernel module once every kernel of the family is loaded in this process.
+        self.module: ModuleType | None = None
+        #: The background compilation started by this process, while it runs.
+        self.background: subprocess.Popen[bytes] | None = None
+        #: Set when a background compilation failed or could not start: never again.
+        self.spawn_failed = False
+
+    def __repr__(self) -> str:
+        return f"Kernels({self.name!r}, {self.module_name!r})"
+
+    def _entries(self) -> tuple[ModuleType, list[tuple[Any, Any]]]:
+        kn = importlib.import_module(self.module_name)  # imports numba
+        return kn, [(getattr(kn, name), sig) for name, sig in kn.signatures().items()]
+
+    def _finish(self, kn: ModuleType, entries: list[tuple[Any, Any]]) -> ModuleType:
+        for disp, _ in entries:
+            disp.disable_compile()  # a call with other types is a bug, not a compilation
+        self.module = kn
+        return kn
+
+    def load(self) -> bool:
+        """Load every kernel of the family from numba's cache; never compiles.
+
+        Returns whether they are all available in this process now.
+        """
+        if self.module is not None:
+            return True
+        kn, entries = self._entries()
+        if all(load_cached_overload(disp, sig) for disp, sig in entries):
+            self._finish(kn, entries)
+            return True
+        return False
+
+    def compile(self) -> ModuleType:
+        """Make the family available in this process now: load it, or compile it here.
+
+        Waits for this process's own background compilation first (it fills the cache).
+        """
+        if self.module is not None:
+            return self.module
+        if self.background is not None:
+            self.background.wait()
+            self.background = None
+        kn, entries = self._entries()
+        for disp, sig in entries:
+            if not load_cached_overload(disp, sig):
+                disp.compile(sig)
+        return self._finish(kn, entries)
+
+    def ready(self, *, start: bool = True) -> bool:
+        """Whether the kernels run now without compiling; else compile them in the background.
+
+        They are loaded from numba's cache when they are there. When they are not (first use
+        after installation), and ``start`` is true, a background Python process compiles
+        them into the cache, unless ``SPEEDPLAN_BACKGROUND_COMPILE=0`` or another process
+        holds the family's lock; later calls load them once that process is done.
+        """
+        if self.module is not None:
+            return True
+        if not self.background_done():
+            return False
+        if self.load():
+            return True
+        if start and self.background_allowed() and claim_lock(self.lock_path()):
+            names = [self.name, *(n for n in self.then
+                                  if FAMILIES[n].module is None
+                                  and claim_lock(FAMILIES[n].lock_path()))]
+            self.background = spawn_compile(names)
+            self.spawn_failed = self.background is None
+            if self.background is None:
+                for name in names:
+                    _release(FAMILIES[name])
+        return False
+
+    def available(self, *, wait: bool) -> ModuleType | None:
+        """The kernel module if the family runs now, after compiling it here if need be.
+
+        The family is compiled in this process when ``wait`` is true or background
+        compilation is off (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could be
+        started or it failed); otherwise ``None`` while a background process compiles it.
+        """
+        if self.ready(start=not wait):
+            return self.module
+        if wait or (self.background is None and not self.background_allowed()):
+            return self.compile()
+        return None
+
+    def background_done(self) -> bool:
+        """Whether this process's background compilation is over, or none ran."""
+        if self.background is None:
+            return True
+        code = self.background.poll()
+        if code is None:
+            return False
+        self.background = None
+        self.spawn_failed = code != 0
+        return True
+
+    def background_allowed(self) -> bool:
+        """Whether a background compilation may start (on, and none failed before)."""
+        return not self.spawn_failed and background_allowed()
+
+    def lock_path(self) -> str:
+        """One lock per family, copy of speedplan, numba version, cache directory, interpreter."""
+        import numba
+
+        spec = importlib.util.find_spec(self.module_name)
+        origin = spec.origin if spec is not None and spec.origin else self.module_name
+        key = "|".join((os.path.abspath(origin), numba.__version__,
+                        os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
+        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+        return os.path.join(tempfile.gettempdir(), f"speedplan-kernel-{digest}.lock")
+
+
+#: Every family of compiled kernels, by name, in the order a plan() needs them.
+FAMILIES: dict[str, Kernels] = {
+    "relaxation": Kernels("relaxation", "speedplan.solve._banded_ipm", then=("time law",)),
+    "time law": Kernels("time law", "speedplan.core._law_kernel"),
+    "refinement": Kernels("refinement", "speedplan.solve._banded_nlp_kernels"),
+}
+
+
+def claim_lock(path: str) -> bool:
+    """Create the lock file ``path``; False if a fresh one exists (another process compiles).
+
+    A lock older than :data:`COMPILE_LOCK_STALE` was left by a process that died: taken over.
+    """
+    for _ in range(2):
+        try:
+            os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+            return True
+        except FileExistsError:
+            try:
+                if time.time() - os.path.getmtime(path) < COMPILE_LOCK_STALE:
+                    return False
+                os.remove(path)  # stale: its compiling process died
+            except OSError:
+                return False
+        except OSError:
+            return True  # no usable temporary directory: compile without a lock
+    return False
+
+
+#: The compiling process's program (``-c``; ``-m`` would import this module twice).
+_MAIN = "import sys; from speedplan.core.jit import _main; sys.exit(_main(sys.argv[1:]))"
+
+
+def _package_root() -> str:
+    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def spawn_compile(names: Iterable[str]) -> subprocess.Popen[bytes] | None:
+    """Start a Python process compiling the families ``names``, on this very copy of speedplan.
+
+    The process compiles the families ``names`` into numba's cache and removes each one's
+    lock (claimed by the caller) when it is done. It runs at normal priority: measured on a
+    loaded 2-core machine, a compilation at the lowest priority took 75 s instead of 25 s,
+    and every plan meanwhile ran on the slower fallback.
+    """
+    if not sys.executable:
+        return None
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (_package_root(), env.get("PYTHONPATH")) if p)
+    try:
+        return subprocess.Popen([sys.executable, "-c", _MAIN, *names], env=env,
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+    except OSError:
+        return None
+
+
+def compile_families(names: Iterable[str] | None = None, *, parallel: bool = True
+                     ) -> dict[str, float]:
+    """Compile the kernel families ``names`` (default: all) into numba's cache; wait for them.
+
+    With ``parallel``, each family compiles in its own process (the compilation is
+    single-threaded, so this uses the machine's cores); otherwise they compile here, one
+    after the other. Families already in the cache load in well under a second.
+
+    Returns
+    -------
+    dict
+        Seconds per family (wall clock, from the start of the call).
+
+    Raises
+    ------
+    RuntimeError
+        If a compilation process failed (its output is in the message).
+
+    Examples
+    --------
+    >>> seconds = compile_families(["time law"], parallel=False)
+    >>> list(seconds)
+    ['time law']
+    """
+    chosen = list(FAMILIES) if names is None else list(names)
+    unknown = [n for n in chosen if n not in FAMILIES]
+    if unknown:
+        raise ValueError(f"unknown kernel families {unknown}; valid: {list(FAMILIES)}")
+    t0 = time.perf_counter()
+    seconds: dict[str, float] = {}
+    if not parallel:
+        for name in chosen:
+            FAMILIES[name].compile()
+            seconds[name] = time.perf_counter() - t0
+        return seconds
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (_package_root(), env.get("PYTHONPATH")) if p)
+    procs = {name: subprocess.Popen([sys.executable, "-c", _MAIN, "--no-lock", name],
+                                    env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT)
+             for name in chosen}
+    failed = []
+    pending = dict(procs)
+    while pending:
+        for name, proc in list(pending.items()):
+            if proc.poll() is not None:
+                seconds[name] = time.perf_counter() - t0
+                out = proc.communicate()[0].decode(errors="replace")
+                if proc.returncode != 0:
+                    failed.append(f"{name}: {out.strip()[-2000:]}")
+                del pending[name]
+        time.sleep(0.02)
+    if failed:
+        raise RuntimeError("compiling the kernels failed:\n" + "\n".join(failed))
+    return seconds
+
+
+def _main(argv: list[str]) -> int:
+    """The compiling process: ``[--no-lock] NAME...``; compile each, then release its lock."""
+    lock = "--no-lock" not in argv
+    for name in (a for a in argv if a != "--no-lock"):
+        family = FAMILIES[name]
+        try:
+            family.compile()
+        finally:
+            if lock:
+                _release(family)
+    return 0
+
+
+def _release(family: Kernels) -> None:
+    """Remove ``family``'s compile lock."""
+    try:
+        os.remove(family.lock_path())
+    except OSError:
+        pass
