@@ -5,8 +5,9 @@
 where the vehicle must be at rest: where a boundary state forces a stop on the way (a
 decelerating start whose speed falls exactly to zero: the motion to that point is forced, a
 :class:`ForcedLeg`), and — with the route and cusp support — at cusps and stops. Each
-:class:`Leg` is planned on its own; :meth:`Leg.solve` restates a discrete infeasibility in
-speeds and metres.
+:class:`Leg` is planned on its own (:mod:`speedplan.strategy` solves it);
+:func:`explain_infeasible` restates a discrete infeasibility of its problem in speeds and
+metres. This layer builds data and calls no solver.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
 from ..core.limits import Limits
 from ..geometry import Path, SpeedBound, bound_breakpoints
-from ..solve import DiscreteProblem, DiscreteSolution, solve_problem
+from ..solve import DiscreteProblem
 from ..solve.banded import MAX_RAMP_STEPS, ramp_steps
 from ..solve.nojerk import max_feasible_w
 from ..solve.problem import StencilRows
@@ -40,8 +41,8 @@ from .request import PlanRequest, within_limit
 from .standstill import calibrate_standstill_rows
 
 __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
-           "build_model", "coarsenable", "coarser_leg", "grid_anchors", "node_bounds",
-           "rest_points"]
+           "build_model", "coarsenable", "coarser_leg", "explain_infeasible", "grid_anchors",
+           "node_bounds", "rest_points"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
@@ -142,18 +143,6 @@ class Leg(_Ends):
     refine: str = "auto"
     backend: str = "auto"
     anchors: FloatArray = field(default_factory=lambda: np.zeros(0))
-
-    def solve(self, *, fallback: bool = True) -> DiscreteSolution:
-        """Solve the leg's discrete problem; an infeasibility is restated physically.
-
-        ``fallback``: whether a failed relaxation backend is retried with the other one
-        (:func:`~speedplan.solve.solve_problem`).
-        """
-        try:
-            return solve_problem(self.problem, refine=self.refine, backend=self.backend,
-                                 fallback=fallback)
-        except InfeasibleError as exc:
-            raise _explain(exc, self) from exc
 
 
 @dataclass(frozen=True)
@@ -764,7 +753,7 @@ def node_bounds(bound: Any, s: FloatArray, per_interval: int = 8) -> FloatArray:
     return w
 
 
-def _explain(exc: InfeasibleError, leg: Leg) -> InfeasibleError:
+def explain_infeasible(exc: InfeasibleError, leg: Leg) -> InfeasibleError:
     """Restate a discrete infeasibility in speeds and metres (positions along the path)."""
     lim = leg.limits
     if exc.s is None:
