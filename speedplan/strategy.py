@@ -40,6 +40,7 @@ import numpy as np
 
 from .core.attempts import Attempt, AttemptOutcome, describe_attempts
 from .core.checks import FloatArray, as_scalar
+from .core.deadline import deadline
 from .core.errors import (
     InfeasibleError,
     LimitWarning,
@@ -116,6 +117,11 @@ class Budget:
         """Whether the limit has passed."""
         return self.remaining() <= 0.0
 
+    @property
+    def deadline(self) -> float | None:
+        """When the limit passes (a ``time.perf_counter()`` value), ``None`` without one."""
+        return None if self.time_limit is None else self.start + self.time_limit
+
 
 @dataclass
 class Record:
@@ -136,7 +142,8 @@ class Record:
             raise self.timeout()
         t0 = time.perf_counter()
         try:
-            result = run()
+            with deadline(self.budget.deadline):  # for backends that can stop at it
+                result = run()
         except catch as exc:
             self.entries.append(Attempt(name, leg, "failed", _reason(exc),
                                         time.perf_counter() - t0))
@@ -272,17 +279,18 @@ def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg, i: int, record: Re
                               else "default_grid", i, lambda: solve_leg(leg)), False
     with contextlib.suppress(SolverError):
         return record.attempt("default_grid", i, lambda: solve_leg(leg, fallback=False)), False
-    grids: list[tuple[str, Leg]] = [("default_grid", leg)]  # built only now: most solve at once
+    grids: list[Leg] = [leg]  # each built inside its attempt: most default grids solve at once
     for factor in COARSER_GRIDS:
-        coarser = coarser_leg(request, leg, factor)
-        if coarser is None or coarser.problem.n >= grids[-1][1].problem.n:
+        try:
+            result = record.attempt(f"coarser_grid_1/{round(1 / factor)}", i,
+                                    partial(_solve_coarser, request, grids, factor))
+        except SolverError:
+            continue
+        except _NotCoarser:  # not recorded: nothing was tried
             break
-        grids.append((f"coarser_grid_1/{round(1 / factor)}", coarser))
-    for name, grid in grids[1:]:
-        with contextlib.suppress(SolverError):
-            return record.attempt(name, i, partial(solve_leg, grid, fallback=False)), True
+        return result, True
     failure: SolverError | None = None
-    for _, grid in grids:
+    for grid in grids:
         try:
             return record.attempt("other_backend", i, partial(solve_leg, grid)), False
         except SolverError as exc:
@@ -290,6 +298,23 @@ def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg, i: int, record: Re
                 failure = exc
     assert failure is not None
     raise failure
+
+
+class _NotCoarser(Exception):
+    """The default grid cannot get coarser (:func:`~speedplan.model.build.coarser_leg`)."""
+
+
+def _solve_coarser(request: PlanRequest, grids: list[Leg], factor: float) -> LegResult:
+    """The first leg of ``grids`` on a grid with ``factor`` times its nodes, solved.
+
+    The grid is appended to ``grids``; :class:`_NotCoarser` when it would not be coarser
+    than the last one there.
+    """
+    coarser = coarser_leg(request, grids[0], factor)
+    if coarser is None or coarser.problem.n >= grids[-1].problem.n:
+        raise _NotCoarser
+    grids.append(coarser)
+    return solve_leg(coarser, fallback=False)
 
 
 # ---- verify ---------------------------------------------------------------------------------

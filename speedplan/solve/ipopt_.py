@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..core.checks import FloatArray
+from ..core.deadline import remaining
 from ..core.errors import SolverError
 from .problem import DiscreteProblem
 
@@ -125,7 +126,9 @@ def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
     g, lbg, ubg = _rows(problem, x)
     nlp = {"x": x, "f": ca.dot(ca.DM(problem.tau), 1.0 / ca.sqrt(x)), "g": g}
     try:
-        solver = ca.nlpsol("refine", "ipopt", nlp, {"ipopt": IPOPT_OPTIONS, **NLPSOL_OPTIONS})
+        left = remaining()  # the plan's deadline (speedplan.core.deadline), if any
+        options = IPOPT_OPTIONS if left is None else {**IPOPT_OPTIONS, "max_wall_time": left}
+        solver = ca.nlpsol("refine", "ipopt", nlp, {"ipopt": options, **NLPSOL_OPTIONS})
         ub = problem.w_max[1:-1]
         lb = np.minimum(wmin, ub)
         if problem.w_min is not None:
