@@ -5,6 +5,7 @@ Usage::
     python benchmarks/bench_latency.py --plans 2000 --seed 0
     python benchmarks/bench_latency.py --plans 300 --baseline /path/to/other/checkout
     python benchmarks/bench_latency.py --cases-only --time-limit 2
+    python benchmarks/bench_latency.py --plans 200 --cap 60 --baseline /path/to/checkout
 
 The fuzz mixes straight moves (the trust fuzz's ranges, ``tests/trust_fuzz.py``), curved G2
 paths through random waypoints, slow zones, comfort limits (``j_lat_max``, ``yaw_rate_max``)
@@ -17,7 +18,8 @@ class.
 
 With ``--baseline DIR`` the same measurement is also run on the speedplan checkout in ``DIR``
 (a subprocess with ``PYTHONPATH=DIR``) and both are printed side by side, so the two runs
-share the machine's load.
+share the machine's load. ``--cap`` stops a plan still running after that many seconds (it
+is counted at the cap, outcome ``stopped at ...``), so that a slow checkout finishes.
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ import subprocess
 import sys
 import time
 import warnings
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import TimeoutError as FuturesTimeout
 from dataclasses import dataclass
 from pathlib import Path as FsPath
 from typing import Any
@@ -143,25 +147,56 @@ def fuzz_cases(sp: Any, plans: int, seed: int) -> list[Job]:
     return jobs
 
 
-def run(jobs: list[Job], time_limit: float | None, sp: Any) -> list[dict[str, Any]]:
-    """Plan every job; its seconds and outcome."""
+def plan_one(job: Job, time_limit: float | None) -> dict[str, Any]:
+    """Plan ``job``: its seconds and outcome."""
+    import speedplan as sp
+
+    kwargs = dict(job.kwargs)
+    if time_limit is not None:
+        kwargs["time_limit"] = time_limit
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            profile = sp.plan(job.path, job.limits, **kwargs)
+        outcome = profile.status
+        warned = sorted({w.category.__name__ for w in caught})
+    except Exception as exc:  # the outcome is data here
+        outcome, warned = type(exc).__name__, []
+    return {"name": job.name, "seconds": time.perf_counter() - t0, "outcome": outcome,
+            "warnings": warned}
+
+
+def _warm() -> None:
+    import speedplan as sp
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sp.plan(_straight(sp, 5.0), sp.Limits(2.0, 1.0, 1.0, 0.5))  # compile the kernels
+
+
+def run(jobs: list[Job], time_limit: float | None, cap: float | None) -> list[dict[str, Any]]:
+    """Plan every job; with ``cap``, in a worker process stopped after ``cap`` seconds."""
+    if cap is None:
+        return [plan_one(job, time_limit) for job in jobs]
     out = []
+    pool = None
     for job in jobs:
-        kwargs = dict(job.kwargs)
-        if time_limit is not None:
-            kwargs["time_limit"] = time_limit
-        t0 = time.perf_counter()
+        if pool is None:
+            pool = ProcessPoolExecutor(1)
+            pool.submit(_warm).result()
+        future = pool.submit(plan_one, job, time_limit)
         try:
-            with warnings.catch_warnings(record=True) as caught:
-                warnings.simplefilter("always")
-                profile = sp.plan(job.path, job.limits, **kwargs)
-            outcome = profile.status
-            warned = sorted({w.category.__name__ for w in caught})
-        except Exception as exc:  # the outcome is data here
-            outcome, warned = type(exc).__name__, []
-        seconds = time.perf_counter() - t0
-        out.append({"name": job.name, "seconds": seconds, "outcome": outcome,
-                    "warnings": warned})
+            out.append(future.result(timeout=cap))
+        except FuturesTimeout:  # a plan still running at the cap: stopped, counted at it
+            for proc in list(getattr(pool, "_processes", {}).values()):
+                proc.kill()
+            pool.shutdown(wait=True, cancel_futures=True)
+            pool = None
+            out.append({"name": job.name, "seconds": cap, "outcome": f"stopped at {cap:g} s",
+                        "warnings": []})
+    if pool is not None:
+        pool.shutdown()
     return out
 
 
@@ -169,12 +204,10 @@ def measure(args: argparse.Namespace) -> dict[str, Any]:
     """Warm up, then time the named cases and the fuzz on the speedplan on ``sys.path``."""
     import speedplan as sp
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        sp.plan(_straight(sp, 5.0), sp.Limits(2.0, 1.0, 1.0, 0.5))  # compile the kernels
-    cases = run(named_cases(sp), args.time_limit, sp)
+    _warm()
+    cases = run(named_cases(sp), args.time_limit, args.cap)
     fuzz = [] if args.cases_only else run(fuzz_cases(sp, args.plans, args.seed),
-                                          args.time_limit, sp)
+                                          args.time_limit, args.cap)
     return {"speedplan": str(FsPath(sp.__file__).parent.parent), "cases": cases, "fuzz": fuzz}
 
 
@@ -231,6 +264,9 @@ def main(argv: list[str] | None = None) -> None:
                     help="plan(..., time_limit=...) [s] (this checkout only)")
     ap.add_argument("--baseline", default=None,
                     help="another speedplan checkout to measure too, side by side")
+    ap.add_argument("--cap", type=float, default=None,
+                    help="stop a plan after this many seconds and count it at the cap "
+                         "(each plan then runs in a worker process)")
     ap.add_argument("--json", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.json:
@@ -239,7 +275,9 @@ def main(argv: list[str] | None = None) -> None:
     runs = []
     if args.baseline is not None:
         argv_base = [sys.executable, str(HERE), "--json", "--plans", str(args.plans),
-                     "--seed", str(args.seed)] + (["--cases-only"] if args.cases_only else [])
+                     "--seed", str(args.seed)] + (["--cases-only"] if args.cases_only else []
+                                                  ) + ([] if args.cap is None
+                                                       else ["--cap", str(args.cap)])
         env = dict(os.environ, PYTHONPATH=str(FsPath(args.baseline).resolve()))
         done = subprocess.run(argv_base, env=env, capture_output=True, text=True, check=True)
         runs.append(("baseline", json.loads(done.stdout.splitlines()[-1])))
