@@ -8,6 +8,7 @@ import threading
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from concurrent.futures import BrokenExecutor, Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -235,8 +236,9 @@ def plan_many(
     -----
     A process pool breaks when one of its workers dies (killed, or out of memory): every
     job it held or had queued then fails with ``BrokenProcessPool``. Those jobs are run once
-    more on a fresh process pool (with as many workers); only the jobs that fail again are
-    reported as failed, with the error of that second run.
+    more on a fresh process pool (as many workers, the same start method); only the jobs
+    that fail again are reported as failed, with the error of that second run. A pool that
+    breaks before any job finished is not retried: it cannot run jobs at all (see below).
 
     Process pools under the ``spawn`` or ``forkserver`` start method (the default on macOS
     and Windows, and on Linux from Python 3.14) import the main module in every worker. A
@@ -280,7 +282,9 @@ def plan_many(
     done = total - len(requests)
     if report is not None and done:
         report(done, total)
-    workers = getattr(executor, "_max_workers", None) if executor is not None else None
+    # A fresh pool after a worker died is built like the one that broke.
+    workers = getattr(executor, "_max_workers", None)
+    context = getattr(executor, "_mp_context", None)
     own = executor is None and bool(requests)
     ex = executor if executor is not None else (
         ProcessPoolExecutor(max_workers=os.cpu_count()) if requests else None)
@@ -296,9 +300,15 @@ def plan_many(
     finally:
         if own and ex is not None:
             ex.shutdown()
-    if lost:
+    if lost and len(lost) == len(requests):  # no job ran: the pool itself cannot work
+        for i in lost:
+            results[i] = BatchResult(i, None, BrokenProcessPool(
+                "the process pool broke before any job finished"))
+        tick()
+    elif lost:
         logger.debug("plan_many: a worker died; %d jobs run again on a fresh pool", len(lost))
-        with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as fresh:
+        with ProcessPoolExecutor(max_workers=workers or os.cpu_count(),
+                                 mp_context=context) as fresh:
             _run_batch(fresh, {i: requests[i] for i in lost}, results, tick, final=True)
     out = [r for r in results if r is not None]
     common = _common_failure(out, requests)
