@@ -6,8 +6,10 @@ only when the ones before it did not answer:
 * **model** (once per request): ``"model"``, the request as asked (moving boundary states
   capped by the max-jerk motion); ``"exact_reach"``, the exact reach envelope in distance,
   when the first refuses moving states that a motion whose speed first dips reaches;
-  ``"jerk_slack"`` and ``"exact_reach_jerk_slack"``, both again with ``j_max (1 +
-  STATE_JERK_SLACK)``, for moving states just outside what ``j_max`` reaches (with a
+  ``"state_rounding"`` and ``"exact_reach_state_rounding"``, both again with ``j_max (1 +
+  STATE_JERK_ROUNDING)`` near the states (a state read off a plan; silent); then
+  ``"jerk_slack"`` and ``"exact_reach_jerk_slack"`` with ``j_max (1 + STATE_JERK_SLACK)``
+  near them, for moving states just outside what ``j_max`` reaches (with a
   :class:`~speedplan.SpeedplanWarning`).
 * **solve** (per leg): ``"forced_motion"`` for a leg with no freedom left; ``"given_grid"``
   for the caller's grid (``n`` or ``ds``: both relaxation backends, never another grid);
@@ -49,7 +51,7 @@ from .core.errors import (
     SpeedplanWarning,
 )
 from .model import ForcedLeg, Leg, Model, PlanRequest, build_model
-from .model.boundary import STATE_JERK_SLACK, state_jerk
+from .model.boundary import STATE_JERK_ROUNDING, STATE_JERK_SLACK, state_jerk
 from .model.build import coarsenable, coarser_leg, explain_infeasible, leg_on_grid
 from .model.refine import refined_grid
 from .solve import DiscreteSolution, solve_problem
@@ -72,7 +74,8 @@ COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
 
 #: Every attempt's name, in the order the strategy tries them (see the module docstring).
 ATTEMPTS: tuple[str, ...] = (
-    "model", "exact_reach", "jerk_slack", "exact_reach_jerk_slack",
+    "model", "exact_reach", "state_rounding", "exact_reach_state_rounding", "jerk_slack",
+    "exact_reach_jerk_slack",
     "forced_motion", "given_grid", "default_grid",
     *(f"coarser_grid_1/{round(1 / f)}" for f in COARSER_GRIDS),
     "other_backend", "local_refinement", "default_grid_other_backend",
@@ -185,10 +188,13 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
     keeps the relaxation exact but misses feasible motions whose speed first dips: if it
     refuses the states, the exact envelope in distance (``reach="distance"``) decides.
 
-    Marginal states: moving boundary states just outside what ``j_max`` reaches are planned
-    with ``j_max (1 + STATE_JERK_SLACK)`` (with a warning). A state measured on the vehicle
-    can lie a hair outside the set a jerk-limited motion reaches; refusing it would strand
-    the vehicle. The plan is still verified against the requested limits.
+    Marginal states: a moving boundary state that ``j_max (1 + STATE_JERK_ROUNDING)``
+    reaches (a state read off a plan, on the boundary of the reachable set up to the law's
+    rounding) is planned with that jerk near it, silently; one just outside what ``j_max``
+    reaches is planned with ``j_max (1 + STATE_JERK_SLACK)`` near it, with a warning (a
+    state measured on the vehicle: refusing it would strand the vehicle). "Near" is where
+    the state's envelopes bind (:attr:`PlanRequest.state_jerk`); elsewhere the jerk rows
+    keep ``j_max``, and the plan is verified against the requested limits.
     """
     moving = any(x != 0.0 for x in (request.v0, request.a0, request.vf, request.af))
     try:
@@ -200,23 +206,27 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
         refusal = exc
     exact = replace(request, reach="distance")
     with contextlib.suppress(InfeasibleError):
-        return exact, record.attempt("exact_reach", None, lambda: build_model(exact),
+        return exact, record.attempt("exact_reach", None, partial(build_model, exact),
                                      catch=(InfeasibleError,))
-    lim = request.limits
-    looser_jerk = replace(lim, j_max=state_jerk(lim.j_max))
-    for name, base in (("jerk_slack", request), ("exact_reach_jerk_slack", exact)):
-        looser = replace(base, limits=looser_jerk)
+    j_max = request.limits.j_max
+    for name, base, jerk in (
+            ("state_rounding", request, j_max * (1.0 + STATE_JERK_ROUNDING)),
+            ("exact_reach_state_rounding", exact, j_max * (1.0 + STATE_JERK_ROUNDING)),
+            ("jerk_slack", request, state_jerk(j_max)),
+            ("exact_reach_jerk_slack", exact, state_jerk(j_max))):
+        looser = replace(base, state_jerk=jerk)
         with contextlib.suppress(InfeasibleError):
             model = record.attempt(name, None, partial(build_model, looser),
                                    catch=(InfeasibleError,))
             break
     else:
         raise refusal from None
-    warnings.warn(
-        f"the boundary states are reachable only with {STATE_JERK_SLACK:.0%} more jerk than "
-        f"j_max={lim.j_max:.6g} m/s³ ({refusal}); planned with j_max={looser.limits.j_max:.6g} "
-        "m/s³, within the jerk tolerance", SpeedplanWarning, stacklevel=4,
-    )
+    if name.endswith("jerk_slack"):
+        warnings.warn(
+            f"the boundary states are reachable only with {STATE_JERK_SLACK:.0%} more jerk "
+            f"than j_max={j_max:.6g} m/s³ ({refusal}); planned with j_max={jerk:.6g} m/s³ "
+            "near them, within the jerk tolerance", SpeedplanWarning, stacklevel=4,
+        )
     return looser, model
 
 

@@ -188,3 +188,47 @@ def test_plan_many_survives_a_worker_killed_mid_batch():
     results = sp.plan_many(jobs, progress=_kill_a_worker_once)
     assert [r.index for r in results] == list(range(24))
     assert all(r.ok for r in results), [repr(r.error) for r in results if not r.ok]
+
+
+def test_states_read_off_a_plan_replan_without_a_warning():
+    # A controller replanning at 10 Hz from its own plan's state: e.g. the U-turn at t = 3 s,
+    # whose state needs 2.6e-5 more jerk than j_max (the law's rounding), warned per cycle.
+    from speedplan.io import read_path
+
+    u_turn = read_path(os.path.join(os.path.dirname(__file__), "..", "paths", "u_turn.json"))
+    first = sp.plan(u_turn, LGV)
+    rounded = 0
+    for t in (*np.linspace(0.25, first.duration - 0.5, 13), 3.0):
+        state = first.at(t)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            again = sp.plan(u_turn.sub(float(state.s[0])), LGV, v0=float(state.v[0]),
+                            a0=float(state.a[0]))
+        assert again.verification.ok, (t, again.verification.summary())
+        assert t + again.duration >= first.duration * (1 - 1e-4), t
+        rounded += any(a.name.endswith("state_rounding") for a in again.attempts
+                       if a.outcome == "answered")
+    assert rounded > 0  # the case is exercised
+
+
+def _final_stop_jerk(profile: sp.SpeedProfile, seconds: float) -> float:
+    """Largest finite-difference jerk over the last ``seconds`` of the profile [m/s³]."""
+    dt = 1e-3
+    t = np.arange(profile.duration - seconds, profile.duration, dt)
+    v = profile.at(t).v
+    return float(np.abs(np.diff(v, 2)).max() / dt**2)
+
+
+def test_the_jerk_slack_of_an_outside_state_applies_near_it_only():
+    # Accelerating 0.4 % harder than the plan's own state at t = 3 s: the speed would
+    # overshoot v_max under j_max, not under 1.02 j_max. Planned with a warning; the final
+    # stop, 20 m further, keeps j_max.
+    first = sp.plan(STRAIGHT, LGV)
+    state = first.at(3.0)
+    rest = sp.Path.from_segments([Line(30.0 - float(state.s[0]))])
+    with pytest.warns(sp.SpeedplanWarning, match="reachable only with 2% more jerk"):
+        again = sp.plan(rest, LGV, v0=float(state.v[0]), a0=float(state.a[0]) * 1.004)
+    assert next(a.name for a in again.attempts if a.outcome == "answered") == "jerk_slack"
+    assert again.verification.ok
+    # The last 4 s (the stop into rest): the jerk of the plan without slack.
+    assert _final_stop_jerk(again, 4.0) <= _final_stop_jerk(first, 4.0) * (1 + 2e-3)
