@@ -179,9 +179,10 @@ def run(jobs: list[Job], time_limit: float | None, cap: float | None) -> list[di
     """Plan every job; with ``cap``, in a worker process stopped after ``cap`` seconds."""
     if cap is None:
         return [plan_one(job, time_limit) for job in jobs]
-    out = []
+    out: list[dict[str, Any]] = []
     pool = None
-    for job in jobs:
+    for k, job in enumerate(jobs):
+        print(f"\r{k}/{len(jobs)}", end="", file=sys.stderr, flush=True)
         if pool is None:
             pool = ProcessPoolExecutor(1)
             pool.submit(_warm).result()
