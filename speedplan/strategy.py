@@ -287,27 +287,40 @@ def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg, i: int, record: Re
     if not coarsenable(request, leg):
         return record.attempt("given_grid" if request.n is not None or request.ds is not None
                               else "default_grid", i, lambda: solve_leg(leg)), False
-    with contextlib.suppress(SolverError):
-        return record.attempt("default_grid", i, lambda: solve_leg(leg, fallback=False)), False
     grids: list[Leg] = [leg]  # each built inside its attempt: most default grids solve at once
+    try:
+        return record.attempt("default_grid", i, partial(solve_leg, leg, fallback=False)), False
+    except SolverError as exc:
+        failures = [exc]
     for factor in COARSER_GRIDS:
         try:
             result = record.attempt(f"coarser_grid_1/{round(1 / factor)}", i,
                                     partial(_solve_coarser, request, grids, factor))
-        except SolverError:
+        except SolverError as exc:
+            failures.append(exc)
             continue
         except _NotCoarser:  # not recorded: nothing was tried
             break
         return result, True
-    failure: SolverError | None = None
-    for grid in grids:
+    # Each grid with the backend that did not fail on it (the failed one is not run again).
+    for grid, failed in zip(grids, failures, strict=True):
+        run = (partial(solve_leg, replace(grid, backend=_other_backend(failed.backend)),
+                       fallback=False) if failed.backend in ("banded", "clarabel")
+               else partial(solve_leg, grid))  # a law that did not arrive: both backends
         try:
-            return record.attempt("other_backend", i, partial(solve_leg, grid)), False
+            return record.attempt("other_backend", i, run), False
         except SolverError as exc:
             if grid is leg:
-                failure = exc
-    assert failure is not None
+                failure = SolverError(
+                    f"both relaxation backends failed on the default grid ({failed.backend}: "
+                    f"{failed}; {exc.backend}: {exc}), and on its coarser grids",
+                    backend=f"{failed.backend},{exc.backend}", status=exc.status)
     raise failure
+
+
+def _other_backend(failed: str) -> str:
+    """The relaxation backend that is not ``failed`` (``"banded"`` or ``"clarabel"``)."""
+    return "clarabel" if failed == "banded" else "banded"
 
 
 class _NotCoarser(Exception):

@@ -232,3 +232,23 @@ def test_the_jerk_slack_of_an_outside_state_applies_near_it_only():
     assert again.verification.ok
     # The last 4 s (the stop into rest): the jerk of the plan without slack.
     assert _final_stop_jerk(again, 4.0) <= _final_stop_jerk(first, 4.0) * (1 + 2e-3)
+
+
+def test_a_backend_that_fails_on_a_grid_is_not_run_on_it_again(monkeypatch):
+    # The banded backend stalls on every grid: the strategy tries it on the default grid
+    # and on each coarser one once, then Clarabel on each in turn, never banded again.
+    discrete = importlib.import_module("speedplan.solve.discrete")
+    calls: list[int] = []
+
+    def stalls(unit):
+        calls.append(unit.n)
+        raise sp.SolverError("stalled (test)", backend="banded", status="NoProgress")
+
+    monkeypatch.setitem(discrete.RELAXATION_BACKENDS, "banded", stalls)
+    profile = sp.plan(STRAIGHT, LGV, backend="banded")
+    names = [(a.name, a.outcome) for a in profile.attempts]
+    assert names[:5] == [("model", "answered"), ("default_grid", "failed"),
+                         ("coarser_grid_1/2", "failed"), ("coarser_grid_1/4", "failed"),
+                         ("other_backend", "answered")]
+    assert len(calls) == len(set(calls)) == 3  # each grid (its own node count) once
+    assert profile.solution.backend == "clarabel" and profile.verification.ok
