@@ -14,7 +14,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 
-__all__ = ["MIN_SOLVER_TIME", "deadline", "remaining"]
+__all__ = ["MIN_SOLVER_TIME", "deadline", "passed", "remaining"]
 
 #: Shortest time limit handed to a backend [s]: below, it would stop before its first
 #: iteration and report a failure that says nothing about the problem.
@@ -49,3 +49,19 @@ def remaining() -> float | None:
     if at is None:
         return None
     return max(at - time.perf_counter(), MIN_SOLVER_TIME)
+
+
+def passed() -> bool:
+    """Whether the current deadline (if any) has passed.
+
+    Examples
+    --------
+    >>> import time
+    >>> with deadline(time.perf_counter() - 1.0):
+    ...     passed()
+    True
+    >>> passed()
+    False
+    """
+    at = _DEADLINE.get()
+    return at is not None and time.perf_counter() >= at

@@ -18,6 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.checks import FloatArray
+from ..core.deadline import passed
 from .banded_nlp import LATERAL_STARTS, STARTS, solve_banded_nlp
 from .ipopt_ import RefineResult, refine_ipopt
 from .problem import DiscreteProblem
@@ -77,6 +78,8 @@ def refine(
     iterations = 0
     found: list[float] = []
     for start in LATERAL_STARTS if problem.has_lateral else STARTS:
+        if iterations and passed():  # the plan's deadline (speedplan.core.deadline): stop
+            break
         res = solve_banded_nlp(problem, w0, start)
         iterations += res.iterations
         status = f"banded/{start.name}: {res.status}"
@@ -88,7 +91,7 @@ def refine(
             if any(abs(objective - f) <= AGREE * f for f in found):
                 break  # two paths ended at the same point: the third would too (corpus)
             found.append(objective)
-    if best is None:
+    if best is None and not passed():
         ipopt = refine_ipopt(problem, w0)
         iterations += ipopt.iterations
         status = f"ipopt: {ipopt.status}"
