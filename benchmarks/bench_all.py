@@ -104,7 +104,7 @@ def cases() -> list[tuple[str, sp.Path, sp.Limits, dict[str, Any]]]:
 @contextmanager
 def staged(acc: dict[str, float]) -> Iterator[None]:
     """Wrap the stage functions that ``plan()`` calls; accumulate their times into ``acc``."""
-    plan_mod = importlib.import_module("speedplan.plan")
+    plan_mod = importlib.import_module("speedplan.strategy")  # the stages it calls
     saved: list[tuple[Any, str, Any]] = []
     inner: list[float] = []  # time spent in wrapped calls nested in the open ones
 
@@ -140,7 +140,7 @@ def staged(acc: dict[str, float]) -> Iterator[None]:
     wrap(plan_mod, "build_model", "build")
     wrap(plan_mod, "leg_on_grid", "build")
     wrap(plan_mod, "refined_grid", "build")
-    wrap(Leg, "solve", "solve rest", split)
+    wrap(plan_mod, "solve_problem", "solve rest", split)
     wrap(plan_mod, "law_for", "law")
     wrap(SpeedProfile, "check_leg", "checks")
     wrap(SpeedProfile, "verify", "verify")

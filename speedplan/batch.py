@@ -7,12 +7,13 @@ import sys
 import threading
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from concurrent.futures import BrokenExecutor, Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-from .core.checks import shown
+from .core.checks import as_scalar, shown
 from .core.errors import InvalidInputError, SpeedplanError
 from .core.log import logger
 from .model import PlanRequest
@@ -120,11 +121,11 @@ def _captured_warnings() -> Iterator[list[JobWarning]]:
                 _context = _show_before = None
 
 
-def _run_job(request: PlanRequest) -> _Outcome:
+def _run_job(request: PlanRequest, time_limit: float | None = None) -> _Outcome:
     """The worker: ``plan_request(request)`` with the warnings it issues."""
     with _captured_warnings() as caught:
         try:
-            profile = plan_request(request)
+            profile = plan_request(request, time_limit=time_limit)
         except SpeedplanError as exc:
             return _Outcome(None, exc, tuple(caught))
     return _Outcome(profile, None, tuple(caught))
@@ -164,9 +165,14 @@ def _job_list(jobs: Any) -> list[Any]:
         ) from exc
 
 
-def _request(kwargs: dict[str, Any]) -> PlanRequest:
+def _request(kwargs: dict[str, Any], time_limit: float | None
+             ) -> tuple[PlanRequest, float | None]:
+    """The job's request and its time limit (its own ``time_limit``, else the batch's)."""
     kw = dict(kwargs)
-    return PlanRequest.create(kw.pop("path"), kw.pop("limits"), **kw)
+    limit = kw.pop("time_limit", time_limit)
+    if limit is not None:
+        limit = as_scalar("time_limit", limit, positive=True)
+    return PlanRequest.create(kw.pop("path"), kw.pop("limits"), **kw), limit
 
 
 def _print_progress(done: int, total: int) -> None:
@@ -193,6 +199,7 @@ def plan_many(
     executor: Executor | None = None,
     *,
     progress: bool | Callable[[int, int], None] = False,
+    time_limit: float | None = None,
 ) -> list[BatchResult]:
     """Plan many paths in parallel; results come back in job order.
 
@@ -206,6 +213,10 @@ def plan_many(
         dask.distributed ``Client.get_executor()`` or a Ray executor work unchanged.
     progress : bool or callable
         ``True`` prints ``planned k/N`` to stderr; a callable receives ``(done, total)``.
+    time_limit : float, optional
+        Seconds each job may take once it runs (:func:`speedplan.plan`'s ``time_limit``); a
+        job's own ``time_limit`` keyword takes precedence. A job that runs out of it fails
+        with :class:`~speedplan.PlanTimeout`.
 
     Returns
     -------
@@ -223,6 +234,12 @@ def plan_many(
 
     Notes
     -----
+    A process pool breaks when one of its workers dies (killed, or out of memory): every
+    job it held or had queued then fails with ``BrokenProcessPool``. Those jobs are run once
+    more on a fresh process pool (as many workers, the same start method); only the jobs
+    that fail again are reported as failed, with the error of that second run. A pool that
+    breaks before any job finished is not retried: it cannot run jobs at all (see below).
+
     Process pools under the ``spawn`` or ``forkserver`` start method (the default on macOS
     and Windows, and on Linux from Python 3.14) import the main module in every worker. A
     script must therefore call ``plan_many`` under ``if __name__ == "__main__":``; without
@@ -239,7 +256,7 @@ def plan_many(
     >>> lim = Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
     >>> jobs = [(Path.from_waypoints([[0, 0], [L, 0]], kind="polyline"), lim) for L in (5, 10)]
     >>> with ThreadPoolExecutor(2) as ex:
-    ...     results = plan_many(jobs, ex)
+    ...     results = plan_many(jobs, ex, time_limit=30.0)
     >>> [r.ok for r in results], results[0].warnings
     ([True, True], ())
     """
@@ -249,42 +266,50 @@ def plan_many(
             "`executor` must be a concurrent.futures.Executor (something with submit()); got "
             f"{type(executor).__name__}"
         )
+    if time_limit is not None:
+        time_limit = as_scalar("time_limit", time_limit, positive=True)
     total = len(normalised)
     report = _print_progress if progress is True else (progress or None)
     results: list[BatchResult | None] = [None] * total
     # Check every job here, before shipping any: a bad argument costs no worker round trip.
-    requests: dict[int, PlanRequest] = {}
+    requests: dict[int, tuple[PlanRequest, float | None]] = {}
     for i, kwargs in enumerate(normalised):
         try:
-            requests[i] = _request(kwargs)
+            requests[i] = _request(kwargs, time_limit)
         except (InvalidInputError, TypeError) as exc:
             logger.debug("plan_many: job %d refused before sending: %s", i, exc)
             results[i] = BatchResult(i, None, exc)
     done = total - len(requests)
     if report is not None and done:
         report(done, total)
+    # A fresh pool after a worker died is built like the one that broke.
+    workers = getattr(executor, "_max_workers", None)
+    context = getattr(executor, "_mp_context", None)
     own = executor is None and bool(requests)
     ex = executor if executor is not None else (
         ProcessPoolExecutor(max_workers=os.cpu_count()) if requests else None)
+    def tick() -> None:
+        if report is not None:
+            report(sum(r is not None for r in results), total)
+
+    lost: list[int] = []  # jobs of a process pool that broke under them
     try:
         if ex is not None:
-            futures = {ex.submit(_run_job, req): i for i, req in requests.items()}
-            for fut in as_completed(futures):
-                i = futures[fut]
-                try:
-                    outcome = fut.result()
-                    result = BatchResult(i, outcome.profile, outcome.error, outcome.warnings)
-                except Exception as exc:  # one job's failure must not lose the others
-                    result = BatchResult(i, None, exc)
-                if result.error is not None:
-                    logger.debug("plan_many: job %d failed: %r", i, result.error)
-                results[i] = result
-                done += 1
-                if report is not None:
-                    report(done, total)
+            lost = _run_batch(ex, requests, results, tick,
+                              final=not isinstance(ex, ProcessPoolExecutor))
     finally:
         if own and ex is not None:
             ex.shutdown()
+    if lost and len(lost) == len(requests):  # no job ran: the pool itself cannot work
+        for i in lost:
+            results[i] = BatchResult(i, None, BrokenProcessPool(
+                "the process pool broke before any job finished"))
+        tick()
+    elif lost:
+        logger.debug("plan_many: a worker died; %d jobs run again on a fresh pool", len(lost))
+        with ProcessPoolExecutor(max_workers=workers or os.cpu_count(),
+                                 mp_context=context) as fresh:
+            _run_batch(fresh, {i: requests[i] for i in lost}, results, tick, final=True)
     out = [r for r in results if r is not None]
     common = _common_failure(out, requests)
     if common is not None:
@@ -297,3 +322,33 @@ def plan_many(
             "the jobs can be pickled"
         ) from common
     return out
+
+
+def _run_batch(ex: Executor, requests: dict[int, tuple[PlanRequest, float | None]],
+               results: list[BatchResult | None], tick: Callable[[], None], *, final: bool
+               ) -> list[int]:
+    """Run ``requests`` on ``ex`` into ``results``; the jobs lost to a broken executor.
+
+    Unless ``final``, a lost job gets no result here (it is to be run again); otherwise its
+    result is the ``BrokenExecutor`` error.
+    """
+    futures: dict[Future[_Outcome], int] = {
+        ex.submit(_run_job, req, limit): i for i, (req, limit) in requests.items()}
+    lost = []
+    for fut in as_completed(futures):
+        i = futures[fut]
+        try:
+            outcome = fut.result()
+            result = BatchResult(i, outcome.profile, outcome.error, outcome.warnings)
+        except BrokenExecutor as exc:  # the pool died under the job, not the job itself
+            if not final:
+                lost.append(i)
+                continue
+            result = BatchResult(i, None, exc)
+        except Exception as exc:  # one job's failure must not lose the others
+            result = BatchResult(i, None, exc)
+        if result.error is not None:
+            logger.debug("plan_many: job %d failed: %r", i, result.error)
+        results[i] = result
+        tick()
+    return sorted(lost)

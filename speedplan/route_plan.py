@@ -11,13 +11,21 @@ import numpy as np
 
 from .batch import plan_many
 from .core.checks import as_scalar
-from .core.errors import InfeasibleError, InvalidInputError, SolverError, SpeedplanError
+from .core.errors import (
+    InfeasibleError,
+    InvalidInputError,
+    PlanTimeout,
+    SolverError,
+    SpeedplanError,
+)
 from .core.limits import Limits
 from .geometry import SpanLimit
 from .geometry._checks import wrap_angle
 from .plan import plan
 from .route import THETA_TOLERANCE, Route, RouteProfile
 from .route.profile import RouteTurn
+from .strategy import Budget
+from .timing import SpeedProfile
 from .timing.rotation import Turn
 
 __all__ = ["plan_route", "plan_route_update", "route_jobs", "route_turns"]
@@ -201,7 +209,10 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
         Plan the legs on it (``plan_many``); default: one after the other in this process.
     **plan_options
         Other :func:`speedplan.plan` keywords (``n``, ``ds``, ``zones``, ``refine``,
-        ``standstill``, ``backend``); stops, spans and boundary states come from the route.
+        ``standstill``, ``backend``, ``time_limit``); stops, spans and boundary states come
+        from the route. ``time_limit`` [s] bounds the whole route when the legs are planned
+        here (each leg gets what the ones before it left), each leg with an ``executor``
+        (they run in parallel).
 
     Returns
     -------
@@ -235,20 +246,29 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     >>> profile.node_times.round(3).tolist(), profile.status
     ([0.0, 14.828], 'optimal')
     """
+    time_limit = plan_options.pop("time_limit", None)
+    budget = Budget.of(time_limit)
     jobs, starts = route_jobs(route, limits, start_s=start_s, v0=v0, a0=a0, **plan_options)
     if heading0 is not None:
         heading0 = as_scalar("heading0", heading0)
     turns = route_turns(route, limits, start_s=start_s, v0=v0, heading0=heading0)
     if executor is None:
-        legs = []
+        legs: list[SpeedProfile] = []
         for job, lo in zip(jobs, starts, strict=True):
             options = {k: v for k, v in job.items() if k not in ("path", "limits")}
             try:
+                if budget.time_limit is not None:  # the legs share the route's limit
+                    if budget.expired():
+                        raise PlanTimeout(
+                            f"time_limit={budget.time_limit:.6g} s ran out after {len(legs)} "
+                            f"of the route's {len(jobs)} legs; pass a larger time_limit",
+                            time_limit=budget.time_limit)
+                    options["time_limit"] = budget.remaining()
                 legs.append(plan(job["path"], job["limits"], **options))
             except SpeedplanError as exc:
                 raise _on_leg(exc, lo, job) from exc
     else:
-        results = plan_many(jobs, executor)
+        results = plan_many(jobs, executor, time_limit=budget.time_limit)
         legs = []
         for result, lo, job in zip(results, starts, jobs, strict=True):
             if result.error is not None:
@@ -407,4 +427,6 @@ def _on_leg(exc: SpeedplanError, lo: float, job: dict[str, Any]) -> SpeedplanErr
         return SolverError(msg, backend=exc.backend, status=exc.status)
     if isinstance(exc, InvalidInputError):
         return InvalidInputError(msg)
+    if isinstance(exc, PlanTimeout):
+        return PlanTimeout(msg, time_limit=exc.time_limit, attempts=exc.attempts)
     return SpeedplanError(msg)

@@ -50,11 +50,11 @@ def sample_cases():
 
 def first_profile(path, lim, kw, n):
     """The profile of the first solve on the uniform grid, before any refinement."""
-    from speedplan.plan import _solve
+    from speedplan.strategy import solve_leg
 
     req = PlanRequest.create(path, lim, n=n, **kw)
     model = build_model(req)
-    legs = tuple(_solve(leg) for leg in model.legs)
+    legs = tuple(solve_leg(leg) for leg in model.legs)
     return SpeedProfile(path=path, limits=lim, legs=legs, speed_bound=model.bound, request=req)
 
 

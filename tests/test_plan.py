@@ -25,6 +25,7 @@ from speedplan import (
 from speedplan.geometry import Arc, Clothoid, Line
 from speedplan.io import read_path, read_zones
 from speedplan.model import PlanRequest, build_model
+from speedplan.strategy import solve_leg
 from speedplan.timing import TOLERANCES, law_for
 from speedplan.timing.verify import check_law
 
@@ -127,7 +128,7 @@ def test_every_sample_path(file):
 def _law_check(path, lim, **kw):
     """The check of a plan's law on its initial grid, before any local refinement."""
     leg = build_model(PlanRequest.create(path, lim, **kw)).legs[0]
-    law = law_for(leg.problem.s, leg.solve().w, leg.time_law)
+    law = law_for(leg.problem.s, solve_leg(leg).solution.w, leg.time_law)
     return check_law(law, 0.0, path, leg.bound, lim).verification, law.duration
 
 

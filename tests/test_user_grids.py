@@ -22,14 +22,14 @@ from speedplan.geometry import Line
 from speedplan.model import PlanRequest, build_model
 from speedplan.model.grid import END_PER_PHASE, GRADING, graded_ends
 
-plan_module = importlib.import_module("speedplan.plan")
+strategy = importlib.import_module("speedplan.strategy")
 
 
 def _first_checks(path: sp.Path, lim: sp.Limits, **kw: object) -> list[sp.Verification]:
     """The checks of the laws of the model's own grid, before any refinement."""
     request = PlanRequest.create(path, lim, **kw)
     model = build_model(request)
-    legs = tuple(plan_module._solve(leg) for leg in model.legs)
+    legs = tuple(strategy.solve_leg(leg) for leg in model.legs)
     profile = sp.SpeedProfile(path=path, limits=lim, legs=legs, speed_bound=model.bound,
                               request=request)
     return [profile.check_leg(i).verification for i in range(len(legs))]

@@ -6,10 +6,13 @@ Every error a user can meet derives from :class:`SpeedplanError`, so one
 
 from __future__ import annotations
 
+from typing import Any
+
 __all__ = [
     "InfeasibleError",
     "InvalidInputError",
     "LimitWarning",
+    "PlanTimeout",
     "SolverError",
     "SpeedplanError",
     "SpeedplanWarning",
@@ -51,6 +54,35 @@ class SolverError(SpeedplanError):
         super().__init__(message)
         self.backend = backend
         self.status = status
+
+
+class PlanTimeout(SpeedplanError):
+    """No verified plan was found within ``plan(..., time_limit=...)``.
+
+    Raised instead of returning a profile whose continuous trajectory has not passed its
+    check: the message names every attempt of the strategy that ran and why each did not
+    answer (:mod:`speedplan.strategy`).
+
+    Attributes
+    ----------
+    time_limit : float
+        The limit that ran out [s].
+    attempts : tuple of Attempt
+        The attempts made, in order (:class:`~speedplan.core.attempts.Attempt`).
+    """
+
+    def __init__(self, message: str, *, time_limit: float, attempts: tuple[Any, ...] = ()
+                 ) -> None:
+        super().__init__(message)
+        self.time_limit = time_limit
+        self.attempts = attempts
+
+    def __reduce__(self) -> tuple[Any, ...]:  # picklable for plan_many's workers
+        return (_plan_timeout, (str(self), self.time_limit, self.attempts))
+
+
+def _plan_timeout(message: str, time_limit: float, attempts: tuple[Any, ...]) -> PlanTimeout:
+    return PlanTimeout(message, time_limit=time_limit, attempts=attempts)
 
 
 class SpeedplanWarning(UserWarning):

@@ -10,8 +10,9 @@ Modules, one job each:
 * :mod:`~speedplan.model.standstill` — jerk rows next to a standstill;
 * :mod:`~speedplan.model.refine` — local grid refinement where a law exceeds a limit;
 * :mod:`~speedplan.model.build` — :func:`build_model`: request -> :class:`Model` (speed bound,
-  :class:`~speedplan.solve.DiscreteProblem`, time-law options), and solving it with errors in
-  physical terms.
+  :class:`~speedplan.solve.DiscreteProblem`, time-law options); the problems are solved by
+  :mod:`speedplan.strategy`, and :func:`~speedplan.model.build.explain_infeasible` restates
+  their infeasibilities in physical terms.
 
 This layer imports ``core``, ``geometry`` and ``solve``.
 """

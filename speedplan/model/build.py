@@ -5,8 +5,9 @@
 where the vehicle must be at rest: where a boundary state forces a stop on the way (a
 decelerating start whose speed falls exactly to zero: the motion to that point is forced, a
 :class:`ForcedLeg`), and — with the route and cusp support — at cusps and stops. Each
-:class:`Leg` is planned on its own; :meth:`Leg.solve` restates a discrete infeasibility in
-speeds and metres.
+:class:`Leg` is planned on its own (:mod:`speedplan.strategy` solves it);
+:func:`explain_infeasible` restates a discrete infeasibility of its problem in speeds and
+metres. This layer builds data and calls no solver.
 """
 
 from __future__ import annotations
@@ -20,11 +21,17 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
 from ..core.limits import Limits
 from ..geometry import Path, SpeedBound, bound_breakpoints
-from ..solve import DiscreteProblem, DiscreteSolution, solve_problem
+from ..solve import DiscreteProblem
 from ..solve.banded import MAX_RAMP_STEPS, ramp_steps
 from ..solve.nojerk import max_feasible_w
 from ..solve.problem import StencilRows
-from .boundary import check_reachable_states, fastest_w, jerk_motion_w, turnaround_speed
+from .boundary import (
+    STATE_JERK_ROUNDING,
+    check_reachable_states,
+    fastest_w,
+    jerk_motion_w,
+    turnaround_speed,
+)
 from .grid import (
     MAX_DEFAULT_NODES,
     MIN_NODES,
@@ -36,12 +43,12 @@ from .grid import (
     uniform_grid,
 )
 from .refine import subdivided_grid
-from .request import PlanRequest, within_limit
+from .request import STATE_ROUNDING, PlanRequest, within_limit
 from .standstill import calibrate_standstill_rows
 
 __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "build_leg",
-           "build_model", "coarsenable", "coarser_leg", "grid_anchors", "lateral_speed_caps",
-           "node_bounds", "rest_points"]
+           "build_model", "coarsenable", "coarser_leg", "explain_infeasible", "grid_anchors",
+           "lateral_speed_caps", "node_bounds", "rest_points"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
@@ -59,6 +66,9 @@ TOUCH_ZERO = 1e-6
 #: never cuts a feasible point.
 CAP_NEWTON_STEPS = 60
 CAP_MARGIN = 1e-9
+#: ... or when passing through the dip instead of restarting from rest gains less than this
+#: fraction of the move's least duration (far below the 1e-4 of the optimum plans promise).
+TOUCH_TIME = 1e-6
 #: Nodes of the sampled forced motion of a :class:`ForcedLeg`.
 FORCED_NODES = 401
 
@@ -147,18 +157,6 @@ class Leg(_Ends):
     refine: str = "auto"
     backend: str = "auto"
     anchors: FloatArray = field(default_factory=lambda: np.zeros(0))
-
-    def solve(self, *, fallback: bool = True) -> DiscreteSolution:
-        """Solve the leg's discrete problem; an infeasibility is restated physically.
-
-        ``fallback``: whether a failed relaxation backend is retried with the other one
-        (:func:`~speedplan.solve.solve_problem`).
-        """
-        try:
-            return solve_problem(self.problem, refine=self.refine, backend=self.backend,
-                                 fallback=fallback)
-        except InfeasibleError as exc:
-            raise _explain(exc, self) from exc
 
 
 @dataclass(frozen=True)
@@ -267,7 +265,7 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
     if request.jerk_limited:
         try:
             check_reachable_states(v0, a0, vf, af, length, lim.v_max, lim.a_max, lim.a_decel,
-                                   lim.j_max)
+                                   request.moving_state_jerk)
         except InfeasibleError as exc:
             if rest_before is None and rest_after is None:
                 raise
@@ -279,9 +277,20 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
                 f"rest): {exc}", constraint=exc.constraint,
                 s=None if exc.s is None else lo + exc.s) from exc
     legs: list[Leg | ForcedLeg] = []
-    head = _forced_stop(v0, a0, lim, end=False) if request.jerk_limited else None
-    tail = _forced_stop(vf, af, lim, end=True) if request.jerk_limited else None
+    j_state = request.moving_state_jerk
+    # A state read off a plan's final stop lies on the stop's curve up to the law's rounding.
+    touch = TOUCH_ZERO if request.state_jerk is None or j_state > lim.j_max * (
+        1.0 + STATE_JERK_ROUNDING) else max(TOUCH_ZERO, 2.0 * STATE_JERK_ROUNDING)
+    touching = {"touch": touch, "least_duration": length / lim.v_max}
+    head = _forced_stop(v0, a0, j_state, end=False, **touching) if request.jerk_limited else None
+    tail = _forced_stop(vf, af, j_state, end=True, **touching) if request.jerk_limited else None
     inner_lo, inner_hi = lo, hi
+    for forced in (head, tail):
+        if forced is not None and length < forced.length <= length * (1.0 + STATE_ROUNDING):
+            # A state on a stop's curve a rounding past the stretch (read off a plan's
+            # final stop): the stop spans the stretch.
+            forced = replace(forced, length=length, s=forced.s * (length / forced.length))
+            head, tail = (forced, None) if forced.v0 > 0 else (None, forced)
     if head is not None:
         legs.append(_shifted(head, lo))
         inner_lo, v0, a0 = lo + head.length, 0.0, 0.0
@@ -503,17 +512,24 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
             f"the speed bound is 0 at s={lo + s[i]:.6g} m inside the path ({_zero_cause(bound)}); "
             "split the path there to plan a stop"
         )
-    floor = env.floor(s)
-    if floor is not None:
-        _check_floor(floor, w_max, s, lo, v0, a0, vf, af)
     m = s.size
-    jerk = np.full(m - 2, lim.J)
-    if request.smooth_standstill:
-        calibrate_standstill_rows(jerk, s, v0, a0, vf, af, lim.j_max)
     accel, decel = np.full(m - 1, lim.A), np.full(m - 1, lim.A_decel)
     if np.isfinite(lim.j_lat_max):
         w_max[1:-1] = np.minimum(w_max[1:-1], lateral_speed_caps(
             request.path, lo, s, lim.j_lat_max, accel, decel))
+    floor = env.floor(s)
+    if floor is not None:
+        # Against the bound at the nodes themselves: the node bound (its minimum over the
+        # adjacent cells) is below it where the bound falls, and a state read off a plan
+        # braking into a curve is that close to the slowest motion (the U-turn at t = 7.8 s).
+        _check_floor(floor, np.maximum(w_max, env.cap(s, np.asarray(bound(s), dtype=np.float64))),
+                     s, lo, v0, a0, vf, af)
+        w_max[1:-1] = np.maximum(w_max[1:-1], floor[1:-1])
+    jerk = np.full(m - 2, lim.J)
+    if request.state_jerk is not None:  # the slack of marginal states, near them only
+        jerk[env.near_states(s, w_max)[1:-1]] = 2.0 * request.state_jerk
+    if request.smooth_standstill:
+        calibrate_standstill_rows(jerk, s, v0, a0, vf, af, lim.j_max)
     problem = DiscreteProblem(
         s=s, w_max=w_max, accel=accel, decel=decel,
         jerk=jerk, w_start=v0 * v0, w_end=vf * vf, w_min=floor,
@@ -744,13 +760,38 @@ class _Envelopes:
     af: float
     length: float
     in_distance: bool = False
+    state_j: float | None = None  # the jerk of a moving state's envelopes (default j_max)
 
     @classmethod
     def of(cls, request: PlanRequest, v0: float, a0: float, vf: float, af: float,
            length: float) -> _Envelopes:
         """The envelopes of one leg of ``request`` between the given states."""
         return cls(request.limits, request.smooth_standstill, request.jerk_limited, v0, a0,
-                   vf, af, length, in_distance=request.reach == "distance")
+                   vf, af, length, in_distance=request.reach == "distance",
+                   state_j=request.moving_state_jerk)
+
+    def near_states(self, s: FloatArray, w_max: FloatArray) -> np.ndarray:
+        """The nodes where a moving boundary state's envelopes bind, and their neighbours.
+
+        Where the fastest motion from (to) a moving state is below the node bound ``w_max``,
+        or its slowest motion above rest: the stretch its own transient spans. Jerk slack
+        for a marginal state (``PlanRequest.state_jerk``) applies there only.
+        """
+        near = np.zeros(s.size, dtype=bool)
+        lim = self.limits
+        if self.v0 > 0:
+            near |= self._fastest(s, self.v0, self.a0, lim.a_max, lim.a_decel, moving=True) \
+                < w_max * (1.0 - 1e-9)
+        if self.vf > 0:
+            near |= self._fastest(self.length - s, self.vf, -self.af, lim.a_decel, lim.a_max,
+                                  moving=True) < w_max * (1.0 - 1e-9)
+        floor = self.floor(s)
+        if floor is not None:
+            near |= floor > 0.0
+        wide = near.copy()  # a jerk row reads its two neighbours
+        wide[1:] |= near[:-1]
+        wide[:-1] |= near[1:]
+        return wide
 
     def cap(self, s: FloatArray, w: FloatArray) -> FloatArray:
         """``w`` capped by the largest ``w`` reachable from (v0, a0) and reaching (vf, af).
@@ -765,17 +806,19 @@ class _Envelopes:
         if not self.jerk_limited:
             return w
         if self.smooth or self.v0 > 0:
-            w = np.minimum(w, self._fastest(s, self.v0, self.a0, lim.a_max, lim.a_decel))
+            w = np.minimum(w, self._fastest(s, self.v0, self.a0, lim.a_max, lim.a_decel,
+                                            moving=self.v0 > 0))
         if self.smooth or self.vf > 0:
             w = np.minimum(w, self._fastest(self.length - s, self.vf, -self.af, lim.a_decel,
-                                            lim.a_max))
+                                            lim.a_max, moving=self.vf > 0))
         return w
 
     def _fastest(self, d: FloatArray, v: float, a: float, a_limit: float,
-                 a_brake: float) -> FloatArray:
+                 a_brake: float, *, moving: bool) -> FloatArray:
+        j = self.state_j if moving and self.state_j is not None else self.limits.j_max
         if self.in_distance:
-            return fastest_w(d, v, a, self.limits.j_max, a_limit, a_brake)
-        return jerk_motion_w(d, v, a, self.limits.j_max, a_limit)
+            return fastest_w(d, v, a, j, a_limit, a_brake)
+        return jerk_motion_w(d, v, a, j, a_limit)
 
     def floor(self, s: FloatArray) -> FloatArray | None:
         """The slowest motion leaving a moving start (and arriving at a moving end)."""
@@ -783,34 +826,47 @@ class _Envelopes:
         if not self.jerk_limited or (self.v0 == 0.0 and self.vf == 0.0):
             return None
         lo = np.zeros_like(s)
+        j = lim.j_max if self.state_j is None else self.state_j
         if self.v0 > 0:
-            lo = np.maximum(lo, jerk_motion_w(s, self.v0, self.a0, -lim.j_max, -lim.a_decel))
+            lo = np.maximum(lo, jerk_motion_w(s, self.v0, self.a0, -j, -lim.a_decel))
         if self.vf > 0:
-            lo = np.maximum(lo, jerk_motion_w(self.length - s, self.vf, -self.af, -lim.j_max,
+            lo = np.maximum(lo, jerk_motion_w(self.length - s, self.vf, -self.af, -j,
                                               -lim.a_max))
         return lo
 
 
-def _forced_stop(v: float, a: float, lim: Limits, *, end: bool) -> ForcedLeg | None:
-    """The forced motion to rest when a decelerating start (accelerating end) touches zero."""
+def _forced_stop(v: float, a: float, j_max: float, *, end: bool, touch: float,
+                 least_duration: float) -> ForcedLeg | None:
+    """The forced motion to rest when a decelerating start (accelerating end) touches zero.
+
+    ``j_max``: the jerk the state may use (``PlanRequest.moving_state_jerk``). It touches
+    zero when the speed falls to within ``touch`` of its own (:data:`TOUCH_ZERO`), or so
+    close to zero that restarting from rest would cost less than :data:`TOUCH_TIME` of
+    ``least_duration`` (the stretch's length over ``v_max``): a dip the grid cannot resolve
+    (a 1.9 km move from 1.5e-5 m/s braking at 0.019 m/s² dips to 9e-9 m/s).
+    """
     slowing = -a if not end else a
     if not (v > 0 and slowing > 0):
         return None
-    dip = turnaround_speed(v, -slowing, lim.j_max)
-    if dip > TOUCH_ZERO * v:
+    dip = turnaround_speed(v, -slowing, j_max)
+    # The optimum passes the dip and speeds up again; from rest it needs 2 sqrt(2 dip / j)
+    # longer, which below TOUCH_TIME of the move's least duration no plan resolves.
+    restart = 2.0 * float(np.sqrt(2.0 * max(dip, 0.0) / j_max))
+    if dip > touch * v and restart > TOUCH_TIME * least_duration:
         return None
-    # v = slowing²/(2 j): the forced motion is the max-jerk stop, time reversed, so
-    # u = w^{3/4} falls linearly to 0 over its length |a|³ / (6 j²).
-    length = slowing**3 / (6.0 * lim.j_max**2)
+    # v = slowing²/(2 j) with j = slowing²/(2 v) <= j_max: the forced motion is that max-jerk
+    # stop, time reversed, so u = w^{3/4} falls linearly to 0 over its length |a|³ / (6 j²).
+    j_max = min(j_max, slowing**2 / (2.0 * v))
+    length = slowing**3 / (6.0 * j_max**2)
     frac = np.linspace(0.0, 1.0, FORCED_NODES)
     s = frac * length
     if end:  # from rest at the leg's start to (v, a) at its end
         w = v * v * frac ** (4.0 / 3.0)
-        law = TimeLawSpec(j_max=lim.j_max, accel_start=None, accel_end=a)
+        law = TimeLawSpec(j_max=j_max, accel_start=None, accel_end=a)
         return ForcedLeg(start=0.0, length=length, v0=0.0, a0=0.0, vf=v, af=a, s=s, w=w,
                          time_law=law)
     w = v * v * (1.0 - frac) ** (4.0 / 3.0)
-    law = TimeLawSpec(j_max=lim.j_max, accel_start=a, accel_end=None)
+    law = TimeLawSpec(j_max=j_max, accel_start=a, accel_end=None)
     return ForcedLeg(start=0.0, length=length, v0=v, a0=a, vf=0.0, af=0.0, s=s, w=w,
                      time_law=law)
 
@@ -849,7 +905,7 @@ def node_bounds(bound: Any, s: FloatArray, per_interval: int = 8) -> FloatArray:
     return w
 
 
-def _explain(exc: InfeasibleError, leg: Leg) -> InfeasibleError:
+def explain_infeasible(exc: InfeasibleError, leg: Leg) -> InfeasibleError:
     """Restate a discrete infeasibility in speeds and metres (positions along the path)."""
     lim = leg.limits
     if exc.s is None:

@@ -103,6 +103,9 @@ class PlanRequest:
     stops: tuple[float, ...] = ()
     spans: tuple[SpanLimit, ...] = ()
     reach: str = "max_jerk"  # one of REACH_MODES; set by plan(), not by callers
+    #: Jerk [m/s³] a moving boundary state may use near it (``None``: ``limits.j_max``):
+    #: set by plan() for states just outside what ``j_max`` reaches, not by callers.
+    state_jerk: float | None = None
 
     @classmethod
     def create(cls, path: Any, limits: Any, *, n: Any = None, ds: Any = None, v0: Any = 0.0,
@@ -154,6 +157,11 @@ class PlanRequest:
     def jerk_limited(self) -> bool:
         """Whether the limits bound the jerk."""
         return bool(np.isfinite(self.limits.j_max))
+
+    @property
+    def moving_state_jerk(self) -> float:
+        """The jerk a moving boundary state may use near it [m/s³] (``state_jerk``)."""
+        return self.limits.j_max if self.state_jerk is None else self.state_jerk
 
     @property
     def smooth_standstill(self) -> bool:

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..core.checks import FloatArray
+from ..core.deadline import remaining
 from ..core.errors import SolverError
 from .problem import DiscreteProblem
 
@@ -163,7 +164,9 @@ def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
                       np.concatenate((ub, np.ones(u0.size))))
     nlp = {"x": variables, "f": ca.dot(ca.DM(problem.tau), 1.0 / ca.sqrt(x)), "g": g}
     try:
-        solver = ca.nlpsol("refine", "ipopt", nlp, {"ipopt": IPOPT_OPTIONS, **NLPSOL_OPTIONS})
+        left = remaining()  # the plan's deadline (speedplan.core.deadline), if any
+        options = IPOPT_OPTIONS if left is None else {**IPOPT_OPTIONS, "max_wall_time": left}
+        solver = ca.nlpsol("refine", "ipopt", nlp, {"ipopt": options, **NLPSOL_OPTIONS})
         sol = solver(x0=x0, lbx=lb, ubx=ub, lbg=lbg, ubg=ubg)
     except RuntimeError as exc:
         raise SolverError(f"IPOPT failed to run: {exc}", backend="ipopt") from exc

@@ -18,6 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.checks import FloatArray
+from ..core.deadline import passed
 from .banded_nlp import LATERAL_STARTS, STARTS, solve_banded_nlp
 from .ipopt_ import RefineResult, refine_ipopt
 from .problem import GRIP_TOL, DiscreteProblem
@@ -79,6 +80,8 @@ def refine(
     # The banded method holds no friction-ellipse rows: IPOPT refines those problems.
     starts = () if problem.has_grip else LATERAL_STARTS if problem.has_lateral else STARTS
     for start in starts:
+        if iterations and passed():  # the plan's deadline (speedplan.core.deadline): stop
+            break
         res = solve_banded_nlp(problem, w0, start)
         iterations += res.iterations
         status = f"banded/{start.name}: {res.status}"
@@ -90,7 +93,7 @@ def refine(
             if any(abs(objective - f) <= AGREE * f for f in found):
                 break  # two paths ended at the same point: the third would too (corpus)
             found.append(objective)
-    if best is None:
+    if best is None and not passed():
         ipopt = refine_ipopt(problem, w0)
         iterations += ipopt.iterations
         status = f"ipopt: {ipopt.status}"

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from .._version import __version__
+from ..core.attempts import Attempt
 from ..core.checks import FloatArray, as_array, as_scalar
 from ..core.errors import InvalidInputError
 from ..core.forward import Forwarded
@@ -126,6 +127,11 @@ class SpeedProfile:
     limits_exceeded : bool
         Whether that check still failed after local refinement (then :attr:`status` is
         ``"limits_exceeded"``).
+    attempts : tuple of Attempt
+        The attempts of the planning strategy, in order (:mod:`speedplan.strategy`): for
+        the request and for each leg, which one answered (``outcome == "answered"``) and
+        why each other failed or was replaced
+        (:class:`~speedplan.core.attempts.Attempt`). Empty for a profile built by hand.
     objective : float
         Discrete objective ``Σ τ_i / sqrt(w_i)`` that the solver minimised [s].
     lower_bound : float
@@ -143,6 +149,7 @@ class SpeedProfile:
     request: PlanRequest | None = None
     verification: Verification | None = None
     limits_exceeded: bool = False
+    attempts: tuple[Attempt, ...] = ()
 
     # ---- the speed law on the grid ----------------------------------------------------------
     @cached_property

@@ -1,0 +1,439 @@
+"""The planning strategy behind :func:`speedplan.plan`: ordered attempts, a budget, a record.
+
+A plan is one pass through a fixed chain of named attempts (:data:`ATTEMPTS`), each tried
+only when the ones before it did not answer:
+
+* **model** (once per request): ``"model"``, the request as asked (moving boundary states
+  capped by the max-jerk motion); ``"exact_reach"``, the exact reach envelope in distance,
+  when the first refuses moving states that a motion whose speed first dips reaches;
+  ``"state_rounding"`` and ``"exact_reach_state_rounding"``, both again with ``j_max (1 +
+  STATE_JERK_ROUNDING)`` near the states (a state read off a plan; silent); then
+  ``"jerk_slack"`` and ``"exact_reach_jerk_slack"`` with ``j_max (1 + STATE_JERK_SLACK)``
+  near them, for moving states just outside what ``j_max`` reaches (with a
+  :class:`~speedplan.SpeedplanWarning`).
+* **solve** (per leg): ``"forced_motion"`` for a leg with no freedom left; ``"given_grid"``
+  for the caller's grid (``n`` or ``ds``: both relaxation backends, never another grid);
+  otherwise ``"default_grid"`` with the request's backend, then ``"coarser_grid_1/2"``,
+  ``"coarser_grid_1/4"``, ``"coarser_grid_1/8"`` (:data:`COARSER_GRIDS`) with it, then
+  ``"other_backend"`` on each of these grids in turn.
+* **verify** (per leg whose continuous law exceeds a tolerance): up to
+  :data:`MAX_REFINEMENTS` rounds of ``"local_refinement"`` of the grid where it does, then,
+  for a leg answered on a coarser grid, ``"default_grid_other_backend"``.
+
+:class:`Budget` holds the caller's ``time_limit``: it is checked before every attempt, and
+an attempt the budget no longer covers is not started. The record of every attempt (which
+answered, why the others failed or were replaced, what each cost) is kept on the profile,
+:attr:`~speedplan.SpeedProfile.attempts`. When the budget runs out before a verified plan,
+:class:`~speedplan.PlanTimeout` names what was tried; a profile whose law has not passed
+its check is never returned.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from functools import partial
+from typing import TypeVar
+
+import numpy as np
+
+from .core.attempts import Attempt, AttemptOutcome, describe_attempts
+from .core.checks import FloatArray, as_scalar
+from .core.deadline import deadline
+from .core.errors import (
+    InfeasibleError,
+    LimitWarning,
+    PlanTimeout,
+    SolverError,
+    SpeedplanWarning,
+)
+from .model import ForcedLeg, Leg, Model, PlanRequest, build_model
+from .model.boundary import STATE_JERK_ROUNDING, STATE_JERK_SLACK, state_jerk
+from .model.build import coarsenable, coarser_leg, explain_infeasible, leg_on_grid
+from .model.refine import refined_grid
+from .solve import DiscreteSolution, solve_problem
+from .timing import TOLERANCES, LegResult, SpeedProfile, Verification, law_for
+
+__all__ = ["ATTEMPTS", "COARSER_GRIDS", "MAX_REFINEMENTS", "REFINE_FACTORS",
+           "STATE_CONSTRAINTS", "Budget", "Record", "model_request", "refine_factor",
+           "solve_leg", "solve_legs", "verified_profile"]
+
+#: What the reachability checks of boundary states name when they refuse one.
+STATE_CONSTRAINTS = ("jerk", "v_max", "length", "speed_bound")
+#: Rounds of local grid refinement where the continuous law exceeds a tolerance.
+MAX_REFINEMENTS = 3
+#: Bounds on the factor a refinement round multiplies the flagged steps by (finer in one
+#: round grades the grid so steeply that the banded kernel loses accuracy, measured).
+REFINE_FACTORS = (1 / 4, 1 / 2)
+#: Fractions of its nodes a jerk-limited default grid is rebuilt with, in turn, when the
+#: relaxation backend does not converge on it (:func:`~speedplan.model.build.coarser_leg`).
+COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
+
+#: Every attempt's name, in the order the strategy tries them (see the module docstring).
+ATTEMPTS: tuple[str, ...] = (
+    "model", "exact_reach", "state_rounding", "exact_reach_state_rounding", "jerk_slack",
+    "exact_reach_jerk_slack",
+    "forced_motion", "given_grid", "default_grid",
+    *(f"coarser_grid_1/{round(1 / f)}" for f in COARSER_GRIDS),
+    "other_backend", "local_refinement", "default_grid_other_backend",
+)
+
+T = TypeVar("T")
+
+
+@dataclass
+class Budget:
+    """The time a plan may take: ``time_limit`` seconds from ``start`` (``None``: no limit).
+
+    Examples
+    --------
+    >>> Budget(None).remaining()
+    inf
+    >>> Budget(0.0).expired()
+    True
+    """
+
+    time_limit: float | None
+    start: float = field(default_factory=time.perf_counter)
+
+    @classmethod
+    def of(cls, time_limit: float | None) -> Budget:
+        """A budget starting now; ``time_limit`` checked (a positive number of seconds)."""
+        if time_limit is None:
+            return cls(None)
+        return cls(as_scalar("time_limit", time_limit, positive=True))
+
+    def elapsed(self) -> float:
+        """Seconds since the budget started."""
+        return time.perf_counter() - self.start
+
+    def remaining(self) -> float:
+        """Seconds left (``inf`` without a limit)."""
+        if self.time_limit is None:
+            return float("inf")
+        return self.time_limit - self.elapsed()
+
+    def expired(self) -> bool:
+        """Whether the limit has passed."""
+        return self.remaining() <= 0.0
+
+    @property
+    def deadline(self) -> float | None:
+        """When the limit passes (a ``time.perf_counter()`` value), ``None`` without one."""
+        return None if self.time_limit is None else self.start + self.time_limit
+
+
+@dataclass
+class Record:
+    """The attempts made so far for one plan, and the budget they run under."""
+
+    budget: Budget
+    entries: list[Attempt] = field(default_factory=list)
+
+    def attempt(self, name: str, leg: int | None, run: Callable[[], T],
+                catch: tuple[type[Exception], ...] = (SolverError,)) -> T:
+        """``run()`` as the attempt ``name``, recorded; an exception in ``catch`` is re-raised.
+
+        Raises :class:`~speedplan.PlanTimeout` instead of starting ``run`` when the budget
+        has run out.
+        """
+        if self.budget.expired():
+            self.entries.append(Attempt(name, leg, "skipped", "time limit reached", 0.0))
+            raise self.timeout()
+        t0 = time.perf_counter()
+        try:
+            with deadline(self.budget.deadline):  # for backends that can stop at it
+                result = run()
+        except catch as exc:
+            self.entries.append(Attempt(name, leg, "failed", _reason(exc),
+                                        time.perf_counter() - t0))
+            raise
+        self.entries.append(Attempt(name, leg, "answered", "", time.perf_counter() - t0))
+        return result
+
+    def mark_previous(self, leg: int | None, reason: str) -> None:
+        """Mark the answer of ``leg`` before its latest one as replaced, saying why."""
+        answered = [k for k, e in enumerate(self.entries)
+                    if e.leg == leg and e.outcome == "answered"]
+        if len(answered) >= 2:
+            self.mark(answered[-2], "replaced", reason)
+
+    def mark(self, k: int, outcome: AttemptOutcome, reason: str) -> None:
+        """Set the outcome of entry ``k`` (an attempt whose result was discarded)."""
+        self.entries[k] = replace(self.entries[k], outcome=outcome, reason=reason)
+
+    def timeout(self) -> PlanTimeout:
+        """The error for a budget that ran out before a verified plan."""
+        limit = float(self.budget.time_limit or 0.0)
+        return PlanTimeout(
+            f"no verified plan within time_limit={limit:.6g} s ({self.budget.elapsed():.3g} s "
+            f"spent); tried: {describe_attempts(self.entries)}. Pass a larger time_limit, or "
+            "time_limit=None to run every attempt", time_limit=limit,
+            attempts=tuple(self.entries))
+
+
+def _reason(exc: Exception) -> str:
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text[:300]}"
+
+
+# ---- model ----------------------------------------------------------------------------------
+def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Model]:
+    """The request's model, else with exact reach envelopes, else with a hair more jerk.
+
+    Moving boundary states are capped by the max-jerk motion (``reach="max_jerk"``), which
+    keeps the relaxation exact but misses feasible motions whose speed first dips: if it
+    refuses the states, the exact envelope in distance (``reach="distance"``) decides.
+
+    Marginal states: a moving boundary state that ``j_max (1 + STATE_JERK_ROUNDING)``
+    reaches (a state read off a plan, on the boundary of the reachable set up to the law's
+    rounding) is planned with that jerk near it, silently; one just outside what ``j_max``
+    reaches is planned with ``j_max (1 + STATE_JERK_SLACK)`` near it, with a warning (a
+    state measured on the vehicle: refusing it would strand the vehicle). "Near" is where
+    the state's envelopes bind (:attr:`PlanRequest.state_jerk`); elsewhere the jerk rows
+    keep ``j_max``, and the plan is verified against the requested limits.
+    """
+    moving = any(x != 0.0 for x in (request.v0, request.a0, request.vf, request.af))
+    try:
+        return request, record.attempt("model", None, lambda: build_model(request),
+                                       catch=(InfeasibleError,))
+    except InfeasibleError as exc:
+        if not (moving and request.jerk_limited and exc.constraint in STATE_CONSTRAINTS):
+            raise
+        refusal = exc
+    exact = replace(request, reach="distance")
+    with contextlib.suppress(InfeasibleError):
+        return exact, record.attempt("exact_reach", None, partial(build_model, exact),
+                                     catch=(InfeasibleError,))
+    j_max = request.limits.j_max
+    for name, base, jerk in (
+            ("state_rounding", request, j_max * (1.0 + STATE_JERK_ROUNDING)),
+            ("exact_reach_state_rounding", exact, j_max * (1.0 + STATE_JERK_ROUNDING)),
+            ("jerk_slack", request, state_jerk(j_max)),
+            ("exact_reach_jerk_slack", exact, state_jerk(j_max))):
+        looser = replace(base, state_jerk=jerk)
+        with contextlib.suppress(InfeasibleError):
+            model = record.attempt(name, None, partial(build_model, looser),
+                                   catch=(InfeasibleError,))
+            break
+    else:
+        raise refusal from None
+    if name.endswith("jerk_slack"):
+        warnings.warn(
+            f"the boundary states are reachable only with {STATE_JERK_SLACK:.0%} more jerk "
+            f"than j_max={j_max:.6g} m/s³ ({refusal}); planned with j_max={jerk:.6g} m/s³ "
+            "near them, within the jerk tolerance", SpeedplanWarning, stacklevel=4,
+        )
+    return looser, model
+
+
+# ---- solve ----------------------------------------------------------------------------------
+def solve_leg(leg: Leg | ForcedLeg, *, fallback: bool = True) -> LegResult:
+    """Solve one leg and build its law; an infeasibility is restated in metres.
+
+    ``fallback``: whether a failed relaxation backend is retried with the other one
+    (:func:`~speedplan.solve.solve_problem`).
+    """
+    if isinstance(leg, ForcedLeg):
+        t0 = time.perf_counter()
+        law = law_for(leg.s, leg.w, leg.time_law)
+        duration = law.duration
+        solution = DiscreteSolution(
+            w=leg.w, objective=duration, lower_bound=duration, gap=0.0, exact=True,
+            exact_a_priori=True, jerk_violation=0.0, refined=False, status="optimal",
+            solve_time=time.perf_counter() - t0, backend="forced",
+        )
+        return LegResult(start=leg.start, s=leg.s, solution=solution, law=law)
+    try:
+        solution = solve_problem(leg.problem, refine=leg.refine, backend=leg.backend,
+                                 fallback=fallback)
+    except InfeasibleError as exc:
+        raise explain_infeasible(exc, leg) from exc
+    law = law_for(leg.problem.s, solution.w, leg.time_law)
+    if not np.isfinite(law.duration):  # never hand out a trajectory that does not arrive
+        raise SolverError(
+            f"the speed law between s={leg.start:.6g} m and s={leg.start + leg.length:.6g} m "
+            "comes to rest before its end: the grid does not resolve a boundary transient")
+    return LegResult(start=leg.start, s=leg.problem.s, solution=solution, law=law)
+
+
+def solve_legs(request: PlanRequest, model: Model, record: Record
+               ) -> tuple[list[LegResult], list[bool]]:
+    """Every leg's first answer, and whether it came from a coarser grid (see the module)."""
+    results, coarsened = [], []
+    for i, leg in enumerate(model.legs):
+        result, coarse = _first_answer(request, leg, i, record)
+        results.append(result)
+        coarsened.append(coarse)
+    return results, coarsened
+
+
+def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg, i: int, record: Record
+                  ) -> tuple[LegResult, bool]:
+    """The first of the leg's solve attempts that answers.
+
+    Measured on slow-zone paths (``benchmarks/fuzz_zones.py``): both interior-point methods
+    can stall on a fine default grid and converge on one with a half to an eighth of its
+    nodes, in well under a second, where the other backend takes 10 s to 7 min on the fine
+    grid to fail or to return a relaxation that needs IPOPT. So the backend alone is tried
+    on the default grid and on the coarser ones, and only then the same grids with the other
+    backend as well. A user grid is never changed.
+    """
+    if isinstance(leg, ForcedLeg):
+        return record.attempt("forced_motion", i, lambda: solve_leg(leg)), False
+    if not coarsenable(request, leg):
+        return record.attempt("given_grid" if request.n is not None or request.ds is not None
+                              else "default_grid", i, lambda: solve_leg(leg)), False
+    grids: list[Leg] = [leg]  # each built inside its attempt: most default grids solve at once
+    try:
+        return record.attempt("default_grid", i, partial(solve_leg, leg, fallback=False)), False
+    except SolverError as exc:
+        failures = [exc]
+    for factor in COARSER_GRIDS:
+        try:
+            result = record.attempt(f"coarser_grid_1/{round(1 / factor)}", i,
+                                    partial(_solve_coarser, request, grids, factor))
+        except SolverError as exc:
+            failures.append(exc)
+            continue
+        except _NotCoarser:  # not recorded: nothing was tried
+            break
+        return result, True
+    # Each grid with the backend that did not fail on it (the failed one is not run again).
+    for grid, failed in zip(grids, failures, strict=True):
+        run = (partial(solve_leg, replace(grid, backend=_other_backend(failed.backend)),
+                       fallback=False) if failed.backend in ("banded", "clarabel")
+               else partial(solve_leg, grid))  # a law that did not arrive: both backends
+        try:
+            return record.attempt("other_backend", i, run), False
+        except SolverError as exc:
+            if grid is leg:
+                failure = SolverError(
+                    f"both relaxation backends failed on the default grid ({failed.backend}: "
+                    f"{failed}; {exc.backend}: {exc}), and on its coarser grids",
+                    backend=f"{failed.backend},{exc.backend}", status=exc.status)
+    raise failure
+
+
+def _other_backend(failed: str) -> str:
+    """The relaxation backend that is not ``failed`` (``"banded"`` or ``"clarabel"``)."""
+    return "clarabel" if failed == "banded" else "banded"
+
+
+class _NotCoarser(Exception):
+    """The default grid cannot get coarser (:func:`~speedplan.model.build.coarser_leg`)."""
+
+
+def _solve_coarser(request: PlanRequest, grids: list[Leg], factor: float) -> LegResult:
+    """The first leg of ``grids`` on a grid with ``factor`` times its nodes, solved.
+
+    The grid is appended to ``grids``; :class:`_NotCoarser` when it would not be coarser
+    than the last one there.
+    """
+    coarser = coarser_leg(request, grids[0], factor)
+    if coarser is None or coarser.problem.n >= grids[-1].problem.n:
+        raise _NotCoarser
+    grids.append(coarser)
+    return solve_leg(coarser, fallback=False)
+
+
+# ---- verify ---------------------------------------------------------------------------------
+def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
+                     coarsened: list[bool], record: Record) -> SpeedProfile:
+    """The profile of ``legs``, refined locally where its law exceeds a tolerance, checked.
+
+    Each leg is checked once per law it gets: the final verification merges these checks
+    (what ``profile.verify()`` computes) instead of checking every leg again. With a budget
+    that runs out while a leg still exceeds a limit, :class:`~speedplan.PlanTimeout`.
+    """
+    profile = SpeedProfile(path=request.path, limits=request.limits, legs=tuple(legs),
+                           speed_bound=model.bound, request=request)
+    leg_checks = [profile.check_leg(i) for i in range(len(legs))]
+    stuck: set[int] = set()  # legs whose refined law did not arrive: retrying repeats it
+    for _ in range(MAX_REFINEMENTS):
+        if all(c.verification.ok for c in leg_checks):
+            break
+        changed = []
+        for i, (leg, leg_check) in enumerate(zip(model.legs, leg_checks, strict=True)):
+            if leg_check.verification.ok or not isinstance(leg, Leg) or i in stuck:
+                continue
+            grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess, leg.anchors,
+                                refine_factor(leg_check.verification))
+            try:
+                legs[i] = record.attempt("local_refinement", i,
+                                         partial(_solve_on_grid, request, leg, grid))
+            except SolverError:  # keep the verified law; its excess is reported below
+                stuck.add(i)
+                continue
+            record.mark_previous(i, _exceeds(leg_check.verification))
+            changed.append(i)
+        profile = replace(profile, legs=tuple(legs))
+        for i in changed:
+            leg_checks[i] = profile.check_leg(i)
+    # A leg planned on a coarser grid (its backend had stalled on the default one) whose law
+    # still exceeds a limit: the default grid with the other backend as well, if that law
+    # passes (seen on a zone path whose eighth grid left six steps for the last rest phase).
+    for i, (leg, coarse) in enumerate(zip(model.legs, coarsened, strict=True)):
+        if coarse and not leg_checks[i].verification.ok and isinstance(leg, Leg):
+            with contextlib.suppress(SolverError):
+                again = record.attempt("default_grid_other_backend", i, partial(solve_leg, leg))
+                trial = replace(profile, legs=(*legs[:i], again, *legs[i + 1:]))
+                trial_check = trial.check_leg(i)
+                if trial_check.verification.ok:
+                    record.mark_previous(i, _exceeds(leg_checks[i].verification))
+                    profile, legs, leg_checks[i] = trial, list(trial.legs), trial_check
+                else:
+                    record.mark(len(record.entries) - 1, "replaced",
+                                _exceeds(trial_check.verification))
+    check = Verification.merged([c.verification for c in leg_checks])
+    if not check.ok:
+        if record.budget.expired():
+            raise record.timeout()
+        worst = ", ".join(f"{k} {r:.3f}× at s={check.where.get(k, float('nan')):.4g} m"
+                          for k, r in check.violations.items())
+        warnings.warn(
+            f"the planned trajectory exceeds limits beyond tolerance ({worst} of the limit) "
+            f"even after {MAX_REFINEMENTS} local refinements; status 'limits_exceeded' — see "
+            "profile.verification and profile.attempts, or plan with a finer grid (n or ds)",
+            LimitWarning, stacklevel=4,
+        )
+    # The bound's memo (every position evaluated while planning) stays with the plan, not
+    # with the profile a caller keeps.
+    return replace(profile, verification=check, limits_exceeded=not check.ok,
+                   speed_bound=replace(model.bound, memo=None), attempts=tuple(record.entries))
+
+
+def _solve_on_grid(request: PlanRequest, leg: Leg, grid: FloatArray) -> LegResult:
+    """``leg`` on another grid (a local refinement of its own), solved."""
+    return solve_leg(leg_on_grid(request, leg.bound, grid, leg.start, leg.v0, leg.a0, leg.vf,
+                                 leg.af))
+
+
+def _exceeds(check: Verification) -> str:
+    worst = ", ".join(f"{k} {r:.4g}×" for k, r in check.violations.items())
+    return f"its law exceeds {worst} of the limit"
+
+
+def refine_factor(check: Verification) -> float:
+    """What to multiply the flagged steps by so that the worst excess falls to half its tolerance.
+
+    Near a violation the excess of a ratio beyond 1 shrinks about like the grid step (a
+    first-order discretisation error), so a ratio ``1 + e`` asks for the steps times
+    ``tol / (2 e)``; the factor is kept within :data:`REFINE_FACTORS`.
+
+    Examples
+    --------
+    >>> from speedplan.timing import Verification
+    >>> refine_factor(Verification(maxima={}, ratios={"lateral_jerk": 1.4}, where={}))
+    0.25
+    >>> round(refine_factor(Verification(maxima={}, ratios={"jerk": 1.06, "speed": 1.0},
+    ...                                  where={})), 6)
+    0.416667
+    """
+    wanted = [0.5 * TOLERANCES[name] / (ratio - 1.0)
+              for name, ratio in check.ratios.items() if ratio > 1.0 + TOLERANCES[name]]
+    lo, hi = REFINE_FACTORS
+    return float(np.clip(min(wanted, default=hi), lo, hi))
