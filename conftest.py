@@ -1,4 +1,4 @@
-"""Session set-up shared by the test suite and the doctests."""
+"""Set-up shared by the test suite and the doctests, once per test run."""
 
 import pytest
 

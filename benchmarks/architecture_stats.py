@@ -3,6 +3,13 @@
 Usage::
 
     python benchmarks/architecture_stats.py [--before 4f4e992^] [--after HEAD] [--top 10]
+    python benchmarks/architecture_stats.py --page           # the figures of the working tree
+    python benchmarks/architecture_stats.py --page --write   # ... written into the page
+
+``--page`` measures the working tree (the files on disk, committed or not) and prints the
+figures block of ``docs/architecture.md`` (between its ``architecture-stats`` markers);
+``--write`` replaces the block in the page. ``tests/test_architecture_page.py`` fails when
+the page's block differs from what the tree gives, so the page cannot quote an old tree.
 
 Reads both trees straight from git (``git ls-tree``/``git show``, no checkout) and parses every
 ``speedplan/**.py`` with :mod:`ast`. The layers and the rule that assigns a module to one are
@@ -74,6 +81,12 @@ def tree_sources(ref: str) -> dict[str, str]:
     return {n: git("show", f"{ref}:{n}") for n in names}
 
 
+def worktree_sources() -> dict[str, str]:
+    """``{path: source}`` of every ``speedplan/**.py`` on disk."""
+    return {p.relative_to(ROOT).as_posix(): p.read_text(encoding="utf-8")
+            for p in sorted((ROOT / "speedplan").rglob("*.py"))}
+
+
 def module_name(path: str) -> str:
     parts = list(Path(path).with_suffix("").parts)
     if parts[-1] == "__init__":
@@ -117,8 +130,9 @@ class Stats:
     wide: list[tuple[str, str]]
 
 
-def measure(ref: str, layers: tuple[str, ...]) -> Stats:
-    sources = tree_sources(ref)
+def measure(ref: str | None, layers: tuple[str, ...]) -> Stats:
+    """The structure of the tree at git ``ref``, or of the working tree when ``None``."""
+    sources = worktree_sources() if ref is None else tree_sources(ref)
     funcs: list[Function] = []
     modules: dict[int, list[str]] = {}
     upward: list[tuple[str, str]] = []
@@ -136,7 +150,8 @@ def measure(ref: str, layers: tuple[str, ...]) -> Stats:
             elif own - other > 1:
                 wide.append((module, target))
     funcs.sort(key=lambda f: (-f.lines, f.module, f.name))
-    return Stats(ref=ref, commit=git("rev-parse", "--short", ref).strip(),
+    return Stats(ref=ref or "working tree",
+                 commit="" if ref is None else git("rev-parse", "--short", ref).strip(),
                  lines=sum(t.count("\n") for t in sources.values()), functions=funcs,
                  modules=modules, upward=upward, wide=wide)
 
@@ -168,13 +183,61 @@ def report(stats: Stats, layers: tuple[str, ...], top: int) -> None:
           f"({', '.join(f'{a}->{b} {n}' for (a, b), n in sorted(pairs.items()))})")
 
 
+PAGE = ROOT / "docs" / "architecture.md"
+START, END = "<!-- architecture-stats:start -->", "<!-- architecture-stats:end -->"
+
+
+def page_block(stats: Stats, layers: tuple[str, ...], top: int = 5) -> str:
+    """The figures block of docs/architecture.md, markers included."""
+    n_mod = sum(len(v) for v in stats.modules.values())
+    pairs = Counter(layer_name(layer_of(t, layers), layers) for _, t in stats.wide)
+    per_layer = ", ".join(f"{layer_name(i, layers)} {len(stats.modules[i])}"
+                          for i in sorted(stats.modules))
+    rows = [
+        START,
+        "| | |",
+        "|---|---|",
+        f"| modules, lines, functions | {n_mod}, {stats.lines}, {len(stats.functions)} |",
+        f"| modules per layer | {per_layer} |",
+        f"| functions over 100 / over 50 lines | {sum(f.lines > 100 for f in stats.functions)}"
+        f" / {sum(f.lines > 50 for f in stats.functions)} |",
+        "| longest functions (lines) | " + ", ".join(
+            f"`{f.module.removeprefix('speedplan.')}.{f.name}` {f.lines}"
+            for f in stats.functions[:top]) + " |",
+        f"| upward imports (forbidden) | {len(stats.upward)} |",
+        f"| imports skipping a layer downwards | {len(stats.wide)}: "
+        + ", ".join(f"into {k} {n}" for k, n in sorted(pairs.items())) + " |",
+        END,
+    ]
+    return "\n".join(rows)
+
+
+def page_is_current(text: str, block: str) -> bool:
+    return START in text and text[text.index(START):text.index(END) + len(END)] == block
+
+
+def write_page(block: str) -> None:
+    text = PAGE.read_text(encoding="utf-8")
+    text = text[:text.index(START)] + block + text[text.index(END) + len(END):]
+    PAGE.write_text(text, encoding="utf-8")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--page", action="store_true",
+                    help="the figures block of docs/architecture.md for the working tree")
+    ap.add_argument("--write", action="store_true", help="with --page: write it into the page")
     ap.add_argument("--before", default="4f4e992^", help="git ref of the 'before' tree")
     ap.add_argument("--after", default="HEAD", help="git ref of the 'after' tree")
     ap.add_argument("--top", type=int, default=10, help="how many longest functions")
     args = ap.parse_args()
     layers = contract_layers()
+    if args.page:
+        block = page_block(measure(None, layers), layers)
+        if args.write:
+            write_page(block)
+        print(block)
+        return
     print("layers (tests/test_architecture.py), bottom to top:", ", ".join(layers), "+ top")
     for ref in (args.before, args.after):
         report(measure(ref, layers), layers, args.top)

@@ -1,4 +1,4 @@
-"""Every performance target of issue #17 in one run: where ``plan()``'s time goes, and more.
+"""Every performance figure in one run: where ``plan()``'s time goes, and more.
 
 Usage::
 

@@ -1,6 +1,6 @@
 """Very fine uniform grids: refused up front when unresolvable, solved at the finest allowed.
 
-Cases of speedplan issue #13 (item 4): straights with the LGV limits (``v_max=2, a_max=1,
+Straights with the LGV limits (``v_max=2, a_max=1,
 a_lat_max=1, j_max=0.5``) at steps down to 0.05 mm, and the finest grid the refusal's message
 suggests. Prints, per case, the outcome (status and backend, or the exception), the
 relaxation's ramp length in grid steps (:func:`speedplan.solve.banded.ramp_steps`), its

@@ -12,6 +12,7 @@ import io
 import logging
 import math
 import os
+import re
 import sys
 import time
 import warnings
@@ -46,6 +47,28 @@ STANDSTILL_HELP = {
     "smooth": "acceleration 0 at a standstill, jerk-limited from the first instant",
     "free": "the paper's model: the acceleration may jump at a standstill",
 }
+
+#: Python argument names in error messages, as the flags a command-line user typed.
+FLAGS = {name: "--" + name.replace("_", "-") for name in (
+    "v_max", "a_max", "a_lat_max", "j_max", "a_decel", "j_lat_max", "yaw_rate_max", "v0", "a0",
+    "vf", "af", "start_s", "standstill", "n", "ds", "backend", "refine", "dt", "format",
+    "output_format", "precision", "dpi", "instances")}
+_IDENTIFIER = re.compile(r"`([A-Za-z_][A-Za-z0-9_]*)`")
+
+
+def flag_names(message: str) -> str:
+    """``message`` with each quoted Python argument name replaced by its command-line flag.
+
+    Examples
+    --------
+    >>> from speedplan.cli import flag_names
+    >>> flag_names("`v_max` must be > 0; got -1.0")
+    '`--v-max` must be > 0; got -1.0'
+    >>> flag_names("unknown type '.md'; pass `format`, or see `Path`")
+    "unknown type '.md'; pass `--format`, or see `Path`"
+    """
+    return _IDENTIFIER.sub(lambda m: f"`{FLAGS.get(m.group(1), m.group(1))}`", message)
+
 
 EPILOG = """\
 exit codes:
@@ -154,6 +177,9 @@ def _add_common(p: argparse.ArgumentParser, out: str | None = None,
     g.add_argument("-o", "--output", default=out, metavar="FILE",
                    help="trajectory file: .csv or .json, or - for standard output (the "
                    "summary then goes to standard error); '' writes none")
+    g.add_argument("--precision", type=_positive(int), default=None, metavar="DIGITS",
+                   help="significant digits of the CSV numbers (default: the shortest decimal "
+                   "that reads back exactly)")
     g.add_argument("--output-format", choices=TRAJECTORY_FORMATS, default=None,
                    help="format of the trajectory on standard output (default: csv)")
     g.add_argument("--plot", default=plot, metavar="FIG",
@@ -178,6 +204,7 @@ def _parser() -> argparse.ArgumentParser:
     ap.add_argument("--version", action="version", version=f"speedplan {__version__}")
     _add_verbose(ap, False)
     sub = ap.add_subparsers(dest="command", required=True, metavar="{plan,demo,bench,compile}")
+    ap.set_defaults(_subparsers=sub.choices)
     p = sub.add_parser(
         "plan", help="plan a path file (CSV waypoints, JSON segments, VDA 5050 edge or order)",
         description="Plan the minimum-time speed law along a path file and report it; a VDA "
@@ -371,7 +398,7 @@ def _write_outputs(args: argparse.Namespace, traj: Trajectory, info: IO[str]) ->
         if args.output == "-":
             sys.stdout.write("\n")
     else:
-        traj.to_csv(target)
+        traj.to_csv(target, precision=args.precision)
     where = "standard output" if args.output == "-" else args.output
     print(f"wrote     {where} ({len(traj)} samples every {args.dt} s)", file=info)
 
@@ -467,6 +494,23 @@ def _run_plan(args: argparse.Namespace, pathfile: str | FsPath) -> int:
     return _conclude(args, profile.status, check, caught)
 
 
+def _has_matplotlib() -> bool:
+    try:
+        import matplotlib.backend_bases  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _run_demo(args: argparse.Namespace) -> int:
+    """``speedplan demo``: the figure is skipped, with a hint, when matplotlib is missing."""
+    if args.plot and not _has_matplotlib():
+        print(f"note: no figure ({args.plot}): matplotlib is not installed; "
+              "pip install 'speedplan[plot]' to get it", file=sys.stderr)
+        args.plot = None
+    return _run_plan(args, _bundled_paths_dir() / DEMO_PATH)
+
+
 def exit_status(status: str, violations: dict[str, float], *, strict: bool = False
                 ) -> tuple[int, str | None]:
     """Exit code of ``speedplan plan`` for a profile's status and ``verify()`` violations.
@@ -543,13 +587,17 @@ def _configure_logging(verbose: bool) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``speedplan`` command; returns the exit code."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:  # reported with the subcommand's own usage, not the top level's
+        parser_of = args._subparsers.get(args.command, parser)
+        parser_of.error(f"unrecognized arguments: {' '.join(unknown)}")
     _configure_logging(args.verbose)
     try:
         if args.command == "plan":
             return _run_plan(args, args.pathfile)
         if args.command == "demo":
-            return _run_plan(args, _bundled_paths_dir() / DEMO_PATH)
+            return _run_demo(args)
         if args.command == "compile":
             return _run_compile(args)
         return _run_bench(args)
@@ -558,13 +606,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.dup2(devnull, sys.stdout.fileno())
         return EXIT_CODES["ok"]
     except InfeasibleError as exc:
-        print(f"speedplan: infeasible: {exc}", file=sys.stderr)
+        print(f"speedplan: infeasible: {flag_names(str(exc))}", file=sys.stderr)
         return EXIT_CODES["infeasible"]
     except SolverError as exc:
-        print(f"speedplan: solver failure: {exc}", file=sys.stderr)
+        print(f"speedplan: solver failure: {flag_names(str(exc))}", file=sys.stderr)
         return EXIT_CODES["solver"]
     except (SpeedplanError, ValueError, OSError) as exc:
-        print(f"speedplan: error: {exc}", file=sys.stderr)
+        print(f"speedplan: error: {flag_names(str(exc))}", file=sys.stderr)
         return EXIT_CODES["usage"]
 
 

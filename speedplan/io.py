@@ -118,7 +118,8 @@ def _load_text(file: Source, format: str | None) -> tuple[str, str, str]:
         if suffix not in (".csv", ".json"):
             raise InvalidInputError(
                 f"{fs.name}: unknown path file type {fs.suffix!r}; use .csv (waypoints) or "
-                ".json (segments, waypoints or a VDA 5050 trajectory), or pass `format`"
+                ".json (segments, waypoints or a VDA 5050 trajectory), or pass `format` "
+                "('csv' or 'json')"
             )
         format = suffix[1:]
     try:
@@ -169,6 +170,11 @@ def _numeric_column(name: str, rows: list[list[str]], j: int, column: str) -> An
                 f"{name}: data row {i + 1} ({','.join(row)!r}): column {column!r} must hold a "
                 f"number; got {row[j]!r}"
             ) from exc
+        if not np.isfinite(out[i]):
+            raise InvalidInputError(
+                f"{name}: data row {i + 1} ({','.join(row)!r}): column {column!r} must be a "
+                f"finite number, not NaN or infinite; got {row[j].strip()!r}"
+            )
     return out
 
 

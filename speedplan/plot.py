@@ -55,6 +55,21 @@ def _axes(ax: Any) -> Any:
     return ax
 
 
+def _path_legend(ax: Any, title: str) -> None:
+    """The legend in a row just above the axes, the title above that row.
+
+    On narrow axes (a panel of a user's grid) a legend in the title's line would cover the
+    title; any title the axes already had moves up too. Two columns on axes narrower than
+    5 inches.
+    """
+    width = ax.get_window_extent().width / ax.figure.dpi
+    ncol = 4 if width >= 5 else 2
+    rows = -(-len(ax.get_legend_handles_labels()[0]) // ncol)
+    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=ncol, fontsize=8,
+              frameon=False, borderaxespad=0.2)
+    ax.set_title(title, loc="left", pad=6.0 + 13.0 * rows)
+
+
 def _legend_on_top(ax: Any, top: float, bottom: float) -> None:
     """Room above the traces for the legend, so that it never covers them."""
     ax.set_ylim(bottom, top)
@@ -115,10 +130,8 @@ def plot_path(
     ax.plot([], [], color="tab:green", marker=r"$\rightarrow$", ls="none", ms=12,
             label="direction of travel")
     ax.set(xlabel="x [m]", ylabel="y [m]")
-    ax.set_title("path coloured by speed", loc="left")
-    # In the title line, right-aligned: inside the axes it would hide part of the path.
-    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=4, fontsize=8, frameon=False,
-              borderaxespad=0.2)
+    # Above the axes: inside them it would hide part of the path.
+    _path_legend(ax, "path coloured by speed")
     return ax
 
 
@@ -146,21 +159,52 @@ def _norm(lo: float, hi: float) -> Any:
     return Normalize(vmin=lo, vmax=hi)
 
 
-def plot_speed(profile: SpeedProfile, trajectory: Trajectory, ax: Any = None) -> Any:
-    """Speed ``v(s)`` against the speed limit from ``v_max``, curvature and zones.
+def _bound_curves(profile: Any, samples: int = 2000) -> list[tuple[Any, Any]]:
+    """``(s, sqrt(mu+(s)))`` along a SpeedProfile, or per leg along a RouteProfile."""
+    if hasattr(profile, "leg_starts"):  # a RouteProfile: its legs' bounds, end to end
+        per_leg = max(samples // max(len(profile.legs), 1), 50)
+        return [(lo + s, np.sqrt(leg.speed_bound(s)))
+                for leg, lo in zip(profile.legs, profile.leg_starts, strict=True)
+                for s in [np.linspace(0.0, leg.path.length, per_leg)]]
+    s = np.linspace(0.0, profile.path.length, samples)
+    return [(s, np.sqrt(profile.speed_bound(s)))]
+
+
+def plot_speed(profile: SpeedProfile | RouteProfile, trajectory: Trajectory | None = None,
+               ax: Any = None, *, dt: float = 0.01) -> Any:
+    """Speed ``v(s)`` against the speed limit from ``v_max``, curvature, zones and edges.
+
+    Parameters
+    ----------
+    profile : SpeedProfile or RouteProfile
+        What :func:`speedplan.plan` or :func:`speedplan.plan_route` returned.
+    trajectory : Trajectory, optional
+        The sampled trajectory to draw; default ``profile.sample(dt)``.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; default a new figure.
+    dt : float
+        Sampling period [s] when ``trajectory`` is not given.
 
     Returns
     -------
     matplotlib.axes.Axes
     """
+    if not hasattr(profile, "sample") or not hasattr(profile, "duration"):
+        raise InvalidInputError(
+            f"`profile` must be a SpeedProfile or a RouteProfile; got {type(profile).__name__}")
+    trajectory = trajectory if trajectory is not None else profile.sample(dt)
     ax = _axes(ax)
-    s_fine = np.linspace(0.0, profile.path.length, 2000)
-    bound = np.sqrt(profile.speed_bound(s_fine))
-    ax.plot(s_fine, bound, "k--", lw=1, label="speed limit (v_max, lateral, zones)")
+    curves = _bound_curves(profile)
+    label = "speed limit (v_max, lateral, " + (
+        "edge limits)" if hasattr(profile, "leg_starts") else "zones)")
+    for k, (s, bound) in enumerate(curves):
+        ax.plot(s, bound, "k--", lw=1, label=label if k == 0 else None)
     ax.plot(trajectory.s, trajectory.v, "C0", lw=2, label="speed v(s)")
     ax.set(xlabel="s [m]", ylabel="v [m/s]",
            title=f"speed law, duration {profile.duration:.3f} s")
-    top = float(max(np.max(bound[np.isfinite(bound)], initial=0.0), trajectory.v.max()))
+    finite = [b[np.isfinite(b)] for _, b in curves]
+    top = float(max(max((np.max(b, initial=0.0) for b in finite), default=0.0),
+                    trajectory.v.max()))
     _legend_on_top(ax, HEADROOM * top, -0.04 * top)
     return ax
 
@@ -238,6 +282,10 @@ def _panels(fig: Any, figsize: tuple[float, float], mosaic: list[list[str]],
         raise InvalidInputError(
             f"`fig` must be a matplotlib Figure or SubFigure; got {type(fig).__name__}"
         )
+    elif hasattr(fig, "set_layout_engine") and fig.get_layout_engine() is None:
+        # A figure without a layout engine (pyplot's default) would overlap the panels'
+        # labels; the panels fill it, so it gets the layout a new figure has.
+        fig.set_layout_engine("constrained")
     return fig, fig.subplot_mosaic(mosaic, height_ratios=height_ratios)
 
 
@@ -279,7 +327,8 @@ def plot_profile(
         Sampling period [s] when ``trajectory`` is not given.
     fig : matplotlib.figure.Figure or SubFigure, optional
         An empty figure to draw into; default a new ``Figure`` (not registered with pyplot,
-        so nothing needs closing).
+        so nothing needs closing). A figure without a layout engine is given matplotlib's
+        constrained layout, as a new one has, so that the panels' labels do not overlap.
     dpi : float
         Resolution of a saved raster figure [dots per inch].
 
@@ -368,22 +417,13 @@ def plot_route(profile: RouteProfile, file: str | PathLike[str] | None = None, *
         when = "" if np.isnan(t_node) else f" {t_node:.1f} s"
         ax.annotate(f"{node.node_id}{when}", (x, y), xytext=(4, 4), textcoords="offset points",
                     fontsize=8, zorder=7)
-    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=5, fontsize=8, frameon=False,
-              borderaxespad=0.2)
-    ax.set_title("route coloured by speed", loc="left")
-    sp_ax = axes["speed"]
-    for k, (leg, lo) in enumerate(zip(profile.legs, profile.leg_starts, strict=True)):
-        s_fine = np.linspace(0.0, leg.path.length, 800)
-        sp_ax.plot(lo + s_fine, np.sqrt(leg.speed_bound(s_fine)), "k--", lw=1,
-                   label="speed limit (v_max, lateral, edge limits)" if k == 0 else None)
-    sp_ax.plot(traj.s, traj.v, "C0", lw=2, label="speed v(s)")
+    _path_legend(ax, "route coloured by speed")
+    sp_ax = plot_speed(profile, traj, axes["speed"])
     for node, s in zip(route.base_nodes, route.node_s, strict=True):
         sp_ax.axvline(float(s), color="0.6", lw=0.8, zorder=0)
         sp_ax.annotate(node.node_id, (float(s), 0.0), xytext=(2, 2), textcoords="offset points",
                        fontsize=8, color="0.35")
-    sp_ax.set(xlabel="s [m]", ylabel="v [m/s]",
-              title=f"speed along the route, duration {profile.duration:.3f} s")
-    _legend_on_top(sp_ax, HEADROOM * lim.v_max, -0.04 * lim.v_max)
+    sp_ax.set_title(f"speed along the route, duration {profile.duration:.3f} s")
     plot_acceleration(traj, lim, axes["acceleration"])
     plot_jerk(traj, lim, axes["jerk"])
     return _saved(fig, file, dpi)

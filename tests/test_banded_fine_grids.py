@@ -1,4 +1,4 @@
-"""Grids finer than the relaxation resolves are refused up front (speedplan issue #13, item 4)."""
+"""Grids finer than the relaxation resolves are refused up front."""
 
 from __future__ import annotations
 

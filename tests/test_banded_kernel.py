@@ -386,7 +386,7 @@ def test_kernel_keeps_fifty_seven_doubles_per_node():
 
 
 def test_solve_discrete_peak_memory_per_node():
-    # Issue #17's memory target: solve_discrete at most 600 bytes per node at its peak.
+    # Memory: solve_discrete at most 600 bytes per node at its peak.
     # tracemalloc counts numpy's allocations, so the number is deterministic (no timing);
     # it was 1 048 B/node before the kernel stopped storing its derivable vectors.
     import tracemalloc

@@ -59,7 +59,7 @@ def test_cli_json_output(tmp_path, request):
     [
         (["plan", "no_such_file.csv", *LGV_ARGS], 2, "does not exist"),
         (["plan", "paths/u_turn.json", "--v-max", "-1", "--a-max", "1", "--a-lat-max", "1",
-          "--j-max", "1"], 2, "`v_max`"),
+          "--j-max", "1"], 2, "`--v-max`"),
         (["plan", "paths/slow_zone.json", *LGV_ARGS, "--v0", "2", "--a-decel", "0.01"], 3,
          "too short"),
         (["plan", "paths/u_turn.json", *LGV_ARGS, "--standstill", "bogus"], 2, "invalid choice"),

@@ -127,8 +127,8 @@ def test_extreme_limits_are_refused_by_name_not_overflowed(kwargs):
 def test_a_marginal_state_at_the_top_of_the_jerk_range_is_planned_with_the_slack():
     # plan() plans a state that j_max misses by a hair with 1.02 j_max; at j_max = 1e9 that
     # derived limit is past the range, and was refused naming a j_max nobody passed
-    # (independent review). An LGV move's states, braking 0.2 % less hard than planned (outside
-    # what j_max (1 + 1e-4) reaches: states read off the plan itself are planned silently),
+    # by name. An LGV move's states, braking 0.2 % less hard than planned (outside what
+    # j_max (1 + 1e-4) reaches: states read off the plan itself are planned silently),
     # time-scaled to j_max = 1e9.
     lgv = sp.Limits(2.0, 1.0, 1.0, 0.5)
     k = (1e9 / 0.5) ** (1 / 3)

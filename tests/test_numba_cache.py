@@ -2,7 +2,7 @@
 
 Numba pickles every compiled signature, with its argument types, into one index file per
 function. When a ``NamedTuple`` argument class is later removed (the banded kernel's
-``Work`` went in the eighth session), an index left in ``__pycache__`` by the earlier
+``Work`` went in 0.2), an index left in ``__pycache__`` by the earlier
 version failed to unpickle and numba raised ``AttributeError`` from the first call
 (numba issue #6018). :func:`speedplan.core.jit.tolerate_stale_indexes` makes it
 read as obsolete.

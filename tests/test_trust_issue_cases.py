@@ -6,7 +6,7 @@ straight move and finite differences of the sampled trajectory (``oracles.measur
 3. feasible moving states that failed or undercut the optimum;
 4. fine grids ending in ``SolverError`` after minutes;
 5. misleading diagnoses (a wrong constraint, backends disagreeing);
-6. default grids sized from ``v_max`` under a cap far below it (an independent review).
+6. default grids sized from ``v_max`` under a cap far below it.
 """
 
 from __future__ import annotations
@@ -134,7 +134,7 @@ def test_a_short_move_with_tiny_jerk_phases_is_answered_by_the_banded_method():
 @pytest.mark.parametrize(("length", "cap", "lim"), [
     # Capped far below v_max by a span, a zone or v_limit (an edge's maxSpeed in a route):
     # the default grid sized its end transients from v_max and came out 1.2e-3 slower than
-    # ruckig at the cap (an independent review; benchmarks/fuzz_caps.py draws such moves) ...
+    # ruckig at the cap (benchmarks/fuzz_caps.py draws such moves) ...
     (172.9, 0.06039, Limits(v_max=4.93, a_max=0.4172, a_lat_max=1.0, j_max=0.03581)),
     (32.54, 0.06776, Limits(v_max=3.383, a_max=3.707, a_lat_max=1.0, j_max=0.08693)),
     # ... or 2.2e-4 *faster*, with the jerk 4.3 % over j_max.

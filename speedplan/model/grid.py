@@ -289,7 +289,7 @@ def top_speed(w_bound: Callable[[FloatArray], FloatArray], length: float, v_max:
 
     Pass the path's own bound, not one capped by the boundary envelopes: a short move is
     slow because it is short, and its grid sized from that lower speed came out less
-    accurate next to slow zones (an independent review: 8 of 40 short zone moves moved by
+    accurate next to slow zones (measured: 8 of 40 short zone moves moved by
     more than 1e-4, six away from the fine-grid duration, up to 5.8e-4).
 
     Examples

@@ -44,9 +44,6 @@ COLUMNS: dict[str, str] = {
 #: Range of the ``heading`` column in exported files (in memory the heading is continuous).
 HEADING_RANGE = "[-pi, pi)"
 
-#: ``%.17g`` prints every float64 with enough digits to be read back bit for bit.
-_FLOAT_FORMAT = "%.17g"
-
 TextFile = str | PathLike[str] | IO[str]
 
 
@@ -121,15 +118,21 @@ def _jsonable(value: Any) -> Any:
     return str(value)
 
 
-def _write_rows(fh: IO[str], data: FloatArray, chunk: int = 4096) -> None:
-    """The rows of ``data`` as ``%.17g`` CSV: the bytes ``numpy.savetxt`` writes, 2x faster.
+def _write_rows(fh: IO[str], data: FloatArray, precision: int | None = None,
+                chunk: int = 4096) -> None:
+    """The rows of ``data`` as CSV, one ``%`` operation per block of rows.
 
-    One ``%`` operation per block of rows instead of one per row (``savetxt``'s loop).
+    Each number is the shortest decimal that reads back bit for bit (``repr``: ``0.04``, not
+    ``0.040000000000000001``), or has ``precision`` significant digits.
     """
-    row = ",".join([_FLOAT_FORMAT] * data.shape[1]) + "\n"
+    fmt = "%r" if precision is None else f"%.{precision}g"
+    row = ",".join([fmt] * data.shape[1]) + "\n"
     for k in range(0, data.shape[0], chunk):
         block = data[k : k + chunk]
-        fh.write((row * block.shape[0]) % tuple(block.ravel().tolist()))
+        text = (row * block.shape[0]) % tuple(block.ravel().tolist())
+        if precision is None:  # a whole number's repr ends in ".0" (1.0, -0.0): drop it
+            text = text.replace(".0,", ",").replace(".0\n", "\n")
+        fh.write(text)
 
 
 def _comment_value(value: Any) -> str:
@@ -238,11 +241,13 @@ class Trajectory:
         meta["heading_range"] = HEADING_RANGE
         return meta
 
-    def to_csv(self, file: TextFile) -> None:
+    def to_csv(self, file: TextFile, *, precision: int | None = None) -> None:
         """Write CSV: ``# key: value`` metadata lines, a header ``t [s],s [m],...``, the rows.
 
-        Numbers are written with 17 significant digits, so reading them back gives the same
-        float64 values bit for bit; the heading is wrapped to ``[-π, π)``. Metadata values
+        By default each number is the shortest decimal that reads back as the same float64
+        bit for bit (``0.04``, not ``0.040000000000000001``); ``precision`` writes that many
+        significant digits instead (smaller files, values rounded). The heading is wrapped to
+        ``[-π, π)``. Metadata values
         that are not strings are JSON (``null`` for an absent limit). To read the file:
         :func:`speedplan.io.read_trajectory`, ``pandas.read_csv(f, comment="#")``, or in
         plain numpy skip the ``#`` lines and the header (``numpy.genfromtxt(names=True)``
@@ -252,11 +257,14 @@ class Trajectory:
         ----------
         file : str, os.PathLike or text file object
             Where to write; a path's directory must exist.
+        precision : int, optional
+            Significant digits of every number (1 to 17); default the shortest exact form.
 
         Raises
         ------
         InvalidInputError
-            The directory does not exist or the file cannot be written.
+            The directory does not exist or the file cannot be written, or ``precision`` is
+            not an integer from 1 to 17.
 
         Examples
         --------
@@ -275,13 +283,19 @@ class Trajectory:
         >>> bool(np.array_equal(back[:, 6], traj.v))
         True
         """
+        if precision is not None and not (isinstance(precision, int | np.integer)
+                                          and not isinstance(precision, bool)
+                                          and 1 <= precision <= 17):
+            raise InvalidInputError(
+                f"`precision` must be an integer from 1 to 17 (significant digits) or None; "
+                f"got {precision!r}")
         cols = self._export_columns()
         data = np.column_stack(list(cols.values()))
         lines = [f"# {k}: {_comment_value(v)}" for k, v in self._export_metadata().items()]
         lines.append(",".join(f"{name} [{unit}]" for name, unit in self.units.items()))
         with text_output(file, "trajectory CSV") as fh:
             fh.write("\n".join(lines) + "\n")
-            _write_rows(fh, data)
+            _write_rows(fh, data, None if precision is None else int(precision))
 
     def to_json(self, file: TextFile | None = None) -> str:
         """Return (and optionally write) the trajectory as JSON.

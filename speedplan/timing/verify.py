@@ -48,6 +48,7 @@ TOLERANCES: dict[str, float] = {
 LIMIT_NAMES = tuple(TOLERANCES)
 
 
+
 @dataclass(frozen=True)
 class Verification:
     """Realised maxima of a law and their ratios to the limits.
@@ -68,6 +69,9 @@ class Verification:
         (:meth:`speedplan.RouteProfile.verify`).
     where : dict
         Arc length [m] at which each ratio is largest.
+    unset : frozenset of str
+        The quantities whose limit is not set (``inf`` or ``None``): their ratio is 0 and
+        :meth:`summary` says "not set".
     max_speed, max_accel, max_decel, max_jerk, max_lateral : float
         Largest speed [m/s], acceleration, braking deceleration [m/s²], absolute jerk [m/s³]
         and absolute lateral acceleration [m/s²]: the entries of ``maxima``.
@@ -85,6 +89,7 @@ class Verification:
     maxima: dict[str, float]
     ratios: dict[str, float]
     where: dict[str, float] = field(default_factory=dict)
+    unset: frozenset[str] = frozenset()
 
     # Shorthands for entries of ``maxima``, documented in the class docstring.
     max_speed = Forwarded[float]("maxima", key="speed")
@@ -104,9 +109,23 @@ class Verification:
         return not self.violations
 
     def summary(self) -> str:
-        """One line per limit: realised ratio, tolerance and where."""
+        """One line per limit: realised ratio, tolerance and where.
+
+        A limit that is not set says "not set" (its ratio is 0 and means nothing).
+
+        Examples
+        --------
+        >>> from speedplan import Limits, Path, plan
+        >>> prof = plan(Path.from_waypoints([[0, 0], [10, 0]], kind="polyline"),
+        ...             Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+        >>> print(prof.verify().summary().splitlines()[-1])
+        lateral_jerk  not set
+        """
         lines = []
         for k, r in self.ratios.items():
+            if k in self.unset:
+                lines.append(f"{k:12s}  not set")
+                continue
             flag = "  VIOLATED" if not r <= 1 + TOLERANCES[k] else ""
             at = f" at s={self.where[k]:.4g} m" if k in self.where and r > 0 else ""
             lines.append(f"{k:12s} {r:8.4f} of limit (tolerance {1 + TOLERANCES[k]:.3f}){at}"
@@ -128,7 +147,8 @@ class Verification:
             ratios[k] = worst.ratios[k]
             if k in worst.where:
                 where[k] = worst.where[k]
-        return Verification(maxima=maxima, ratios=ratios, where=where)
+        unset = frozenset.intersection(*(p.unset for p in parts)) if parts else frozenset()
+        return Verification(maxima=maxima, ratios=ratios, where=where, unset=unset)
 
 
 @dataclass(frozen=True)
@@ -263,4 +283,9 @@ def check_law(law: TimeLaw, offset: float, path: Path,
             excess |= per_piece > limit * (1.0 + TOLERANCES[name])
     order = {k: i for i, k in enumerate(LIMIT_NAMES)}
     ratios = dict(sorted(ratios.items(), key=lambda kv: order[kv[0]]))
-    return LegCheck(Verification(maxima=maxima, ratios=ratios, where=where), excess, knots)
+    limit_of = {"speed": limits.v_max, "accel": limits.a_max, "decel": limits.a_decel,
+                "lateral": limits.a_lat_max, "jerk": limits.j_max,
+                "yaw_rate": limits.yaw_rate_max, "lateral_jerk": limits.j_lat_max}
+    unset = frozenset(k for k, lim in limit_of.items() if not np.isfinite(lim))
+    return LegCheck(Verification(maxima=maxima, ratios=ratios, where=where, unset=unset),
+                    excess, knots)
