@@ -141,21 +141,14 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
     b_parts.append(rhs.ravel())
     row0 += 6 * m
     n_grip_cones = 0
-    if problem.grip is not None:  # (1, u_i, g_j w_j) at the cell's ends j = i, i + 1
-        k = 2 * (n - 1)
-        cell = np.concatenate((seg, seg))
-        node = np.concatenate((seg, seg + 1))
-        r = np.column_stack((3 * np.arange(k) + 1, 3 * np.arange(k) + 2))
-        c = np.column_stack((iu + cell, iw + node))
-        v = np.column_stack((-one(k), -problem.grip[node]))
-        blocks_r.append(r.ravel() + row0)
-        blocks_c.append(c.ravel())
-        blocks_v.append(v.ravel())
-        rhs = np.zeros((k, 3))
-        rhs[:, 0] = 1.0
-        b_parts.append(rhs.ravel())
-        row0 += 3 * k
-        n_grip_cones = k
+    if problem.grip is not None:
+        r, c, v, rhs = _grip_cones(problem.grip, iw, iu)
+        blocks_r.append(r + row0)
+        blocks_c.append(c)
+        blocks_v.append(v)
+        b_parts.append(rhs)
+        row0 += rhs.size
+        n_grip_cones = rhs.size // 3
 
     A = sp.csc_matrix(
         (np.concatenate(blocks_v), (np.concatenate(blocks_r), np.concatenate(blocks_c))),
@@ -167,6 +160,25 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
     cones = [clarabel.ZeroConeT(2), clarabel.NonnegativeConeT(n_nonneg)]
     cones += [clarabel.SecondOrderConeT(3)] * (2 * m + n_grip_cones)
     return A, b, q, cones
+
+
+def _grip_cones(grip: FloatArray, iw: int, iu: int
+                ) -> tuple[IntArray, IntArray, FloatArray, FloatArray]:
+    """Rows, columns, values and right-hand side of the cones ``(1, u_i, g_j w_j)``.
+
+    Two per cell ``i``, at its ends ``j = i, i + 1``; ``iw`` and ``iu`` are the first columns
+    of ``w`` and ``u``.
+    """
+    seg = np.arange(grip.size - 1)
+    k = 2 * seg.size
+    cell = np.concatenate((seg, seg))
+    node = np.concatenate((seg, seg + 1))
+    rows = np.column_stack((3 * np.arange(k) + 1, 3 * np.arange(k) + 2)).ravel()
+    cols = np.column_stack((iu + cell, iw + node)).ravel()
+    vals = np.column_stack((-np.ones(k), -grip[node])).ravel()
+    rhs = np.zeros((k, 3))
+    rhs[:, 0] = 1.0
+    return rows, cols, vals, rhs.ravel()
 
 
 def default_settings() -> clarabel.DefaultSettings:
