@@ -127,8 +127,8 @@ def plan(
         No jerk-limited motion meets the boundary states (the message says which state, which
         limit and where, ``s`` in metres). A moving state that ``j_max (1 +
         STATE_JERK_ROUNDING)`` (1e-4) reaches, such as a state read off a plan, is planned
-        with that jerk near it, silently; one that ``j_max (1 + STATE_JERK_SLACK)`` (2 %)
-        reaches, with that jerk near it and a :class:`~speedplan.SpeedplanWarning`
+        with that jerk, silently; one that ``j_max (1 + STATE_JERK_SLACK)`` (2 %) reaches,
+        with that jerk and a :class:`~speedplan.SpeedplanWarning`
         (:func:`speedplan.strategy.model_request`).
     SolverError
         Neither relaxation backend converged on the leg's grid (nor, on a default grid, on

@@ -219,10 +219,10 @@ def _final_stop_jerk(profile: sp.SpeedProfile, seconds: float) -> float:
     return float(np.abs(np.diff(v, 2)).max() / dt**2)
 
 
-def test_the_jerk_slack_of_an_outside_state_applies_near_it_only():
+def test_an_outside_state_is_planned_with_the_jerk_slack_and_a_warning():
     # Accelerating 0.4 % harder than the plan's own state at t = 3 s: the speed would
-    # overshoot v_max under j_max, not under 1.02 j_max. Planned with a warning; the final
-    # stop, 20 m further, keeps j_max.
+    # overshoot v_max under j_max, not under 1.02 j_max. Planned with a warning, and the
+    # attempt that answered says so.
     first = sp.plan(STRAIGHT, LGV)
     state = first.at(3.0)
     rest = sp.Path.from_segments([Line(30.0 - float(state.s[0]))])
@@ -230,8 +230,8 @@ def test_the_jerk_slack_of_an_outside_state_applies_near_it_only():
         again = sp.plan(rest, LGV, v0=float(state.v[0]), a0=float(state.a[0]) * 1.004)
     assert next(a.name for a in again.attempts if a.outcome == "answered") == "jerk_slack"
     assert again.verification.ok
-    # The last 4 s (the stop into rest): the jerk of the plan without slack.
-    assert _final_stop_jerk(again, 4.0) <= _final_stop_jerk(first, 4.0) * (1 + 2e-3)
+    # Within the promised jerk tolerance of the requested limit (finite differences).
+    assert _final_stop_jerk(again, 4.0) <= LGV.j_max * 1.05
 
 
 def test_a_backend_that_fails_on_a_grid_is_not_run_on_it_again(monkeypatch):
@@ -252,3 +252,16 @@ def test_a_backend_that_fails_on_a_grid_is_not_run_on_it_again(monkeypatch):
                          ("other_backend", "answered")]
     assert len(calls) == len(set(calls)) == 3  # each grid (its own node count) once
     assert profile.solution.backend == "clarabel" and profile.verification.ok
+
+
+def test_a_long_move_from_a_marginal_braking_state_answers_in_seconds():
+    # A trust-fuzz move (27.8 km, braking start that j_max misses by a hair): with the jerk
+    # slack held near the state only, the relaxation was inexact and the refinement ran for
+    # minutes; with the slack over the whole move it answers in about a second.
+    lim = sp.Limits(v_max=5.720500233946498, a_max=1.0997156178083936, a_lat_max=1,
+                    j_max=0.04562513470868499, a_decel=1.1432836388457868)
+    path = sp.Path.from_segments([Line(27781.810078116458)])
+    with pytest.warns(sp.SpeedplanWarning, match="2% more jerk"):
+        profile = sp.plan(path, lim, v0=2.7363134118689274, a0=-0.5026231549740972,
+                          time_limit=30.0)
+    assert profile.status == "optimal" and profile.verification.ok

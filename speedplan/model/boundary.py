@@ -52,11 +52,11 @@ __all__ = [
 #: Relative slack of the reachability tests (rounding of the closed forms).
 _SLACK = 1e-9
 #: Moving boundary states just outside what ``j_max`` reaches are planned with
-#: ``j_max (1 + STATE_JERK_SLACK)`` near them (:func:`speedplan.strategy.model_request`, with
-#: a warning).
+#: ``j_max (1 + STATE_JERK_SLACK)`` (:func:`speedplan.strategy.model_request`, with a
+#: warning).
 STATE_JERK_SLACK = 0.02
 #: A moving boundary state that ``j_max (1 + STATE_JERK_ROUNDING)`` reaches is planned with
-#: that jerk near it, silently: a state read off a plan lies on the boundary of what
+#: that jerk, silently: a state read off a plan lies on the boundary of what
 #: ``j_max`` reaches (the time-optimal motion rides its limits) and the law's rounding puts
 #: it a hair outside (measured: the U-turn's state at t = 3 s needs 2.6e-5 more jerk).
 STATE_JERK_ROUNDING = 1e-4

@@ -526,8 +526,8 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
                      s, lo, v0, a0, vf, af)
         w_max[1:-1] = np.maximum(w_max[1:-1], floor[1:-1])
     jerk = np.full(m - 2, lim.J)
-    if request.state_jerk is not None:  # the slack of marginal states, near them only
-        jerk[env.near_states(s, w_max)[1:-1]] = 2.0 * request.state_jerk
+    if request.state_jerk is not None:  # the slack of marginal states, over the whole leg
+        jerk[:] = 2.0 * request.state_jerk
     if request.smooth_standstill:
         calibrate_standstill_rows(jerk, s, v0, a0, vf, af, lim.j_max)
     problem = DiscreteProblem(
@@ -769,29 +769,6 @@ class _Envelopes:
         return cls(request.limits, request.smooth_standstill, request.jerk_limited, v0, a0,
                    vf, af, length, in_distance=request.reach == "distance",
                    state_j=request.moving_state_jerk)
-
-    def near_states(self, s: FloatArray, w_max: FloatArray) -> np.ndarray:
-        """The nodes where a moving boundary state's envelopes bind, and their neighbours.
-
-        Where the fastest motion from (to) a moving state is below the node bound ``w_max``,
-        or its slowest motion above rest: the stretch its own transient spans. Jerk slack
-        for a marginal state (``PlanRequest.state_jerk``) applies there only.
-        """
-        near = np.zeros(s.size, dtype=bool)
-        lim = self.limits
-        if self.v0 > 0:
-            near |= self._fastest(s, self.v0, self.a0, lim.a_max, lim.a_decel, moving=True) \
-                < w_max * (1.0 - 1e-9)
-        if self.vf > 0:
-            near |= self._fastest(self.length - s, self.vf, -self.af, lim.a_decel, lim.a_max,
-                                  moving=True) < w_max * (1.0 - 1e-9)
-        floor = self.floor(s)
-        if floor is not None:
-            near |= floor > 0.0
-        wide = near.copy()  # a jerk row reads its two neighbours
-        wide[1:] |= near[:-1]
-        wide[:-1] |= near[1:]
-        return wide
 
     def cap(self, s: FloatArray, w: FloatArray) -> FloatArray:
         """``w`` capped by the largest ``w`` reachable from (v0, a0) and reaching (vf, af).

@@ -103,8 +103,9 @@ class PlanRequest:
     stops: tuple[float, ...] = ()
     spans: tuple[SpanLimit, ...] = ()
     reach: str = "max_jerk"  # one of REACH_MODES; set by plan(), not by callers
-    #: Jerk [m/s³] a moving boundary state may use near it (``None``: ``limits.j_max``):
-    #: set by plan() for states just outside what ``j_max`` reaches, not by callers.
+    #: Jerk [m/s³] the jerk rows allow when a moving boundary state needs a hair more than
+    #: ``limits.j_max`` (``None``: ``limits.j_max``): set by plan() for states just outside
+    #: what ``j_max`` reaches, not by callers.
     state_jerk: float | None = None
 
     @classmethod
@@ -160,7 +161,7 @@ class PlanRequest:
 
     @property
     def moving_state_jerk(self) -> float:
-        """The jerk a moving boundary state may use near it [m/s³] (``state_jerk``)."""
+        """The jerk a moving boundary state may use [m/s³] (``state_jerk``)."""
         return self.limits.j_max if self.state_jerk is None else self.state_jerk
 
     @property
