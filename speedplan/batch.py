@@ -38,7 +38,7 @@ class BatchResult:
         The warnings issued while the job ran (e.g. ``("LimitWarning", "...")``), captured
         in the worker, where they would otherwise go to the worker's stderr or nowhere.
         Empty for jobs refused before they were sent and for jobs that failed with an
-        exception that is not a :class:`~speedplan.SpeedplanError` (a bug: its traceback
+        exception that is not a [`SpeedplanError`][speedplan.SpeedplanError] (a bug: its traceback
         is kept instead).
     """
 

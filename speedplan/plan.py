@@ -34,7 +34,7 @@ MAX_REFINEMENTS = 3
 #: round grades the grid so steeply that the banded kernel loses accuracy, measured).
 REFINE_FACTORS = (1 / 4, 1 / 2)
 #: Fractions of its nodes a jerk-limited default grid is rebuilt with, in turn, when the
-#: relaxation backend does not converge on it (:func:`~speedplan.model.build.coarser_leg`).
+#: relaxation backend does not converge on it (`coarser_leg`).
 COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
 
 
@@ -68,13 +68,13 @@ def plan(
         Uniform grid with ``n`` nodes or step at most ``ds`` [m] (per leg), graded finer
         at a leg's ends where its step is longer than 1/20 of the boundary transient (the
         first jerk phase from rest, a moving state's change of acceleration;
-        :func:`~speedplan.model.grid.graded_ends`): the law would exceed the limits there and
+        `graded_ends`): the law would exceed the limits there and
         the grid be refined after a first solve. By default the
         grid is adaptive and smoothly graded: ~80 nodes per jerk transition, coarse in long
         cruises; where the relaxation backend does not converge on it (seen on paths with
         slow zones), the leg is planned on the same grid with a half, a quarter, an eighth
-        of its nodes (:data:`COARSER_GRIDS`), then on these grids with the other backend
-        too, before a :class:`~speedplan.SolverError` is raised. A grid given with ``n`` or
+        of its nodes (`COARSER_GRIDS`), then on these grids with the other backend
+        too, before a [`SolverError`][speedplan.SolverError] is raised. A grid given with ``n`` or
         ``ds`` is never changed this way.
     v0, a0 : float
         Speed [m/s] and acceleration [m/s²] at the start (default: at rest).
@@ -83,22 +83,22 @@ def plan(
     zones : sequence of SpeedZone, optional
         Polygons with their own speed limit.
     v_limit : tuple (s, v), optional
-        Per-position speed limit along the path (see :func:`speedplan.speed_bounds`).
+        Per-position speed limit along the path (see `speedplan.speed_bounds`).
     refine : {"auto", "always", "never"}
-        IPOPT refinement when the relaxation is not exact (see :func:`solve_discrete`).
+        IPOPT refinement when the relaxation is not exact (see `solve_discrete`).
     standstill : {"smooth", "free"}
         ``"smooth"`` (default): acceleration 0 at a standstill, jerk-limited from the first
         instant. ``"free"``: the paper's model, where acceleration may jump *at a standstill*
         (moving boundary states stay jerk-limited).
     backend : {"auto", "clarabel", "banded"}
-        Relaxation backend (see :func:`speedplan.solve_discrete`).
+        Relaxation backend (see [`speedplan.solve_discrete`][speedplan.solve_discrete]).
     stops : sequence of float, optional
         Positions [m] strictly inside the path where the vehicle must come to rest
         (v = 0, a = 0), e.g. a route node with a blocking action. The vehicle also stops at
-        every cusp of the path (:attr:`Path.cusps`, where it reverses) and, when
-        ``limits.j_lat_max`` is set, at every curvature jump (:meth:`Path.curvature_jumps`;
-        a :class:`~speedplan.SpeedplanWarning` says where — G2 paths, the default of
-        :meth:`Path.from_waypoints`, have none).
+        every cusp of the path ([`Path.cusps`][speedplan.Path.cusps], where it reverses) and, when
+        ``limits.j_lat_max`` is set, at every curvature jump (`Path.curvature_jumps`;
+        a [`SpeedplanWarning`][speedplan.SpeedplanWarning] says where — G2 paths, the default of
+        [`Path.from_waypoints`][speedplan.Path.from_waypoints], have none).
     spans : sequence of SpanLimit, optional
         Speed and yaw-rate limits over stretches of the path (e.g. a route's edges).
 
@@ -106,10 +106,10 @@ def plan(
     -------
     SpeedProfile
         The speed law, its certificate, and ``sample(dt)`` for a time trajectory. Its
-        continuous trajectory is checked against every limit (:meth:`SpeedProfile.verify`);
+        continuous trajectory is checked against every limit (`SpeedProfile.verify`);
         where it exceeds a tolerance the grid is refined there, up to
-        :data:`MAX_REFINEMENTS` times; if it still does, the status is
-        ``"limits_exceeded"`` and a :class:`~speedplan.LimitWarning` is issued.
+        `MAX_REFINEMENTS` times; if it still does, the status is
+        ``"limits_exceeded"`` and a [`LimitWarning`][speedplan.LimitWarning] is issued.
 
     Raises
     ------
@@ -120,7 +120,7 @@ def plan(
         No jerk-limited motion meets the boundary states (the message says which state, which
         limit and where, ``s`` in metres). Moving states that ``j_max`` misses by a hair but
         ``j_max (1 + STATE_JERK_SLACK)`` (2 %) reaches are planned with that jerk instead, with
-        a :class:`~speedplan.SpeedplanWarning`.
+        a [`SpeedplanWarning`][speedplan.SpeedplanWarning].
     SolverError
         Neither relaxation backend converged on the leg's grid (nor, on a default grid, on
         the coarser ones), and no feasible speed law could be produced.
@@ -146,7 +146,7 @@ def plan(
 
 
 def plan_request(request: PlanRequest) -> SpeedProfile:
-    """:func:`plan` for an already validated :class:`~speedplan.model.PlanRequest`."""
+    """[`plan`][speedplan.plan] for an already validated `PlanRequest`."""
     modelled, model = _model_reaching_the_states(request)
     jumps = [r.s for r in model.rests if r.reason == "curvature jump"]
     if jumps:
@@ -255,7 +255,7 @@ def refine_factor(check: Verification) -> float:
 
     Near a violation the excess of a ratio beyond 1 shrinks about like the grid step (a
     first-order discretisation error), so a ratio ``1 + e`` asks for the steps times
-    ``tol / (2 e)``; the factor is kept within :data:`REFINE_FACTORS`.
+    ``tol / (2 e)``; the factor is kept within `REFINE_FACTORS`.
 
     Examples
     --------
@@ -273,13 +273,13 @@ def refine_factor(check: Verification) -> float:
 
 
 def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> tuple[LegResult, bool]:
-    """:func:`_solve`, on coarser default grids if the backend does not converge.
+    """`_solve`, on coarser default grids if the backend does not converge.
 
     Measured on slow-zone paths (``benchmarks/fuzz_zones.py``): both interior-point methods
     can stall on a fine default grid and converge on one with a half to an eighth of its
     nodes, in well under a second, where the other backend takes 10 s to 7 min on the fine
     grid to fail or to return a relaxation that needs IPOPT. So the backend alone is tried
-    on the default grid and on the coarser ones (:data:`COARSER_GRIDS`), and only then the
+    on the default grid and on the coarser ones (`COARSER_GRIDS`), and only then the
     same grids with the other backend as well; the law is verified and refined locally like
     any other. A user grid is never changed. Returns the result and whether it came from a
     coarser grid before the other backend was tried on the default one.
@@ -305,7 +305,7 @@ def _solve_default(request: PlanRequest, leg: Leg | ForcedLeg) -> tuple[LegResul
 
 
 def _solve(leg: Leg | ForcedLeg, *, fallback: bool = True) -> LegResult:
-    """Solve one leg and build its law (``fallback``: see :meth:`Leg.solve`)."""
+    """Solve one leg and build its law (``fallback``: see `Leg.solve`)."""
     if isinstance(leg, ForcedLeg):
         t0 = time.perf_counter()
         law = law_for(leg.s, leg.w, leg.time_law)

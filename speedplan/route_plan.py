@@ -21,12 +21,12 @@ _FROM_ROUTE = ("v0", "a0", "vf", "af", "stops", "spans", "v_limit")
 
 def route_jobs(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
                a0: float = 0.0, **plan_options: Any) -> tuple[list[dict[str, Any]], list[float]]:
-    """The :func:`speedplan.plan` jobs of a route's stop-to-stop legs, and where each starts.
+    """The `speedplan.plan` jobs of a route's stop-to-stop legs, and where each starts.
 
     Leg ``j`` runs from ``max(stop_s[j], start_s)`` to ``stop_s[j + 1]`` along
-    :attr:`Route.path` (legs wholly behind ``start_s`` are dropped); the first starts at
+    `Route.path` (legs wholly behind ``start_s`` are dropped); the first starts at
     ``(v0, a0)``, every other from rest; each ends at rest. The edges' ``v_max`` and
-    ``yaw_rate_max`` become :class:`~speedplan.SpanLimit` over their part of the leg.
+    ``yaw_rate_max`` become [`SpanLimit`][speedplan.SpanLimit] over their part of the leg.
 
     Examples
     --------
@@ -95,17 +95,17 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
                **plan_options: Any) -> RouteProfile:
     """Plan the minimum-time motion along a route's released base.
 
-    The vehicle stops (v = 0, a = 0) at every :attr:`Route.stop_s` — the nodes with a
+    The vehicle stops (v = 0, a = 0) at every `Route.stop_s` — the nodes with a
     blocking action, changes of driving direction, heading jumps it cannot round — and at
     the end of the released base, and drives through every other node without slowing
-    more than its limits ask. Each stop-to-stop leg is one :func:`speedplan.plan` (one
+    more than its limits ask. Each stop-to-stop leg is one [`speedplan.plan`][speedplan.plan] (one
     discrete problem, certified on its own); the legs are independent, so ``executor``
-    can plan them in parallel (:func:`speedplan.plan_many`).
+    can plan them in parallel ([`speedplan.plan_many`][speedplan.plan_many]).
 
     Parameters
     ----------
     route : Route
-        E.g. ``Route.from_vda5050(order)`` or :func:`speedplan.io.read_route`.
+        E.g. ``Route.from_vda5050(order)`` or [`speedplan.io.read_route`][speedplan.io.read_route].
     limits : Limits
         The vehicle's limits; each edge's ``v_max`` and ``yaw_rate_max`` apply on top over
         the edge.
@@ -117,14 +117,14 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     executor : concurrent.futures.Executor, optional
         Plan the legs on it (``plan_many``); default: one after the other in this process.
     **plan_options
-        Other :func:`speedplan.plan` keywords (``n``, ``ds``, ``zones``, ``refine``,
+        Other [`speedplan.plan`][speedplan.plan] keywords (``n``, ``ds``, ``zones``, ``refine``,
         ``standstill``, ``backend``); stops, spans and boundary states come from the route.
 
     Returns
     -------
     RouteProfile
         ``duration``, ``node_times``, ``legs``, ``sample(dt)`` (a
-        :class:`~speedplan.route.RouteTrajectory` with an ``edge`` column), ``verify()``.
+        [`RouteTrajectory`][speedplan.route.RouteTrajectory] with an ``edge`` column), ``verify()``.
 
     Raises
     ------
@@ -137,7 +137,7 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     Examples
     --------
     One 12 m edge limited to 1 m/s (a VDA 5050 order reads into the same
-    :class:`~speedplan.Route`, see :meth:`~speedplan.Route.from_vda5050`):
+    [`Route`][speedplan.Route], see [`from_vda5050`][speedplan.Route.from_vda5050]):
 
     >>> from speedplan import Limits, plan_route
     >>> from speedplan.geometry import Line, Path

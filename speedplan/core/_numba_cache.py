@@ -8,7 +8,7 @@ of the package drops or renames one of those classes, an index left behind by th
 version (``pip install -U`` leaves ``__pycache__`` in place) fails to unpickle, and numba
 raises that error from the first call instead of recompiling: ``AttributeError: Can't get
 attribute 'Work' on <module 'speedplan.solve._banded_ipm'>`` (numba issue #6018, still so in
-numba 0.68). :func:`tolerate_stale_indexes` makes such an index read as empty, which is how
+numba 0.68). `tolerate_stale_indexes` makes such an index read as empty, which is how
 numba already treats an index written by another numba version or for an older source; the
 next compilation writes a fresh one.
 """

@@ -1,6 +1,6 @@
 """Exceptions raised by speedplan.
 
-Every error a user can meet derives from :class:`SpeedplanError`, so one
+Every error a user can meet derives from [`SpeedplanError`][speedplan.SpeedplanError], so one
 ``except SpeedplanError`` catches them all.
 """
 
@@ -35,7 +35,7 @@ class InfeasibleError(SpeedplanError):
     constraint : str
         The constraint that makes the request impossible (e.g. ``"decel"``, ``"w_start"``).
     s : float or None
-        Position along the path [m] (grid position for :func:`solve_discrete`) where it bites.
+        Position along the path [m] (grid position for `solve_discrete`) where it bites.
     """
 
     def __init__(self, message: str, *, constraint: str = "", s: float | None = None) -> None:

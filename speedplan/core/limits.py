@@ -76,9 +76,9 @@ class Limits:
                                                                      allow_inf=True))
 
     def check_range(self) -> None:
-        """Raise :class:`~speedplan.InvalidInputError` unless every finite limit is in range.
+        """Raise `InvalidInputError` unless every finite limit is in range.
 
-        The range is :data:`LIMIT_RANGE`. :func:`speedplan.plan` checks the limits it is
+        The range is `LIMIT_RANGE`. [`speedplan.plan`][speedplan.plan] checks the limits it is
         given; the limits it derives may pass the range's ends (a marginal boundary state
         planned with 2 % more jerk than ``j_max = 1e9``).
 

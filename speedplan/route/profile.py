@@ -21,7 +21,7 @@ __all__ = ["RouteProfile", "RouteTrajectory"]
 
 @dataclass(frozen=True)
 class RouteTrajectory(Trajectory):
-    """A :class:`~speedplan.Trajectory` along a route, with the edge each sample is on.
+    """A [`Trajectory`][speedplan.Trajectory] along a route, with the edge each sample is on.
 
     Attributes
     ----------
@@ -34,23 +34,23 @@ class RouteTrajectory(Trajectory):
 
     @property
     def units(self) -> dict[str, str]:
-        """:data:`~speedplan.timing.trajectory.COLUMNS` and ``edge``."""
+        """`COLUMNS` and ``edge``."""
         return {**COLUMNS, "edge": "1"}
 
 
 @dataclass(frozen=True, eq=False)
 class RouteProfile:
-    """The minimum-time motion along a route: one :class:`~speedplan.SpeedProfile` per leg.
+    """The minimum-time motion along a route: one [`SpeedProfile`][speedplan.SpeedProfile] per leg.
 
-    The vehicle stops between legs (at :attr:`Route.stop_s`) and drives through every other
-    node; each leg was planned on its own (see :func:`speedplan.plan_route`).
+    The vehicle stops between legs (at `Route.stop_s`) and drives through every other
+    node; each leg was planned on its own (see [`speedplan.plan_route`][speedplan.plan_route]).
 
     Attributes
     ----------
     route : Route
         What was planned.
     legs : tuple of SpeedProfile
-        One per stop-to-stop leg from :attr:`start_s` on, in order.
+        One per stop-to-stop leg from [`start_s`][speedplan.RouteProfile] on, in order.
     leg_starts : tuple of float
         Where each leg starts along ``route.path`` [m]; the last leg ends at the route's end.
     start_s : float
@@ -68,7 +68,7 @@ class RouteProfile:
 
     @property
     def duration(self) -> float:
-        """Time from :attr:`start_s` to the end of the route [s]."""
+        """Time from [`start_s`][speedplan.RouteProfile] to the end of the route [s]."""
         return float(self.leg_times[-1])
 
     @cached_property
@@ -82,8 +82,8 @@ class RouteProfile:
     def node_times(self) -> FloatArray:
         """When the vehicle is on each released node [s from the start], in order.
 
-        ``NaN`` for the nodes behind :attr:`start_s` (already passed when an order update
-        took over); increasing from there to :attr:`duration` at the last node. At a stop,
+        ``NaN`` for the nodes behind `start_s` (already passed when an order update
+        took over); increasing from there to `duration` at the last node. At a stop,
         the time of arrival.
         """
         node_s = self.route.node_s
@@ -133,7 +133,7 @@ class RouteProfile:
 
     @property
     def verification(self) -> Verification:
-        """The checks :func:`speedplan.plan` made of each leg, merged."""
+        """The checks [`speedplan.plan`][speedplan.plan] made of each leg, merged."""
         return Verification.merged([leg.verification or leg.verify() for leg in self.legs])
 
     # ---- sampling in time -------------------------------------------------------------------

@@ -177,7 +177,7 @@ def _can_round(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
     """Whether the corner on ``node`` between two straight edges is rounded (G2).
 
     Both edges run straight between node positions, the node allows a deviation, the turn is
-    not a reversal (:data:`~speedplan.geometry.corners.CUSP_ANGLE`) and the vehicle keeps
+    not a reversal (`CUSP_ANGLE`) and the vehicle keeps
     its driving direction.
     """
     return (_is_straight(before.path) and _is_straight(after.path)
@@ -189,9 +189,9 @@ def _join_at_node(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
     """Whether the vehicle must stop on ``node`` to pass from ``before`` to ``after``.
 
     The one place that decides how a route passes a node between two edges: where the
-    heading changes by more than :data:`HEADING_TOLERANCE`, the corner is rounded within
-    ``node.allowed_deviation_xy`` when both edges are straight (:func:`_can_round`: a G2
-    clothoid–arc–clothoid corner, as :meth:`Path.from_waypoints` builds them), else the
+    heading changes by more than `HEADING_TOLERANCE`, the corner is rounded within
+    ``node.allowed_deviation_xy`` when both edges are straight (`_can_round`: a G2
+    clothoid–arc–clothoid corner, as `Path.from_waypoints` builds them), else the
     vehicle stops there (it turns on the spot).
     """
     if _heading_change(before.path, after.path) <= HEADING_TOLERANCE:
@@ -204,9 +204,9 @@ class Route:
     """A route: nodes and the edges between them, as in a VDA 5050 order.
 
     ``edges[i]`` runs from ``nodes[i]`` to ``nodes[i + 1]``. The planning quantities
-    (:attr:`length`, :attr:`node_s`, :attr:`edge_spans`, :attr:`stop_s`, :meth:`legs`) cover
+    ([`length`][speedplan.Route.length], `node_s`, `edge_spans`, `stop_s`, `legs`) cover
     the **released base** only — the vehicle plans it and must be able to stop at its end;
-    the horizon (``released`` false) is kept in :attr:`nodes` and :attr:`edges` for
+    the horizon (``released`` false) is kept in [`nodes`][speedplan.Route] and `edges` for
     information. Arc length ``s`` [m] runs along the base from its first node; the edges'
     paths are chained end to start (each within its node's allowed deviation of the next).
 
@@ -214,7 +214,7 @@ class Route:
     with a blocking (SOFT or HARD) action, at the start node of an edge with such an action,
     where the driving direction changes (an edge driven backwards after one driven forwards,
     or the reverse: a cusp) and where the heading jumps between two edges (see
-    :data:`HEADING_TOLERANCE`).
+    `HEADING_TOLERANCE`).
 
     Parameters
     ----------
@@ -322,12 +322,12 @@ class Route:
     # ---- the released base ------------------------------------------------------------------
     @cached_property
     def base_edges(self) -> tuple[RouteEdge, ...]:
-        """The released edges (a prefix of :attr:`edges`)."""
+        """The released edges (a prefix of [`edges`][speedplan.Route])."""
         return tuple(e for e in self.edges if e.released)
 
     @property
     def base_nodes(self) -> tuple[RouteNode, ...]:
-        """The released nodes (a prefix of :attr:`nodes`, one more than :attr:`base_edges`)."""
+        """The released nodes (a prefix of `nodes`, one more than `base_edges`)."""
         return self.nodes[: len(self.base_edges) + 1]
 
     @cached_property
@@ -368,7 +368,7 @@ class Route:
 
     @property
     def path(self) -> Path:
-        """The released base as one :class:`~speedplan.Path`: what ``plan_route`` plans.
+        """The released base as one [`Path`][speedplan.Path]: what ``plan_route`` plans.
 
         The edges' paths in order (driven in reverse where the edge says so), with the corners
         between straight edges rounded within their node's allowed deviation.
@@ -377,16 +377,16 @@ class Route:
 
     @property
     def node_s(self) -> FloatArray:
-        """Arc length [m] of each released node along :attr:`path`.
+        """Arc length [m] of each released node along [`path`][speedplan.Route.path].
 
-        0 first, :attr:`length` last; on a rounded corner, the corner's middle (its point
+        0 first, `length` last; on a rounded corner, the corner's middle (its point
         nearest the node).
         """
         return self._geometry[1]
 
     @property
     def rounded_nodes(self) -> tuple[int, ...]:
-        """Indices of the released nodes whose corner is rounded (see :attr:`path`)."""
+        """Indices of the released nodes whose corner is rounded (see `path`)."""
         return self._geometry[2]
 
     @property
@@ -415,7 +415,7 @@ class Route:
 
     @property
     def stop_reasons(self) -> tuple[str, ...]:
-        """Why the vehicle stops at each entry of :attr:`stop_s`."""
+        """Why the vehicle stops at each entry of [`stop_s`][speedplan.Route.stop_s]."""
         return tuple(reason for _, reason in self._stops)
 
     def legs(self) -> list[tuple[RouteEdge, ...]]:
@@ -442,7 +442,7 @@ class Route:
         Route
             Edges with a ``trajectory`` become NURBS paths (3.0 defaults: ``degree`` 1,
             uniform clamped knots, weights 1); edges without one run straight between their
-            node positions. See :mod:`speedplan.route.vda5050` for the fields read per version.
+            node positions. See `speedplan.route.vda5050` for the fields read per version.
 
         Raises
         ------

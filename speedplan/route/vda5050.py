@@ -1,4 +1,4 @@
-"""VDA 5050 orders (2.0, 2.1, 3.0) to a :class:`~speedplan.route.Route`.
+"""VDA 5050 orders (2.0, 2.1, 3.0) to a [`Route`][speedplan.Route].
 
 Field names follow the official JSON schemas and specification of the VDA5050/VDA5050
 repository (``json_schemas/order.schema`` and ``VDA5050_EN.md``); where the versions differ:
@@ -144,7 +144,7 @@ def load_order(order: Any) -> tuple[str, Any]:
 
 
 def route_from_vda5050(order: Any) -> Route:
-    """The :class:`Route` of a VDA 5050 order; see :meth:`Route.from_vda5050`.
+    """The [`Route`][speedplan.Route] of a VDA 5050 order; see `Route.from_vda5050`.
 
     Examples
     --------

@@ -141,7 +141,7 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
 
 
 def default_settings() -> clarabel.DefaultSettings:
-    """Clarabel settings used by :func:`solve_relaxation` (printing off, default tolerances)."""
+    """Clarabel settings used by `solve_relaxation` (printing off, default tolerances)."""
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.max_iter = 200

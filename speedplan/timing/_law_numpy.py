@@ -1,8 +1,8 @@
 """The time law's quadrature, inversion and kinematics in numpy.
 
-The interface of :mod:`speedplan.core._law_kernel`, the compiled version.
+The interface of `speedplan.core._law_kernel`, the compiled version.
 
-Used until numba's compiled code can run without compiling (:func:`backend`): the first
+Used until numba's compiled code can run without compiling (`backend`): the first
 ``plan()`` of a fresh environment answers with Clarabel while a background process compiles
 the banded kernel (``speedplan.solve.banded``), and compiling the time-law kernel in the
 foreground too would cost it seconds. The two agree to rounding (``tests/test_timing_law.py``
@@ -26,7 +26,7 @@ def backend() -> ModuleType:
     """The compiled kernel when the banded kernel is loaded in this process, else this module.
 
     Once numba has loaded the banded kernel, the time-law kernel loads from numba's cache in
-    ~20 ms (the background compilation, :func:`~speedplan.solve.banded.compile_kernel`,
+    ~20 ms (the background compilation, `compile_kernel`,
     compiles both); before that, numpy avoids a foreground compilation.
     """
     from ..solve.banded import _Kernel
