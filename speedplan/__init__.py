@@ -1,6 +1,6 @@
 """speedplan: minimum-time speed laws along a path, with a certificate of optimality.
 
-Speed, tangential-acceleration, lateral-acceleration and true jerk limits; see :func:`plan`.
+Speed, tangential-acceleration, lateral-acceleration and true jerk limits; see `plan`.
 """
 
 import importlib

@@ -1,4 +1,4 @@
-"""``python -m speedplan``: the ``speedplan`` command line (see :mod:`speedplan.cli`)."""
+"""``python -m speedplan``: the ``speedplan`` command line (see `speedplan.cli`)."""
 
 import sys
 

@@ -39,7 +39,7 @@ class BatchResult:
         The warnings issued while the job ran (e.g. ``("LimitWarning", "...")``), captured
         in the worker, where they would otherwise go to the worker's stderr or nowhere.
         Empty for jobs refused before they were sent and for jobs that failed with an
-        exception that is not a :class:`~speedplan.SpeedplanError` (a bug: its traceback
+        exception that is not a [`SpeedplanError`][speedplan.SpeedplanError] (a bug: its traceback
         is kept instead).
     """
 
@@ -214,9 +214,9 @@ def plan_many(
     progress : bool or callable
         ``True`` prints ``planned k/N`` to stderr; a callable receives ``(done, total)``.
     time_limit : float, optional
-        Seconds each job may take once it runs (:func:`speedplan.plan`'s ``time_limit``); a
+        Seconds each job may take once it runs (`speedplan.plan`'s ``time_limit``); a
         job's own ``time_limit`` keyword takes precedence. A job that runs out of it fails
-        with :class:`~speedplan.PlanTimeout`.
+        with [`PlanTimeout`][speedplan.PlanTimeout].
 
     Returns
     -------

@@ -337,7 +337,7 @@ def _stdin_text(args: argparse.Namespace) -> str:
 
 
 def _read_order(args: argparse.Namespace, pathfile: str | FsPath) -> Any:
-    """The :class:`~speedplan.route.Route` when the input is a VDA 5050 order, else ``None``."""
+    """The [`Route`][speedplan.Route] when the input is a VDA 5050 order, else ``None``."""
     import json
 
     from .io import read_route

@@ -4,13 +4,13 @@ Formats
 -------
 CSV waypoints (``.csv``)
     A header row naming the columns, then one waypoint per row, metres; joined by the default
-    kind of :meth:`Path.from_waypoints` (``"g2"``). Blank lines and lines starting with ``#``
+    kind of `Path.from_waypoints` (``"g2"``). Blank lines and lines starting with ``#``
     are ignored. Column names are matched case-insensitively, with surrounding spaces and a
     bracketed unit (``x [m]``) stripped. Read are: ``x`` and ``y`` (required, unit ``m`` if
     given) and at most one of ``heading``, ``yaw`` or ``theta`` (optional, unit ``rad`` if
     given): the waypoint headings of a clothoid chain (``kind="clothoid"``) through those
     poses. **Every other column is ignored**, whatever it holds (numbers, or text such as
-    ROS's ``frame_id``), with a :class:`~speedplan.SpeedplanWarning` naming the ignored
+    ROS's ``frame_id``), with a [`SpeedplanWarning`][speedplan.SpeedplanWarning] naming the ignored
     columns so that a misspelt heading column does not go unnoticed. The columns that are read
     must hold numbers in every row.
 JSON segments (``.json``)
@@ -26,14 +26,14 @@ VDA 5050 trajectory (``.json``)
     [{"x": .., "y": .., "weight": ..}, ...]}``, bare or under ``"trajectory"``; as in VDA 5050
     3.0, ``weight`` defaults to 1, ``degree`` to 1 and ``knotVector`` to uniform clamped knots.
 VDA 5050 order (``.json``)
-    A whole order (``nodes`` and ``edges``) is a route, not a path: :func:`read_route` reads it
-    (each edge's geometry, speed limit and stops); :func:`read_path` refuses it and says so.
+    A whole order (``nodes`` and ``edges``) is a route, not a path: `read_route` reads it
+    (each edge's geometry, speed limit and stops); `read_path` refuses it and says so.
 
 The readers take a file name or an open text stream (``sys.stdin``, ``io.StringIO``); the
 format comes from ``format=``, else the file extension, else (a stream without a name) the
 first character: ``{`` or ``[`` is JSON, anything else CSV.
 
-Every reader raises :class:`~speedplan.errors.InvalidInputError` naming the file and what is
+Every reader raises `InvalidInputError` naming the file and what is
 wrong; never a raw ``KeyError`` or ``JSONDecodeError``.
 """
 
@@ -244,7 +244,7 @@ def _nurbs_from_trajectory(traj: Any) -> Path:
 
 
 def path_from_dict(doc: Any, name: str = "document") -> Path:
-    """Build a :class:`Path` from a parsed JSON document (segments, waypoints or VDA 5050).
+    """Build a `Path` from a parsed JSON document (segments, waypoints or VDA 5050).
 
     Parameters
     ----------
@@ -333,7 +333,7 @@ def read_path(file: Source, *, kind: str | None = None, format: str | None = Non
     file : str, os.PathLike or text stream
         The file, or an open text stream such as ``sys.stdin``.
     kind : {"g2", "clothoid", "spline", "polyline"}, optional
-        How CSV waypoints are joined; see :meth:`Path.from_waypoints`. Default ``"g2"``, or
+        How CSV waypoints are joined; see `Path.from_waypoints`. Default ``"g2"``, or
         ``"clothoid"`` through the given poses when the file has a heading column.
     format : {"csv", "json"}, optional
         The format; default from the file extension, or sniffed from a stream's first
@@ -371,7 +371,7 @@ def read_path(file: Source, *, kind: str | None = None, format: str | None = Non
 
 
 def read_route(file: Source) -> Route:
-    """Read a VDA 5050 order file (versions 2.0, 2.1 and 3.0) as a :class:`~speedplan.route.Route`.
+    """Read a VDA 5050 order file (versions 2.0, 2.1 and 3.0) as a [`Route`][speedplan.Route].
 
     Parameters
     ----------
@@ -413,7 +413,7 @@ def read_route(file: Source) -> Route:
 def read_zones(file: Source, *, format: str | None = None) -> list[SpeedZone]:
     """Speed zones stored in a JSON path file (none for CSV files).
 
-    ``file`` and ``format`` as in :func:`read_path`.
+    ``file`` and ``format`` as in [`read_path`][speedplan.io.read_path].
 
     Examples
     --------
@@ -447,7 +447,7 @@ def _zone_dicts(zones: Any) -> list[dict[str, Any]]:
 def path_to_dict(path: Path, zones: Sequence[SpeedZone] | None = None) -> dict[str, Any]:
     """The JSON-segments document of a path made of lines, arcs and clothoids.
 
-    Exact for paths from :meth:`Path.from_segments`, G2 corner paths, polylines and clothoid
+    Exact for paths from `Path.from_segments`, G2 corner paths, polylines and clothoid
     chains (and their reversals): every piece is written as a segment from the first piece's
     pose (its vehicle heading); pieces driven in reverse carry ``"reverse": true``.
 
@@ -534,7 +534,7 @@ def write_path(
 ) -> None:
     """Write a path file; the extension selects the format.
 
-    ``.json``: JSON segments (exact; lines, arcs and clothoids only, see :func:`path_to_dict`),
+    ``.json``: JSON segments (exact; lines, arcs and clothoids only, see `path_to_dict`),
     with ``zones`` if given. ``.csv``: waypoints with headings sampled every ``ds`` metres
     (default ``length / 200``); read back, they give a clothoid chain through the samples with
     the sampled headings — an approximation whose error shrinks with ``ds`` (zones are not
@@ -576,15 +576,15 @@ def write_nurbs(
     """Write a NURBS path as a VDA 5050 edge ``trajectory`` JSON object (validated first).
 
     VDA 5050 calls the geometry of an edge its ``trajectory``; it holds no timing. For a
-    planned trajectory in time use :meth:`speedplan.Trajectory.to_csv` or
-    :meth:`~speedplan.Trajectory.to_json`.
+    planned trajectory in time use [`speedplan.Trajectory.to_csv`][speedplan.Trajectory.to_csv] or
+    [`to_json`][speedplan.Trajectory.to_json].
 
     Parameters
     ----------
     file : str or os.PathLike
         The ``.json`` file to write.
     degree, knots, control_points, weights
-        As in :meth:`speedplan.Path.from_nurbs` (``weights`` default 1).
+        As in [`speedplan.Path.from_nurbs`][speedplan.Path.from_nurbs] (``weights`` default 1).
 
     Examples
     --------
@@ -609,12 +609,12 @@ def write_nurbs(
 
 def write_trajectory(file: FileName, degree: int, knots: Any, control_points: Any,
                      weights: Any = None) -> None:
-    """Deprecated name of :func:`write_nurbs` (it writes a path, not a trajectory in time).
+    """Deprecated name of `write_nurbs` (it writes a path, not a trajectory in time).
 
     Warns
     -----
     DeprecationWarning
-        Always; call :func:`write_nurbs` instead.
+        Always; call [`write_nurbs`][speedplan.io.write_nurbs] instead.
     """
     warnings.warn(
         "speedplan.io.write_trajectory writes a VDA 5050 NURBS path, not a trajectory in time, "
@@ -651,13 +651,13 @@ def _trajectory_from_columns(name: str, cols: dict[str, Any], metadata: dict[str
 
 
 def read_trajectory(file: Source, *, format: str | None = None) -> Trajectory:
-    """Read a trajectory written by :meth:`Trajectory.to_csv` or :meth:`Trajectory.to_json`.
+    """Read a trajectory written by `Trajectory.to_csv` or `Trajectory.to_json`.
 
     The values come back bit for bit, except the heading: the files hold it wrapped to
     ``[-π, π)`` and it is unwrapped again (``numpy.unwrap``), so it is continuous and starts
     in ``[-π, π)``. The metadata (``# key: value`` lines of a CSV file) is in
     ``Trajectory.metadata``. A route's trajectory (with an ``edge`` column) comes back as a
-    :class:`~speedplan.route.RouteTrajectory`.
+    [`RouteTrajectory`][speedplan.route.RouteTrajectory].
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """plan(): validate the request -> model it -> solve each leg -> time law -> verified profile.
 
-Each stage's fallbacks are the attempts of :mod:`speedplan.strategy`, run under the
+Each stage's fallbacks are the attempts of `speedplan.strategy`, run under the
 caller's ``time_limit``.
 """
 
@@ -65,14 +65,14 @@ def plan(
         Uniform grid with ``n`` nodes or step at most ``ds`` [m] (per leg), graded finer
         at a leg's ends where its step is longer than 1/20 of the boundary transient (the
         first jerk phase from rest, a moving state's change of acceleration;
-        :func:`~speedplan.model.grid.graded_ends`): the law would exceed the limits there and
+        `graded_ends`): the law would exceed the limits there and
         the grid be refined after a first solve. By default the
         grid is adaptive and smoothly graded: ~80 nodes per jerk transition, coarse in long
         cruises; where the relaxation backend does not converge on it (seen on paths with
         slow zones), the leg is planned on the same grid with a half, a quarter, an eighth
-        of its nodes (:data:`COARSER_GRIDS`), then on these grids with the other backend
-        too, before a :class:`~speedplan.SolverError` is raised (the attempts of
-        :mod:`speedplan.strategy`). A grid given with ``n`` or ``ds`` is never changed this
+        of its nodes (`COARSER_GRIDS`), then on these grids with the other backend
+        too, before a [`SolverError`][speedplan.SolverError] is raised (the attempts of
+        `speedplan.strategy`). A grid given with ``n`` or ``ds`` is never changed this
         way.
     v0, a0 : float
         Speed [m/s] and acceleration [m/s²] at the start (default: at rest).
@@ -81,28 +81,28 @@ def plan(
     zones : sequence of SpeedZone, optional
         Polygons with their own speed limit.
     v_limit : tuple (s, v), optional
-        Per-position speed limit along the path (see :func:`speedplan.speed_bounds`).
+        Per-position speed limit along the path (see `speedplan.speed_bounds`).
     refine : {"auto", "always", "never"}
-        IPOPT refinement when the relaxation is not exact (see :func:`solve_discrete`).
+        IPOPT refinement when the relaxation is not exact (see `solve_discrete`).
     standstill : {"smooth", "free"}
         ``"smooth"`` (default): acceleration 0 at a standstill, jerk-limited from the first
         instant. ``"free"``: the paper's model, where acceleration may jump *at a standstill*
         (moving boundary states stay jerk-limited).
     backend : {"auto", "clarabel", "banded"}
-        Relaxation backend (see :func:`speedplan.solve_discrete`).
+        Relaxation backend (see [`speedplan.solve_discrete`][speedplan.solve_discrete]).
     stops : sequence of float, optional
         Positions [m] strictly inside the path where the vehicle must come to rest
         (v = 0, a = 0), e.g. a route node with a blocking action. The vehicle also stops at
-        every cusp of the path (:attr:`Path.cusps`, where it reverses) and, when
-        ``limits.j_lat_max`` is set, at every curvature jump (:meth:`Path.curvature_jumps`;
-        a :class:`~speedplan.SpeedplanWarning` says where — G2 paths, the default of
-        :meth:`Path.from_waypoints`, have none).
+        every cusp of the path ([`Path.cusps`][speedplan.Path.cusps], where it reverses) and, when
+        ``limits.j_lat_max`` is set, at every curvature jump (`Path.curvature_jumps`;
+        a [`SpeedplanWarning`][speedplan.SpeedplanWarning] says where — G2 paths, the default of
+        [`Path.from_waypoints`][speedplan.Path.from_waypoints], have none).
     spans : sequence of SpanLimit, optional
         Speed and yaw-rate limits over stretches of the path (e.g. a route's edges).
     time_limit : float, optional
         Seconds the plan may take (wall clock, from the call). The strategy's attempts
-        (:mod:`speedplan.strategy`) run in order while time is left; the first verified plan
-        is returned, and :class:`~speedplan.PlanTimeout` is raised if the limit passes
+        (`speedplan.strategy`) run in order while time is left; the first verified plan
+        is returned, and [`PlanTimeout`][speedplan.PlanTimeout] is raised if the limit passes
         before one is found. The limit is checked before each attempt: an attempt already
         running is not interrupted, so the answer can come later than the limit by one
         attempt (see docs/failure-modes.md). Default: no limit.
@@ -111,11 +111,11 @@ def plan(
     -------
     SpeedProfile
         The speed law, its certificate, and ``sample(dt)`` for a time trajectory. Its
-        continuous trajectory is checked against every limit (:meth:`SpeedProfile.verify`);
+        continuous trajectory is checked against every limit (`SpeedProfile.verify`);
         where it exceeds a tolerance the grid is refined there, up to
-        :data:`MAX_REFINEMENTS` times; if it still does, the status is
-        ``"limits_exceeded"`` and a :class:`~speedplan.LimitWarning` is issued.
-        :attr:`SpeedProfile.attempts` records which attempt answered for each leg and why
+        `MAX_REFINEMENTS` times; if it still does, the status is
+        ``"limits_exceeded"`` and a [`LimitWarning`][speedplan.LimitWarning] is issued.
+        `SpeedProfile.attempts` records which attempt answered for each leg and why
         the others failed.
 
     Raises
@@ -128,8 +128,8 @@ def plan(
         limit and where, ``s`` in metres). A moving state that ``j_max (1 +
         STATE_JERK_ROUNDING)`` (1e-4) reaches, such as a state read off a plan, is planned
         with that jerk, silently; one that ``j_max (1 + STATE_JERK_SLACK)`` (2 %) reaches,
-        with that jerk and a :class:`~speedplan.SpeedplanWarning`
-        (:func:`speedplan.strategy.model_request`).
+        with that jerk and a [`SpeedplanWarning`][speedplan.SpeedplanWarning]
+        (`speedplan.strategy.model_request`).
     SolverError
         Neither relaxation backend converged on the leg's grid (nor, on a default grid, on
         the coarser ones), and no feasible speed law could be produced.
@@ -165,9 +165,9 @@ def plan(
 
 def plan_request(request: PlanRequest, *, time_limit: float | None = None,
                  budget: Budget | None = None) -> SpeedProfile:
-    """:func:`plan` for an already validated :class:`~speedplan.model.PlanRequest`.
+    """[`plan`][speedplan.plan] for an already validated `PlanRequest`.
 
-    ``budget`` (a :class:`~speedplan.strategy.Budget` already running) takes the place of
+    ``budget`` (a `Budget` already running) takes the place of
     ``time_limit``.
     """
     record = Record(budget if budget is not None else Budget.of(time_limit))

@@ -1,6 +1,6 @@
 """Figures of a planned profile (matplotlib, from the ``plot`` extra, imported lazily).
 
-Everything is drawn on :class:`matplotlib.figure.Figure` objects, never through
+Everything is drawn on `matplotlib.figure.Figure` objects, never through
 ``matplotlib.pyplot``: plotting neither switches the caller's backend nor leaves figures open
 in pyplot's registry. Pass your own figure (``fig=``) or axes (``ax=``) to draw into them;
 in Jupyter a returned figure displays itself.
@@ -177,7 +177,7 @@ def plot_speed(profile: SpeedProfile | RouteProfile, trajectory: Trajectory | No
     Parameters
     ----------
     profile : SpeedProfile or RouteProfile
-        What :func:`speedplan.plan` or :func:`speedplan.plan_route` returned.
+        What [`speedplan.plan`][speedplan.plan] or `speedplan.plan_route` returned.
     trajectory : Trajectory, optional
         The sampled trajectory to draw; default ``profile.sample(dt)``.
     ax : matplotlib.axes.Axes, optional
@@ -262,7 +262,7 @@ def plot_lateral(trajectory: Trajectory, limits: Limits, ax: Any = None) -> Any:
 def plot_jerk(trajectory: Trajectory, limits: Limits, ax: Any = None) -> Any:
     """Jerk ``j(t)`` against ``±j_max``.
 
-    Drawn like :func:`plot_lateral` (no limit lines when the limit is infinite).
+    Drawn like `plot_lateral` (no limit lines when the limit is infinite).
 
     Returns
     -------
@@ -296,7 +296,7 @@ def _saved(fig: Any, file: str | PathLike[str] | None, dpi: float) -> Any:
     return getattr(fig, "figure", None) or fig
 
 
-#: Panel names of :func:`plot_profile`, in ``fig.axes`` order (colour bar last).
+#: Panel names of `plot_profile`, in ``fig.axes`` order (colour bar last).
 PANELS = ("path", "speed", "lateral", "acceleration", "jerk")
 
 
@@ -336,7 +336,7 @@ def plot_profile(
     -------
     matplotlib.figure.Figure
         The figure (``fig``, or the figure holding the SubFigure ``fig``); the panels' axes
-        come first in ``fig.axes``, in the order of :data:`PANELS`, then the colour bar.
+        come first in ``fig.axes``, in the order of `PANELS`, then the colour bar.
 
     Examples
     --------
@@ -363,7 +363,7 @@ def plot_profile(
     return _saved(fig, file, dpi)
 
 
-#: Panel names of :func:`plot_route`, in ``fig.axes`` order (colour bar last).
+#: Panel names of `plot_route`, in ``fig.axes`` order (colour bar last).
 ROUTE_PANELS = ("path", "speed", "acceleration", "jerk")
 
 
@@ -378,14 +378,14 @@ def plot_route(profile: RouteProfile, file: str | PathLike[str] | None = None, *
     Parameters
     ----------
     profile : RouteProfile
-        What :func:`speedplan.plan_route` returned.
+        What [`speedplan.plan_route`][speedplan.plan_route] returned.
     file, trajectory, dt, fig, dpi
-        As in :func:`plot_profile`.
+        As in [`plot_profile`][speedplan.plot.plot_profile].
 
     Returns
     -------
     matplotlib.figure.Figure
-        The panels' axes first in ``fig.axes``, in the order of :data:`ROUTE_PANELS`.
+        The panels' axes first in ``fig.axes``, in the order of `ROUTE_PANELS`.
 
     Examples
     --------

@@ -36,12 +36,12 @@ _FROM_ROUTE = ("v0", "a0", "vf", "af", "stops", "spans", "v_limit")
 
 def route_jobs(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
                a0: float = 0.0, **plan_options: Any) -> tuple[list[dict[str, Any]], list[float]]:
-    """The :func:`speedplan.plan` jobs of a route's stop-to-stop legs, and where each starts.
+    """The `speedplan.plan` jobs of a route's stop-to-stop legs, and where each starts.
 
     Leg ``j`` runs from ``max(stop_s[j], start_s)`` to ``stop_s[j + 1]`` along
-    :attr:`Route.path` (legs wholly behind ``start_s`` are dropped); the first starts at
+    `Route.path` (legs wholly behind ``start_s`` are dropped); the first starts at
     ``(v0, a0)``, every other from rest; each ends at rest. The edges' ``v_max`` and
-    ``yaw_rate_max`` become :class:`~speedplan.SpanLimit` over their part of the leg.
+    ``yaw_rate_max`` become [`SpanLimit`][speedplan.SpanLimit] over their part of the leg.
 
     Examples
     --------
@@ -107,11 +107,11 @@ def _edge_spans(route: Route, lo: float, hi: float) -> list[SpanLimit]:
 
 def route_turns(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
                 heading0: float | None = None) -> tuple[RouteTurn, ...]:
-    """The turns on the spot of a route from ``start_s`` on (see :func:`plan_route`).
+    """The turns on the spot of a route from ``start_s`` on (see `plan_route`).
 
-    Each step of :attr:`Route.turn_headings` on a node at or after ``start_s`` is one
-    rest-to-rest :class:`~speedplan.timing.rotation.Turn` by the shorter way round, within
-    :meth:`Route.turn_rate_limit` and ``limits.yaw_rate_max``, ``limits.yaw_acc_max`` and
+    Each step of [`Route.turn_headings`][speedplan.Route] on a node at or after ``start_s`` is one
+    rest-to-rest [`Turn`][speedplan.timing.rotation.Turn] by the shorter way round, within
+    `Route.turn_rate_limit` and ``limits.yaw_rate_max``, ``limits.yaw_acc_max`` and
     ``limits.yaw_jerk_max``.
     ``heading0`` [rad] replaces the arrival heading where the motion starts.
 
@@ -175,23 +175,23 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
                executor: Executor | None = None, **plan_options: Any) -> RouteProfile:
     """Plan the minimum-time motion along a route's released base.
 
-    The vehicle stops (v = 0, a = 0) at every :attr:`Route.stop_s` — the nodes with a
+    The vehicle stops (v = 0, a = 0) at every `Route.stop_s` — the nodes with a
     blocking action, changes of driving direction, heading jumps it cannot round, node
     orientations (``theta``) the path does not meet — and at the end of the released base,
     and drives through every other node without slowing more than its limits ask. Where its
-    heading must change on a node it turns on the spot (:attr:`Route.turn_headings`): a
+    heading must change on a node it turns on the spot ([`Route.turn_headings`][speedplan.Route]): a
     minimum-time rest-to-rest rotation within the edges' ``maxRotationSpeed``,
     ``limits.yaw_rate_max``, ``limits.yaw_acc_max`` and ``limits.yaw_jerk_max``, the shorter
     way round; the turns'
-    time is part of :attr:`RouteProfile.node_times` (arrival), ``node_leave_times`` and the
-    sampled trajectory. Each stop-to-stop leg is one :func:`speedplan.plan` (one
+    time is part of `RouteProfile.node_times` (arrival), ``node_leave_times`` and the
+    sampled trajectory. Each stop-to-stop leg is one [`speedplan.plan`][speedplan.plan] (one
     discrete problem, certified on its own); the legs are independent, so ``executor``
-    can plan them in parallel (:func:`speedplan.plan_many`).
+    can plan them in parallel ([`speedplan.plan_many`][speedplan.plan_many]).
 
     Parameters
     ----------
     route : Route
-        E.g. ``Route.from_vda5050(order)`` or :func:`speedplan.io.read_route`.
+        E.g. ``Route.from_vda5050(order)`` or [`speedplan.io.read_route`][speedplan.io.read_route].
     limits : Limits
         The vehicle's limits; each edge's ``v_max`` and ``yaw_rate_max`` apply on top over
         the edge.
@@ -208,7 +208,7 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     executor : concurrent.futures.Executor, optional
         Plan the legs on it (``plan_many``); default: one after the other in this process.
     **plan_options
-        Other :func:`speedplan.plan` keywords (``n``, ``ds``, ``zones``, ``refine``,
+        Other [`speedplan.plan`][speedplan.plan] keywords (``n``, ``ds``, ``zones``, ``refine``,
         ``standstill``, ``backend``, ``time_limit``); stops, spans and boundary states come
         from the route. ``time_limit`` [s] bounds the whole route when the legs are planned
         here (each leg gets what the ones before it left), each leg with an ``executor``
@@ -218,7 +218,7 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     -------
     RouteProfile
         ``duration``, ``node_times``, ``legs``, ``sample(dt)`` (a
-        :class:`~speedplan.route.RouteTrajectory` with an ``edge`` column), ``verify()``.
+        [`RouteTrajectory`][speedplan.route.RouteTrajectory] with an ``edge`` column), ``verify()``.
 
     Raises
     ------
@@ -231,7 +231,7 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     Examples
     --------
     One 12 m edge limited to 1 m/s (a VDA 5050 order reads into the same
-    :class:`~speedplan.Route`, see :meth:`~speedplan.Route.from_vda5050`):
+    [`Route`][speedplan.Route], see [`from_vda5050`][speedplan.Route.from_vda5050]):
 
     >>> from speedplan import Limits, plan_route
     >>> from speedplan.geometry import Line, Path
@@ -302,7 +302,7 @@ def plan_route_update(profile: RouteProfile, route: Route, t: float, limits: Lim
     Parameters
     ----------
     profile : RouteProfile
-        The plan being driven (from :func:`plan_route` or this function).
+        The plan being driven (from [`plan_route`][speedplan.plan_route] or this function).
     route : Route
         The order update.
     t : float
@@ -310,12 +310,12 @@ def plan_route_update(profile: RouteProfile, route: Route, t: float, limits: Lim
     limits : Limits, optional
         The vehicle's limits; default those ``profile`` was planned with.
     executor, **plan_options
-        As for :func:`plan_route`.
+        As for [`plan_route`][speedplan.plan_route].
 
     Returns
     -------
     RouteProfile
-        Over the joined route, from the vehicle's position (its :attr:`RouteProfile.start_s`).
+        Over the joined route, from the vehicle's position (its `RouteProfile.start_s`).
 
     Raises
     ------

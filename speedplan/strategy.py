@@ -1,6 +1,6 @@
-"""The planning strategy behind :func:`speedplan.plan`: ordered attempts, a budget, a record.
+"""The planning strategy behind `speedplan.plan`: ordered attempts, a budget, a record.
 
-A plan is one pass through a fixed chain of named attempts (:data:`ATTEMPTS`), each tried
+A plan is one pass through a fixed chain of named attempts (`ATTEMPTS`), each tried
 only when the ones before it did not answer:
 
 * **model** (once per request): ``"model"``, the request as asked (moving boundary states
@@ -10,21 +10,21 @@ only when the ones before it did not answer:
   STATE_JERK_ROUNDING)`` (a state read off a plan; silent); then
   ``"jerk_slack"`` and ``"exact_reach_jerk_slack"`` with ``j_max (1 + STATE_JERK_SLACK)``,
   for moving states just outside what ``j_max`` reaches (with a
-  :class:`~speedplan.SpeedplanWarning`).
+  [`SpeedplanWarning`][speedplan.SpeedplanWarning]).
 * **solve** (per leg): ``"forced_motion"`` for a leg with no freedom left; ``"given_grid"``
   for the caller's grid (``n`` or ``ds``: both relaxation backends, never another grid);
   otherwise ``"default_grid"`` with the request's backend, then ``"coarser_grid_1/2"``,
-  ``"coarser_grid_1/4"``, ``"coarser_grid_1/8"`` (:data:`COARSER_GRIDS`) with it, then
+  ``"coarser_grid_1/4"``, ``"coarser_grid_1/8"`` (`COARSER_GRIDS`) with it, then
   ``"other_backend"`` on each of these grids in turn.
 * **verify** (per leg whose continuous law exceeds a tolerance): up to
-  :data:`MAX_REFINEMENTS` rounds of ``"local_refinement"`` of the grid where it does, then,
+  `MAX_REFINEMENTS` rounds of ``"local_refinement"`` of the grid where it does, then,
   for a leg answered on a coarser grid, ``"default_grid_other_backend"``.
 
-:class:`Budget` holds the caller's ``time_limit``: it is checked before every attempt, and
+`Budget` holds the caller's ``time_limit``: it is checked before every attempt, and
 an attempt the budget no longer covers is not started. The record of every attempt (which
 answered, why the others failed or were replaced, what each cost) is kept on the profile,
-:attr:`~speedplan.SpeedProfile.attempts`. When the budget runs out before a verified plan,
-:class:`~speedplan.PlanTimeout` names what was tried; a profile whose law has not passed
+[`attempts`][speedplan.SpeedProfile]. When the budget runs out before a verified plan,
+[`PlanTimeout`][speedplan.PlanTimeout] names what was tried; a profile whose law has not passed
 its check is never returned.
 """
 
@@ -69,7 +69,7 @@ MAX_REFINEMENTS = 3
 #: round grades the grid so steeply that the banded kernel loses accuracy, measured).
 REFINE_FACTORS = (1 / 4, 1 / 2)
 #: Fractions of its nodes a jerk-limited default grid is rebuilt with, in turn, when the
-#: relaxation backend does not converge on it (:func:`~speedplan.model.build.coarser_leg`).
+#: relaxation backend does not converge on it (`coarser_leg`).
 COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
 
 #: Every attempt's name, in the order the strategy tries them (see the module docstring).
@@ -137,7 +137,7 @@ class Record:
                 catch: tuple[type[Exception], ...] = (SolverError,)) -> T:
         """``run()`` as the attempt ``name``, recorded; an exception in ``catch`` is re-raised.
 
-        Raises :class:`~speedplan.PlanTimeout` instead of starting ``run`` when the budget
+        Raises [`PlanTimeout`][speedplan.PlanTimeout] instead of starting ``run`` when the budget
         has run out.
         """
         if self.budget.expired():
@@ -193,7 +193,7 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
     rounding) is planned with that jerk, silently; one just outside what ``j_max`` reaches
     is planned with ``j_max (1 + STATE_JERK_SLACK)``, with a warning (a state measured on
     the vehicle: refusing it would strand the vehicle). The looser jerk applies to the
-    jerk rows of the whole move (:attr:`PlanRequest.state_jerk`): held only near the state,
+    jerk rows of the whole move (`PlanRequest.state_jerk`): held only near the state,
     the varying jerk bound made the relaxation inexact and a 27.8 km move took minutes in
     the refinement instead of 1 s. The plan is verified against the requested limits.
     """
@@ -236,7 +236,7 @@ def solve_leg(leg: Leg | ForcedLeg, *, fallback: bool = True) -> LegResult:
     """Solve one leg and build its law; an infeasibility is restated in metres.
 
     ``fallback``: whether a failed relaxation backend is retried with the other one
-    (:func:`~speedplan.solve.solve_problem`).
+    (`solve_problem`).
     """
     if isinstance(leg, ForcedLeg):
         t0 = time.perf_counter()
@@ -325,13 +325,13 @@ def _other_backend(failed: str) -> str:
 
 
 class _NotCoarser(Exception):
-    """The default grid cannot get coarser (:func:`~speedplan.model.build.coarser_leg`)."""
+    """The default grid cannot get coarser (`coarser_leg`)."""
 
 
 def _solve_coarser(request: PlanRequest, grids: list[Leg], factor: float) -> LegResult:
     """The first leg of ``grids`` on a grid with ``factor`` times its nodes, solved.
 
-    The grid is appended to ``grids``; :class:`_NotCoarser` when it would not be coarser
+    The grid is appended to ``grids``; `_NotCoarser` when it would not be coarser
     than the last one there.
     """
     coarser = coarser_leg(request, grids[0], factor)
@@ -348,7 +348,7 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
 
     Each leg is checked once per law it gets: the final verification merges these checks
     (what ``profile.verify()`` computes) instead of checking every leg again. With a budget
-    that runs out while a leg still exceeds a limit, :class:`~speedplan.PlanTimeout`.
+    that runs out while a leg still exceeds a limit, [`PlanTimeout`][speedplan.PlanTimeout].
     """
     profile = SpeedProfile(path=request.path, limits=request.limits, legs=tuple(legs),
                            speed_bound=model.bound, request=request)
@@ -423,7 +423,7 @@ def refine_factor(check: Verification) -> float:
 
     Near a violation the excess of a ratio beyond 1 shrinks about like the grid step (a
     first-order discretisation error), so a ratio ``1 + e`` asks for the steps times
-    ``tol / (2 e)``; the factor is kept within :data:`REFINE_FACTORS`.
+    ``tol / (2 e)``; the factor is kept within `REFINE_FACTORS`.
 
     Examples
     --------

@@ -39,10 +39,10 @@ def profile_from_waypoints(
 
     The waypoints are joined by a drivable path, by default straight legs with G2 corners
     that cut each waypoint by at most ``max_deviation`` (0.25 m), then planned with
-    :func:`speedplan.plan`. ``kind``, ``headings``, ``corner_radius``, ``max_deviation`` and
-    ``transition`` are those of :meth:`speedplan.Path.from_waypoints` (an option that does not
-    apply to ``kind`` raises :class:`~speedplan.InvalidInputError`); the other keywords go to
-    :func:`speedplan.plan`.
+    `speedplan.plan`. ``kind``, ``headings``, ``corner_radius``, ``max_deviation`` and
+    ``transition`` are those of `speedplan.Path.from_waypoints` (an option that does not
+    apply to ``kind`` raises `InvalidInputError`); the other keywords go to
+    [`speedplan.plan`][speedplan.plan].
 
     Examples
     --------

@@ -1,12 +1,12 @@
-"""Compiled quadrature, time inversion and kinematics of :class:`~speedplan.timing.law.TimeLaw`.
+"""Compiled quadrature, time inversion and kinematics of `TimeLaw`.
 
 Plain arrays in, plain arrays out (the law's chain of quadratic pieces in ``w`` or
-``u = w^{3/4}``); it lives in ``core`` next to :mod:`speedplan.core.jit`, which compiles it
+``u = w^{3/4}``); it lives in ``core`` next to `speedplan.core.jit`, which compiles it
 (the ``"time law"`` family) without the core layer importing the timing layer.
 
 The time inversion: on a ``w``-piece moving at both ends whose time the quadrature gets to
 rounding (``TimeLaw._exact_inverse``), the offset reached at time ``τ`` is the exact solution
-of ``dσ/dτ = sqrt(w(σ))`` from the knot nearer in time (:func:`_moving_offset`); it meets
+of ``dσ/dτ = sqrt(w(σ))`` from the knot nearer in time (`_moving_offset`); it meets
 the quadrature's time to the same ``1e-15`` of the piece's time as the iteration does, at a
 fifth of its cost (the 10 000 samples of a 100 Hz trajectory: 0.6 ms against 3.3 ms).
 Other pieces (in ``u``, at a standstill, or where the rule is off) run a safeguarded Newton
@@ -15,9 +15,9 @@ the piece's time), started from the third-order kinematic expansion at the left 
 (``σ ≈ v τ + a τ²/2 + j τ³/6``) or, at a standstill, the piece's own power law. Results
 agree with the numpy formulation to rounding (sampled states within 2e-15 of their scale on
 every sample path). Used by
-:mod:`speedplan.timing.law` once numba is loaded (before that, the same formulas in numpy:
+`speedplan.timing.law` once numba is loaded (before that, the same formulas in numpy:
 ``speedplan.timing._law_numpy``): ``import speedplan`` stays free of numba. The entry points'
-explicit signatures are in :func:`signatures`; :mod:`speedplan.core.jit` loads them from
+explicit signatures are in `signatures`; `speedplan.core.jit` loads them from
 numba's cache (~20 ms with numba's runtime loaded) or compiles them (1.5-5 s, once per
 installation).
 """
@@ -47,7 +47,7 @@ _RULE = np.ascontiguousarray(np.stack((
     3.0 * GAUSS_NODES**2)), dtype=np.float64)
 
 #: The law's piece arrays as one argument (``x, y, g, c, is_u, y_right, g_right``, see
-#: :func:`_arrays`).
+#: `_arrays`).
 _PIECES = "Tuple((f8[::1], f8[::1], f8[::1], f8[::1], b1[::1], f8[::1], f8[::1]))"
 Pieces = tuple[FloatArray, FloatArray, FloatArray, FloatArray, np.ndarray, FloatArray,
                FloatArray]
@@ -303,7 +303,7 @@ def invert(pieces: Any, T: np.ndarray, j: np.ndarray, t: np.ndarray, exact: np.n
 def _kinematics_into(pieces: Pieces, j: IntArray, dx: FloatArray, dr: FloatArray,
                      w_out: FloatArray, v_out: FloatArray, a_out: FloatArray,
                      jerk_out: FloatArray) -> None:
-    """``w, v, a, jerk`` at offsets ``(dx, dr)`` of pieces ``j`` (:func:`_state`)."""
+    """``w, v, a, jerk`` at offsets ``(dx, dr)`` of pieces ``j`` (`_state`)."""
     for k in range(j.size):
         w_out[k], v_out[k], a_out[k], jerk_out[k] = _state(pieces, j[k], dx[k], dr[k])
 
@@ -331,7 +331,7 @@ def _arrays(p: Any) -> Pieces:
 
 
 def signatures() -> dict[str, str]:
-    """Every kernel called from Python and its signature (see :mod:`speedplan.core.jit`)."""
+    """Every kernel called from Python and its signature (see `speedplan.core.jit`)."""
     return {
         "_integrals_into":
             f"void({_PIECES}, i8[::1], f8[::1], f8[::1], b1[::1], f8[:, ::1], f8[::1])",

@@ -16,16 +16,16 @@ ATTEMPT_OUTCOMES: tuple[AttemptOutcome, ...] = ("answered", "failed", "replaced"
 
 @dataclass(frozen=True)
 class Attempt:
-    """One attempt of the planning strategy (:mod:`speedplan.strategy`).
+    """One attempt of the planning strategy (`speedplan.strategy`).
 
     Attributes
     ----------
     name : str
-        The attempt's name, one of :data:`speedplan.strategy.ATTEMPTS`.
+        The attempt's name, one of `speedplan.strategy.ATTEMPTS`.
     leg : int or None
         The leg it planned (``None``: the whole request, e.g. its model).
     outcome : str
-        One of :data:`ATTEMPT_OUTCOMES`.
+        One of `ATTEMPT_OUTCOMES`.
     reason : str
         Why it failed or was replaced (empty when it answered).
     seconds : float

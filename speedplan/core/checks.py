@@ -1,6 +1,6 @@
 """Input checks shared by every layer.
 
-Each check raises :class:`~speedplan.errors.InvalidInputError` whose message names the
+Each check raises `InvalidInputError` whose message names the
 argument, shows the offending value and says what to do.
 """
 

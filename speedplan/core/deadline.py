@@ -1,10 +1,10 @@
 """The wall-clock deadline of the plan being computed, for solvers that can stop at one.
 
-:func:`speedplan.plan` with ``time_limit`` runs each attempt of its strategy under
-:func:`deadline`; a backend with a time limit of its own (Clarabel's ``time_limit``,
-IPOPT's ``max_wall_time``) reads :func:`remaining` and stops there instead of running on
+[`speedplan.plan`][speedplan.plan] with ``time_limit`` runs each attempt of its strategy under
+`deadline`; a backend with a time limit of its own (Clarabel's ``time_limit``,
+IPOPT's ``max_wall_time``) reads `remaining` and stops there instead of running on
 past the caller's limit. A context variable, so that threads planning at once (a thread
-pool in :func:`speedplan.plan_many`) each keep their own.
+pool in [`speedplan.plan_many`][speedplan.plan_many]) each keep their own.
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ def deadline(at: float | None) -> Iterator[None]:
 
 
 def remaining() -> float | None:
-    """Seconds left before the current deadline (at least :data:`MIN_SOLVER_TIME`), or ``None``."""
+    """Seconds left before the current deadline (at least `MIN_SOLVER_TIME`), or ``None``."""
     at = _DEADLINE.get()
     if at is None:
         return None

@@ -1,6 +1,6 @@
 """Exceptions raised by speedplan.
 
-Every error a user can meet derives from :class:`SpeedplanError`, so one
+Every error a user can meet derives from [`SpeedplanError`][speedplan.SpeedplanError], so one
 ``except SpeedplanError`` catches them all.
 """
 
@@ -38,7 +38,7 @@ class InfeasibleError(SpeedplanError):
     constraint : str
         The constraint that makes the request impossible (e.g. ``"decel"``, ``"w_start"``).
     s : float or None
-        Position along the path [m] (grid position for :func:`solve_discrete`) where it bites.
+        Position along the path [m] (grid position for `solve_discrete`) where it bites.
     """
 
     def __init__(self, message: str, *, constraint: str = "", s: float | None = None) -> None:
@@ -61,14 +61,14 @@ class PlanTimeout(SpeedplanError):
 
     Raised instead of returning a profile whose continuous trajectory has not passed its
     check: the message names every attempt of the strategy that ran and why each did not
-    answer (:mod:`speedplan.strategy`).
+    answer (`speedplan.strategy`).
 
     Attributes
     ----------
     time_limit : float
         The limit that ran out [s].
     attempts : tuple of Attempt
-        The attempts made, in order (:class:`~speedplan.core.attempts.Attempt`).
+        The attempts made, in order ([`Attempt`][speedplan.core.attempts.Attempt]).
     """
 
     def __init__(self, message: str, *, time_limit: float, attempts: tuple[Any, ...] = ()

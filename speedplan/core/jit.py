@@ -4,22 +4,22 @@ Three families of kernels are compiled with numba and cached on disk (``cache=Tr
 ``__pycache__`` next to the sources, or under ``NUMBA_CACHE_DIR``):
 
 ``"relaxation"``
-    the banded interior-point iteration (:mod:`speedplan.solve._banded_ipm`); until it is
+    the banded interior-point iteration (`speedplan.solve._banded_ipm`); until it is
     available, ``backend="auto"`` answers with Clarabel;
 ``"time law"``
-    the time law's quadrature, inversion and kinematics (:mod:`speedplan.core._law_kernel`);
-    until it is available, the same formulas run in numpy (:mod:`speedplan.timing._law_numpy`);
+    the time law's quadrature, inversion and kinematics (`speedplan.core._law_kernel`);
+    until it is available, the same formulas run in numpy (`speedplan.timing._law_numpy`);
 ``"refinement"``
-    the banded refinement's array work (:mod:`speedplan.solve._banded_nlp_kernels`); until it
-    is available, the same steps run in numpy (:mod:`speedplan.solve.banded_nlp`).
+    the banded refinement's array work (`speedplan.solve._banded_nlp_kernels`); until it
+    is available, the same steps run in numpy (`speedplan.solve.banded_nlp`).
 
 Each kernel module lists the entry points called from Python and their explicit signatures
-(``signatures()``); :class:`Kernels` loads each of them from numba's cache without ever
-compiling (:func:`load_cached_overload`), compiles them when asked to, and otherwise starts
+(``signatures()``); `Kernels` loads each of them from numba's cache without ever
+compiling (`load_cached_overload`), compiles them when asked to, and otherwise starts
 one background Python process that compiles the family into the cache while the fallback
-answers. A lock file per family (:meth:`Kernels.lock_path`) keeps the workers of
-:func:`~speedplan.plan_many`, which all start cold, from compiling the same family at once.
-``speedplan compile`` (:func:`compile_families`) compiles every family in parallel processes
+answers. A lock file per family (`Kernels.lock_path`) keeps the workers of
+[`plan_many`][speedplan.plan_many], which all start cold, from compiling the same family at once.
+``speedplan compile`` (`compile_families`) compiles every family in parallel processes
 and waits: the step for CI jobs, containers and fresh virtual environments, after which the
 first ``plan()`` already runs the compiled kernels.
 
@@ -32,7 +32,7 @@ version of the package drops or renames one of those classes, an index left behi
 earlier version (``pip install -U`` leaves ``__pycache__`` in place) fails to unpickle, and
 numba raises that error from the first call instead of recompiling: ``AttributeError: Can't
 get attribute 'Work' on <module 'speedplan.solve._banded_ipm'>`` (numba issue #6018, still so
-in numba 0.68). :func:`tolerate_stale_indexes` makes such an index read as empty, which is how
+in numba 0.68). `tolerate_stale_indexes` makes such an index read as empty, which is how
 numba already treats an index written by another numba version or for an older source; the
 next compilation writes a fresh one.
 """
@@ -99,7 +99,7 @@ def load_cached_overload(disp: Any, sig: Any) -> bool:
     """Load numba dispatcher ``disp``'s overload for ``sig`` from the on-disk cache; never compiles.
 
     ``sig``: a signature string or a tuple of numba types. Mirrors what
-    :meth:`numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's dispatcher
+    `numba.core.dispatcher.Dispatcher.compile` does on a cache hit (numba's dispatcher
     offers no public "load but do not compile"); any failure means "not loaded".
     """
     from numba.core import sigutils
@@ -131,9 +131,9 @@ class Kernels:
     Parameters
     ----------
     name : str
-        The family's name (a key of :data:`FAMILIES`).
+        The family's name (a key of `FAMILIES`).
     module : str
-        The module defining the kernels. It calls :func:`tolerate_stale_indexes` and
+        The module defining the kernels. It calls `tolerate_stale_indexes` and
         defines ``signatures()``: ``{dispatcher name: signature}`` of every kernel called from
         Python; nothing else of the family is ever compiled in a process that uses it.
     then : tuple of str
@@ -270,7 +270,7 @@ FAMILIES: dict[str, Kernels] = {
 def claim_lock(path: str) -> bool:
     """Create the lock file ``path``; False if a fresh one exists (another process compiles).
 
-    A lock older than :data:`COMPILE_LOCK_STALE` was left by a process that died: taken over.
+    A lock older than `COMPILE_LOCK_STALE` was left by a process that died: taken over.
     """
     for _ in range(2):
         try:

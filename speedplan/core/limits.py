@@ -51,11 +51,11 @@ class Limits:
         paths: where the curvature jumps the vehicle has to stop.
     yaw_rate_max : float, optional
         Yaw-rate limit ``|κ| v`` [rad/s]; ``None`` or ``inf`` for none (the default). It also
-        bounds the yaw rate of a turn on the spot (see :func:`speedplan.plan_route`).
+        bounds the yaw rate of a turn on the spot (see `speedplan.plan_route`).
     yaw_acc_max : float, optional
         Yaw-acceleration limit of a turn on the spot [rad/s²], where a route makes the vehicle
         stop and rotate (a corner it may not cut, a node orientation): > 0, default
-        :data:`DEFAULT_YAW_ACC` (1 rad/s²; ``inf`` is refused, no vehicle turns in no time).
+        `DEFAULT_YAW_ACC` (1 rad/s²; ``inf`` is refused, no vehicle turns in no time).
         While driving, the yaw acceleration ``d(κ v)/dt`` is bounded through ``j_lat_max``
         and the path's curvature instead.
     yaw_jerk_max : float, optional
@@ -121,9 +121,9 @@ class Limits:
         return self.grip == "ellipse"
 
     def check_range(self) -> None:
-        """Raise :class:`~speedplan.InvalidInputError` unless every finite limit is in range.
+        """Raise `InvalidInputError` unless every finite limit is in range.
 
-        The range is :data:`LIMIT_RANGE`. :func:`speedplan.plan` checks the limits it is
+        The range is `LIMIT_RANGE`. [`speedplan.plan`][speedplan.plan] checks the limits it is
         given; the limits it derives may pass the range's ends (a marginal boundary state
         planned with 2 % more jerk than ``j_max = 1e9``).
 

@@ -1,7 +1,7 @@
 """The library's logger: ``logging.getLogger("speedplan")``, silent unless configured.
 
 speedplan logs at ``DEBUG`` level only (files read and written, batch jobs refused or failed,
-solver steps); it attaches a :class:`logging.NullHandler`, so nothing is printed unless the
+solver steps); it attaches a `logging.NullHandler`, so nothing is printed unless the
 application configures logging, e.g. ``logging.basicConfig(level=logging.DEBUG)`` or the
 command line's ``--verbose``.
 

@@ -115,7 +115,7 @@ class SpanLimit:
 
 
 def check_spans(spans: Any, length: float | None = None) -> list[SpanLimit]:
-    """``spans`` as a list of :class:`SpanLimit` (one, a sequence, or ``None``)."""
+    """``spans`` as a list of [`SpanLimit`][speedplan.SpanLimit] (one, a sequence, or ``None``)."""
     out = instances("spans", spans, SpanLimit)
     for i, span in enumerate(out):
         if length is not None and span.end > length * (1 + 1e-9):
@@ -193,7 +193,7 @@ def _bounds(
     path: Path, limits: Limits, q: FloatArray, curvature: FloatArray,
     zone_list: list[SpeedZone], v_limit: Any, span_list: Sequence[SpanLimit] = (),
 ) -> FloatArray:
-    """:func:`speed_bounds` at ``q`` once the path's curvature there is known."""
+    """`speed_bounds` at ``q`` once the path's curvature there is known."""
     w = np.full(q.shape, limits.v_max**2)
     kappa = np.abs(curvature)
     with np.errstate(divide="ignore"):
@@ -225,7 +225,7 @@ def _bounds(
 class SpeedBound:
     """``s -> mu+(s)`` for one path, limits and zones: a picklable callable [m²/s²].
 
-    Calling it is :func:`speed_bounds` with the stored arguments.
+    Calling it is [`speed_bounds`][speedplan.speed_bounds] with the stored arguments.
 
     Examples
     --------
@@ -248,7 +248,7 @@ class SpeedBound:
     def at_offset(self, offset: float) -> SpeedBound:
         """The same bound read from ``offset`` [m] on: ``s -> mu+(offset + s)``.
 
-        Shares the memo (:meth:`memoised`), which is keyed by the path's own arc length.
+        Shares the memo (`memoised`), which is keyed by the path's own arc length.
         """
         return replace(self, offset=self.offset + float(offset))
 
@@ -260,7 +260,7 @@ class SpeedBound:
         same positions. On a spline or NURBS path each curvature is an arc-length inversion
         and, with speed zones, each position a point-in-polygon test; there the returned bound
         looks up the positions it has seen (exactly equal floats) and evaluates only the
-        others (:class:`BoundMemo`). On paths of lines, arcs and clothoids without zones a
+        others (`BoundMemo`). On paths of lines, arcs and clothoids without zones a
         lookup costs more than the evaluation and ``self`` is returned.
 
         Examples
@@ -382,10 +382,10 @@ def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:
     return sk, vk
 
 
-#: Points per scan step of :func:`zone_intervals` where the path, outside a zone at both
+#: Points per scan step of `zone_intervals` where the path, outside a zone at both
 #: ends of the step, comes within one step of it.
 ZONE_RESCAN = 64
-#: Bisection steps of :func:`zone_intervals` per path query (2**depth - 1 points a bracket).
+#: Bisection steps of `zone_intervals` per path query (2**depth - 1 points a bracket).
 _BISECT_DEPTH = 5
 
 
@@ -396,7 +396,7 @@ def zone_intervals(
 
     A point on the polygon boundary counts as inside. Membership is scanned on a grid of
     spacing ``max(0.01 m, length / 200000)``; the steps between two points outside that
-    come within one step of the polygon are scanned again, :data:`ZONE_RESCAN` times finer
+    come within one step of the polygon are scanned again, `ZONE_RESCAN` times finer
     (a zone corner or a narrow zone crossed between two points); every change is then
     located by bisection to ``tol`` metres (an excursion shorter than the finer spacing may
     still be missed). A path starting
@@ -435,7 +435,7 @@ def zone_intervals(
     return out
 
 
-#: :func:`zone_intervals` per path (weakly: the entries go with the path), then per zones
+#: `zone_intervals` per path (weakly: the entries go with the path), then per zones
 #: and ``tol``: paths and zones are immutable, and every plan with zones checks its law
 #: against their entries and exits (``bound_breakpoints``), which cost 3 ms a plan on
 #: ``paths/slow_zone.json``, a third of a plan without jerk limit.
@@ -449,7 +449,7 @@ _ZONE_CACHE_SIZE = 8
 
 def _zone_intervals(path: Path, zone_list: list[SpeedZone], tol: float
                     ) -> list[tuple[float, float, float]]:
-    """:func:`zone_intervals`, computed."""
+    """`zone_intervals`, computed."""
     L = path.length
     s = np.linspace(0.0, L, int(np.clip(np.ceil(L / 0.01), 2000, 200_000)) + 1)
     xy = path.point(s)
@@ -504,7 +504,7 @@ def _rescanned(path: Path, zone: SpeedZone, s: FloatArray, xy: FloatArray,
     """Brackets ``(a, b, entering)`` of crossings between two scan points outside ``zone``.
 
     Only steps with both ends outside and an end within one step of the polygon (a bounding
-    box test first, then the distance) are scanned again, :data:`ZONE_RESCAN` points each.
+    box test first, then the distance) are scanned again, `ZONE_RESCAN` points each.
     """
     step = float(s[1] - s[0])
     x0, y0, x1, y1 = zone.polygon.bounds
@@ -529,11 +529,11 @@ def bound_breakpoints(path: Path, bound: Any) -> FloatArray:
     """Arc lengths [m] where the speed bound ``bound`` may have a kink, a step or a dip.
 
     The joins of the path's pieces (where the curvature may jump or change its law: the
-    extremes of a clothoid chain's curvature lie there) and, for a :class:`SpeedBound`, the
+    extremes of a clothoid chain's curvature lie there) and, for a `SpeedBound`, the
     knots of its ``v_limit`` (piecewise linear: its minimum over any stretch is at a knot or
     an end), the ends of its spans and the entries and exits of its zones
-    (:func:`zone_intervals`, located to 1e-9 m on the inside). In the bound's own arc length
-    (the path's minus :attr:`SpeedBound.offset`), sorted, within the path.
+    (`zone_intervals`, located to 1e-9 m on the inside). In the bound's own arc length
+    (the path's minus `SpeedBound.offset`), sorted, within the path.
 
     Examples
     --------
@@ -560,7 +560,7 @@ def bound_breakpoints(path: Path, bound: Any) -> FloatArray:
 
 
 def check_zones(zones: Any) -> list[SpeedZone]:
-    """``zones`` as a list of :class:`SpeedZone`; raise naming the entry that is not one.
+    """``zones`` as a list of `SpeedZone`; raise naming the entry that is not one.
 
     A single zone counts as a list of one.
 

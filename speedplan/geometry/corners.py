@@ -8,7 +8,7 @@ of each corner, so lateral acceleration never steps and lateral jerk stays bound
 
 Shape and size of a corner turning by ``α``:
 
-* ``transition`` (``f``, default :data:`DEFAULT_TRANSITION`) is the share of ``α`` turned in
+* ``transition`` (``f``, default `DEFAULT_TRANSITION`) is the share of ``α`` turned in
   the two clothoids (each turns ``f α / 2``), the rest in the arc; ``f = 1`` is a symmetric
   clothoid pair without arc. It fixes the corner's *shape*; every length of the corner is then
   proportional to ``R`` (scale-free: the same corner in millimetres or kilometres).
@@ -22,7 +22,7 @@ Shape and size of a corner turning by ``α``:
   the corner that wants it). The end legs belong to their only corner; the path starts and
   ends exactly at the first and last waypoints, along the legs, with curvature 0.
 
-A waypoint where the next leg turns back by more than :data:`CUSP_ANGLE` is a *cusp*: the
+A waypoint where the next leg turns back by more than `CUSP_ANGLE` is a *cusp*: the
 vehicle stops and drives the next part in reverse. For a turn ``α`` the vehicle's heading must
 change by ``δ = α ∓ π`` (``|δ| < π - CUSP_ANGLE``): it drives on past the waypoint along a
 corner turning by ``δ/2`` onto the bisector of the extended legs, stops at the cusp point
@@ -209,11 +209,11 @@ def g2_corners(
         Checked waypoints [m].
     max_deviation : float, optional
         Largest distance from a waypoint to the path [m], > 0 (``inf``: as round as the legs
-        allow); default :data:`DEFAULT_DEVIATION`. At a cusp, the largest distance the vehicle
+        allow); default `DEFAULT_DEVIATION`. At a cusp, the largest distance the vehicle
         drives beyond the waypoint.
     transition : float, optional
         Share of each corner's turn in its two clothoids, in ``(0, 1]``; default
-        :data:`DEFAULT_TRANSITION`.
+        `DEFAULT_TRANSITION`.
 
     Returns
     -------
@@ -235,7 +235,7 @@ def g2_corners(
 def g2_chain(
     pts: FloatArray, deviations: FloatArray, transition: float | None = None,
 ) -> tuple[tuple[ClothoidPiece, ...], FloatArray]:
-    """:func:`g2_corners` with one deviation per waypoint, and where each waypoint lies.
+    """`g2_corners` with one deviation per waypoint, and where each waypoint lies.
 
     Parameters
     ----------
@@ -245,12 +245,12 @@ def g2_chain(
         Largest distance from each inner waypoint to the path [m] (> 0; the ends' values are
         not used). A route's nodes each have their own (VDA 5050 ``allowedDeviationXY``).
     transition : float, optional
-        As in :func:`g2_corners`.
+        As in `g2_corners`.
 
     Returns
     -------
     pieces : tuple of ClothoidPiece
-        As :func:`g2_corners`.
+        As `g2_corners`.
     waypoint_s : ndarray, shape (n,)
         Arc length [m] of the path's point nearest to each waypoint: the midpoint of its
         corner (0 and the length at the ends; at a cusp, the cusp point).

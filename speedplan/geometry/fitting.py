@@ -1,8 +1,8 @@
 """Paths through waypoints: G2 corners (default), G1 clothoid chain, spline, rounded polyline.
 
-``"g2"`` lives in :mod:`~speedplan.geometry.corners`; this module dispatches on ``kind``,
+``"g2"`` lives in `corners`; this module dispatches on ``kind``,
 validates the options of each kind and refuses reversals (turns back by more than
-:data:`~speedplan.geometry.corners.CUSP_ANGLE`) in the kinds that cannot drive in reverse.
+`CUSP_ANGLE`) in the kinds that cannot drive in reverse.
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ __all__ = ["CORNER_FRACTION", "DEFAULT_KIND", "KINDS", "SplineCurve", "clothoid_
            "spline_piece"]
 
 KINDS = ("g2", "clothoid", "spline", "polyline")
-#: The kind of :meth:`Path.from_waypoints`, :meth:`Path.from_linestring`, CSV waypoints
-#: without headings and :func:`speedplan.profile_from_waypoints`.
+#: The kind of `Path.from_waypoints`, `Path.from_linestring`, CSV waypoints
+#: without headings and [`speedplan.profile_from_waypoints`][speedplan.profile_from_waypoints].
 DEFAULT_KIND = "g2"
 #: The kinds each option applies to.
 _OPTIONS = {"headings": ("clothoid",), "corner_radius": ("polyline",),
@@ -180,8 +180,8 @@ def clothoid_chain(pts: FloatArray, headings: Any = None) -> tuple[ClothoidPiece
     """One clothoid per leg through ``pts``, G1 at every waypoint.
 
     The headings at the waypoints are ``headings`` or, by default,
-    :func:`estimate_headings` (leg bisectors). Each leg solves the G1 Hermite problem
-    (:func:`fit_clothoid`); each leg starts with the previous leg's end heading, so the
+    `estimate_headings` (leg bisectors). Each leg solves the G1 Hermite problem
+    (`fit_clothoid`); each leg starts with the previous leg's end heading, so the
     heading is continuous (not only modulo 2π).
 
     Examples
@@ -208,7 +208,7 @@ def clothoid_chain(pts: FloatArray, headings: Any = None) -> tuple[ClothoidPiece
 
 @dataclass(frozen=True, eq=False)
 class SplineCurve:
-    """A :class:`scipy.interpolate.CubicSpline` as a picklable parametric curve.
+    """A `scipy.interpolate.CubicSpline` as a picklable parametric curve.
 
     Examples
     --------
@@ -269,7 +269,7 @@ def rounded_polyline(
     Raises
     ------
     InvalidInputError
-        The polyline turns back by more than 150° (a reversal, see :func:`refuse_reversal`),
+        The polyline turns back by more than 150° (a reversal, see `refuse_reversal`),
         or a rounding parameter is not > 0.
 
     Examples
@@ -356,7 +356,7 @@ def fit_waypoints(
     transition: float | None = None,
     name: str = "xy",
 ) -> tuple[Piece, ...]:
-    """Pieces of a path through the waypoints ``xy``; see :meth:`Path.from_waypoints`.
+    """Pieces of a path through the waypoints ``xy``; see `Path.from_waypoints`.
 
     ``name`` is the argument name used in error messages.
 

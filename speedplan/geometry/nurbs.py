@@ -27,7 +27,7 @@ class NurbsCurve:
     """A rational B-spline ``r(τ) = P(τ) / W(τ)`` as a picklable parametric curve.
 
     ``P`` and ``W`` are the B-splines of the homogeneous control points ``(w x, w y)`` and of
-    the weights ``w`` (one :class:`scipy.interpolate.BSpline` with three columns); derivatives
+    the weights ``w`` (one `scipy.interpolate.BSpline` with three columns); derivatives
     follow from the quotient rule.
 
     Examples
@@ -107,7 +107,7 @@ class NurbsCurve:
 
 
 def nurbs_piece(degree: Any, knots: Any, control_points: Any, weights: Any = None) -> CurvePiece:
-    """Arc-length parametrised piece of a NURBS curve (see :meth:`Path.from_nurbs`).
+    """Arc-length parametrised piece of a NURBS curve (see `Path.from_nurbs`).
 
     Knot checks (VDA 5050 3.0 requires clamped trajectories whose inner knots repeat at most
     ``degree`` times):

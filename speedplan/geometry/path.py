@@ -48,7 +48,7 @@ class PathSamples:
     curvature : ndarray, shape (n,)
         Signed curvatures [1/m] (positive: turning left in the direction of travel).
     direction : ndarray of int, shape (n,)
-        Direction of travel, ``+1`` forward or ``-1`` reverse (see :meth:`Path.direction`).
+        Direction of travel, ``+1`` forward or ``-1`` reverse (see `Path.direction`).
 
     Examples
     --------
@@ -69,20 +69,20 @@ class PathSamples:
 class Path:
     """Planar path parametrised by arc length ``s ∈ [0, length]``.
 
-    Build it with :meth:`from_segments`, :meth:`from_waypoints`, :meth:`from_nurbs` or
-    :meth:`from_linestring`; it is immutable. Positions in metres, headings in radians
+    Build it with [`from_segments`][speedplan.Path.from_segments], `from_waypoints`, `from_nurbs` or
+    `from_linestring`; it is immutable. Positions in metres, headings in radians
     (counter-clockwise from +x, continuous along the path), curvature in 1/m (positive turning
     left). Every query is vectorised over ``s``.
 
     A path may be driven partly in reverse: each piece has a direction of travel (``+1``
-    forward, ``-1`` reverse; :meth:`direction`), and the positions where it flips are
-    :attr:`cusps`, where the vehicle stops. ``heading`` is the vehicle's heading (yaw): the
+    forward, ``-1`` reverse; `direction`), and the positions where it flips are
+    `cusps`, where the vehicle stops. ``heading`` is the vehicle's heading (yaw): the
     direction of travel on forward pieces, that plus π on reverse ones, continuous through
     cusps (the travel tangent flips by π there); ``curvature`` is that of the curve traversed
     in the direction of travel.
 
     Query positions within ``1e-9 * length`` outside ``[0, length]`` (rounding) are clipped to
-    the ends; further outside they raise :class:`~speedplan.errors.InvalidInputError`.
+    the ends; further outside they raise `InvalidInputError`.
 
     Parameters
     ----------
@@ -181,12 +181,12 @@ class Path:
         """Rows ``k0, k1 - k0, length, theta0`` of the pieces, if all are clothoid pieces.
 
         ``None`` unless every piece is a plain
-        :class:`~speedplan.geometry.primitives.ClothoidPiece` (lines, arcs, clothoids: every
+        `ClothoidPiece` (lines, arcs, clothoids: every
         path but NURBS, splines and cut pieces). Curvature and heading are then one
         vectorised pass over all points, with each piece's own formula and operation order
         (bitwise the per-piece result): grouping 10 000 points by piece and calling 70 pieces
-        cost ~1 ms a query, and a plan makes many. Positions likewise (:meth:`_cells`,
-        :meth:`_clothoid_points`), equal to the per-piece result to rounding.
+        cost ~1 ms a query, and a plan makes many. Positions likewise ([`_cells`][speedplan.Path],
+        [`_clothoid_points`][speedplan.Path]), equal to the per-piece result to rounding.
         """
         if not all(type(p) is ClothoidPiece for p in self.pieces):
             return None
@@ -195,7 +195,7 @@ class Path:
 
     @cached_property
     def _cells(self) -> tuple[FloatArray, IntArray, IntArray, tuple[FloatArray, ...]] | None:
-        """The quadrature cells of all pieces, for :meth:`_clothoid_points`.
+        """The quadrature cells of all pieces, for [`_clothoid_points`][speedplan.Path].
 
         ``(starts, first, last, rows)``: the cells' start on the path [m] (sorted), the index
         of each piece's first and last cell, and per cell the rows ``u, x, y, d cos θ,
@@ -226,10 +226,10 @@ class Path:
         return self.offsets[owner] + knots, first, last, rows
 
     def _clothoid_points(self, q: FloatArray, idx: IntArray) -> FloatArray | None:
-        """:meth:`ClothoidPiece.point` of each point's piece, in one pass over all points.
+        """`ClothoidPiece.point` of each point's piece, in one pass over all points.
 
         Each point starts from the tabulated start of its quadrature cell and adds
-        :func:`~speedplan.geometry.primitives.turn_integral` of the step: the same position
+        `turn_integral` of the step: the same position
         to rounding as the piece's Gauss–Legendre rule without its 32 cosines and sines a
         point, and no grouping by piece (10 000 points: 3.1 -> 1.2 ms on the serpentine).
         Lines are exact (``start + u · direction``), as in the piece. ``None`` when some
@@ -263,7 +263,7 @@ class Path:
         return out.reshape(*q.shape, 2)
 
     def _clothoid_values(self, q: FloatArray, idx: IntArray, attr: str) -> FloatArray:
-        """:meth:`ClothoidPiece.curvature` or ``heading`` of each point's piece (see above)."""
+        """`ClothoidPiece.curvature` or ``heading`` of each point's piece (see above)."""
         table = self._clothoids
         assert table is not None
         u = q - self.offsets[idx]
@@ -287,7 +287,7 @@ class Path:
         return self._by_piece(q, idx, attr)
 
     def _by_piece(self, q: FloatArray, idx: IntArray, attr: str) -> FloatArray:
-        """``attr`` of each piece at the points located on it (``q``, ``idx``: :meth:`_locate`)."""
+        """``attr`` of each piece at the points located on it (``q``, ``idx``: `_locate`)."""
         flat, fidx = q.ravel(), idx.ravel()
         trailing = (2,) if attr == "point" else ()
         out = np.empty(flat.shape + trailing)
@@ -344,7 +344,7 @@ class Path:
         """``dκ/ds`` [1/m²] at arc lengths ``s`` [m], within each piece.
 
         At a join the value is that of the piece after it; where the curvature jumps there
-        (:meth:`curvature_jumps`) it is not defined, and a vehicle must stop to pass with a
+        (`curvature_jumps`) it is not defined, and a vehicle must stop to pass with a
         lateral-jerk limit.
 
         Examples
@@ -361,7 +361,7 @@ class Path:
 
         A jump is a change larger than ``tol × (1/length + |κ|)`` from the end of one piece
         to the start of the next (a G1 path: a line onto an arc, a clothoid chain's joins);
-        cusps are not listed. G2 paths (the default of :meth:`from_waypoints`) have none.
+        cusps are not listed. G2 paths (the default of `from_waypoints`) have none.
 
         Examples
         --------
@@ -439,7 +439,7 @@ class Path:
     def sub(self, lo: float, hi: float | None = None) -> Path:
         """The stretch ``[lo, hi]`` [m] of the path (to the end by default), ``s`` from 0.
 
-        Pieces cut by ``lo`` or ``hi`` become :class:`~speedplan.geometry.pieces.SubPiece`
+        Pieces cut by ``lo`` or ``hi`` become `SubPiece`
         views of the originals: positions, headings and curvature are the path's, exactly.
 
         Examples
@@ -596,7 +596,7 @@ class Path:
         Parameters
         ----------
         segments : sequence
-            :class:`Line`, :class:`Arc`, :class:`Clothoid`, or dicts ``{"type": "line" |
+            [`Line`][speedplan.geometry.Line], `Arc`, `Clothoid`, or dicts ``{"type": "line" |
             "arc" | "clothoid", ...}`` with the same fields (and optionally ``"reverse":
             true``). Arcs take a positive radius and a signed angle (positive turns left).
             A segment with ``reverse=True`` is driven in reverse; one that follows a segment
@@ -663,12 +663,12 @@ class Path:
             cut each interior waypoint by at most ``max_deviation``, curvature continuous
             (G2), exactly through the first and last waypoints; a waypoint where the path
             turns back by more than 150° is a cusp, driven in reverse after it (see
-            :mod:`~speedplan.geometry.corners`).
+            `corners`).
             ``"clothoid"``: one clothoid per leg, through every waypoint, tangent continuous
-            (G1); see :func:`~speedplan.geometry.fitting.clothoid_chain`.
+            (G1); see `clothoid_chain`.
             ``"spline"``: chord-length cubic spline reparametrised by true arc length (C²).
             ``"polyline"``: straight legs with corners rounded by tangent circular arcs (G1);
-            see :func:`~speedplan.geometry.fitting.rounded_polyline` for the default rounding.
+            see `rounded_polyline` for the default rounding.
             Only ``"g2"`` drives reversals; the other kinds refuse them.
         headings : array_like, shape (n,), optional
             ``"clothoid"`` only: headings at the waypoints [rad] (default: the bisectors of
@@ -748,7 +748,7 @@ class Path:
                         transition: float | None = None) -> Path:
         """Path through the vertices of a shapely ``LineString`` (z ignored).
 
-        ``kind`` and the keyword options are those of :meth:`from_waypoints`, with the same
+        ``kind`` and the keyword options are those of `from_waypoints`, with the same
         default ``"g2"``: the straight legs of the LineString, its corners cut by at most
         ``max_deviation``.
 

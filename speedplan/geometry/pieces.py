@@ -1,14 +1,14 @@
 """Path pieces, each parametrised by its own arc length ``u ∈ [0, length]``.
 
-One mechanism serves every constructor: a :class:`~speedplan.geometry.path.Path` is a chain of
+One mechanism serves every constructor: a [`Path`][speedplan.Path] is a chain of
 pieces with ``length`` and vectorised ``point(u)``, ``heading(u)``, ``curvature(u)``.
 
-* :class:`~speedplan.geometry.primitives.ClothoidPiece` — curvature linear in ``u``: clothoid,
+* `ClothoidPiece` — curvature linear in ``u``: clothoid,
   arc (constant curvature) or line (zero curvature), evaluated to rounding.
-* :class:`CurvePiece` — a parametric curve ``r(τ)`` with derivatives (cubic spline, NURBS),
+* `CurvePiece` — a parametric curve ``r(τ)`` with derivatives (cubic spline, NURBS),
   reparametrised by arc length: a Gauss–Legendre table of ``∫|r'|``, and per cell a Chebyshev
   interpolant of its inverse ``τ(u)`` accurate to rounding (Newton's method where it is not).
-* :class:`ReversedPiece` — any piece travelled backwards.
+* `ReversedPiece` — any piece travelled backwards.
 
 Every piece has a ``direction`` of travel: ``+1`` forward, ``-1`` driven in reverse. ``point``
 and ``curvature`` describe the curve traversed in the direction of travel; ``heading`` is the
@@ -32,7 +32,7 @@ from ._checks import as_direction
 __all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "CurvePiece", "ParametricCurve", "Piece",
            "ReversedPiece", "SubPiece"]
 
-#: Sub-intervals per polynomial piece in the arc-length table of a :class:`CurvePiece`.
+#: Sub-intervals per polynomial piece in the arc-length table of a `CurvePiece`.
 _TABLE_SPLIT = 8
 #: At most this many rounds of halving the table cells where the arc length is not resolved.
 _TABLE_HALVINGS = 40
@@ -44,7 +44,7 @@ _INVERSION_STEPS = 60
 #: rounding (a cell takes the 16-point rule).
 _SHORT_NODES, _SHORT_WEIGHTS = SHORT_NODES, SHORT_WEIGHTS
 _SHORT_STEP = 1e-3
-#: Degree of the Chebyshev interpolant of ``τ(u)`` on each cell of a :class:`CurvePiece`.
+#: Degree of the Chebyshev interpolant of ``τ(u)`` on each cell of a `CurvePiece`.
 _CHEB_DEGREE = 16
 #: At most this many halvings (in ``u``) of a cell whose interpolant is not accurate to
 #: rounding; cells still off after them are inverted by Newton's method at every query.
@@ -106,7 +106,7 @@ def _clenshaw(coef: FloatArray, x: FloatArray) -> FloatArray:
 
 
 def _clenshaw_t(rows: FloatArray, x: FloatArray) -> FloatArray:
-    """:func:`_clenshaw` of ``rows = coef.T`` (contiguous per degree: 3x faster sums)."""
+    """`_clenshaw` of ``rows = coef.T`` (contiguous per degree: 3x faster sums)."""
     b1 = np.zeros_like(x)
     b2 = np.zeros_like(x)
     two_x = 2.0 * x
@@ -186,12 +186,12 @@ class CurvePiece(Piece):
 
     The arc length ``σ(τ) = ∫|r'|`` is tabulated with a 16-point Gauss–Legendre rule on 8
     cells per polynomial piece, each halved until the rule resolves it (see
-    :meth:`_arc_table`); ``τ(u)`` solves ``σ(τ) = u`` by Newton's method kept inside the
+    `_arc_table`); ``τ(u)`` solves ``σ(τ) = u`` by Newton's method kept inside the
     bracketing table cell, so ``point(u)`` moves at unit speed. Queries use a degree-16
     Chebyshev interpolant of ``τ(u)`` per cell instead, built at construction and checked
     against the 16-point rule between its nodes (cells halved until it agrees to a few ulps,
-    see :meth:`_interpolate`): one Clenshaw sum and one curve evaluation per query. The
-    curvature has its own interpolants on the same cells (:meth:`_interpolate_curvature`):
+    see `_interpolate`): one Clenshaw sum and one curve evaluation per query. The
+    curvature has its own interpolants on the same cells (`_interpolate_curvature`):
     a curvature query is one Clenshaw sum.
     """
 
@@ -253,7 +253,7 @@ class CurvePiece(Piece):
 
         Each interpolant is checked halfway between its nodes, where an interpolant's error
         peaks, and accepted within ``_CHEB_TOLERANCE`` of the length (see
-        :meth:`_fit_cells`); a cell still off after ``_CHEB_HALVINGS`` halvings keeps
+        `_fit_cells`); a cell still off after ``_CHEB_HALVINGS`` halvings keeps
         Newton's method. A query is then one Clenshaw sum instead of Newton steps of 16-point
         integrals of ``|r'|``.
         """
@@ -536,7 +536,7 @@ class CurvePiece(Piece):
         return _signed_curvature(d1, d2)
 
     def curvature_rate(self, u: FloatArray) -> FloatArray:
-        """The central difference of :meth:`Piece.curvature_rate`, both sides in one query."""
+        """The central difference of `Piece.curvature_rate`, both sides in one query."""
         u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
         step = 1e-5 * self.length
         lo, hi = np.maximum(u - step, 0.0), np.minimum(u + step, self.length)

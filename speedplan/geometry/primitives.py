@@ -6,14 +6,14 @@ vehicle's heading ``θ`` is then opposite to its direction of travel, which is
 of travel, and the heading changes at the rate of the curvature in both directions.
 
 A clothoid has curvature linear in arc length, so its heading is quadratic and its position
-is ``∫ (cos θ, sin θ)``, a (generalised) Fresnel integral. :class:`ClothoidPiece` evaluates it
+is ``∫ (cos θ, sin θ)``, a (generalised) Fresnel integral. `ClothoidPiece` evaluates it
 by Gauss–Legendre quadrature on cells over which the heading turns by at most 0.25 rad: 16
 nodes integrate ``cos``/``sin`` of a quadratic over such a cell to rounding, for any
 curvature and sharpness (no separate ``k1 ≈ k0`` branch is needed, unlike the Fresnel-function
 formula). Arcs and lines are the constant-curvature cases of the same piece. A
-:class:`~speedplan.geometry.path.Path` made only of such pieces evaluates all its positions in
+[`Path`][speedplan.Path] made only of such pieces evaluates all its positions in
 one pass instead: from the same tabulated cell starts, the step by the power series of
-:func:`turn_integral` (equal to the quadrature to rounding, no cosine per node).
+`turn_integral` (equal to the quadrature to rounding, no cosine per node).
 """
 
 from __future__ import annotations
@@ -155,7 +155,7 @@ _FIELDS: dict[str, tuple[type[Line | Arc | Clothoid], tuple[str, ...]]] = {
 
 
 def as_segment(seg: Any, name: str) -> Segment:
-    """A :class:`Line`, :class:`Arc` or :class:`Clothoid` from itself or from a dict.
+    """A [`Line`][speedplan.geometry.Line], `Arc` or `Clothoid` from itself or from a dict.
 
     Dicts carry ``"type"`` (``"line"``, ``"arc"`` or ``"clothoid"``), the fields of that
     class and optionally ``"reverse"`` (``true`` for a piece driven in reverse). Errors name
@@ -195,8 +195,8 @@ class ClothoidPiece(Piece):
     ``direction = -1`` drives it in reverse: the travel tangent is ``direction · (cos θ,
     sin θ)``. Positions are tabulated at cell boundaries (heading turn <= 0.25 rad per cell);
     a query adds a 16-point Gauss–Legendre integral from its cell's start, accurate to
-    rounding (a :class:`~speedplan.geometry.path.Path` of such pieces adds
-    :func:`turn_integral` from the same cell starts instead, in one pass over all pieces).
+    rounding (a [`Path`][speedplan.Path] of such pieces adds
+    `turn_integral` from the same cell starts instead, in one pass over all pieces).
     """
 
     start: tuple[float, float]
@@ -261,7 +261,7 @@ class ClothoidPiece(Piece):
         """The same clothoid from its end, curvature from ``-k1`` to ``-k0``.
 
         Heading + π and the same direction flag by default; with ``swap_direction`` the
-        heading is kept and the direction flag flipped (see :meth:`Piece.reversed`).
+        heading is kept and the direction flag flipped (see `Piece.reversed`).
         """
         end, theta = self.end
         turn = 0.0 if swap_direction else np.pi
@@ -280,7 +280,7 @@ def _tabulate(theta0: FloatArray, length: FloatArray, k0: FloatArray, k1: FloatA
     """Knots and knot positions relative to the start (first row 0) of clothoid pieces [m].
 
     One vectorised pass for all pieces with the same number of cells (what keeps building a
-    path of 70 pieces cheap); per piece the arithmetic of :meth:`ClothoidPiece._integrate`,
+    path of 70 pieces cheap); per piece the arithmetic of `ClothoidPiece._integrate`,
     knots as ``np.linspace(0, length, m + 1)`` and a running sum of the cell steps.
     """
     counts = _cells(np.maximum(np.abs(k0), np.abs(k1)) * length)
@@ -305,13 +305,13 @@ def _tabulate(theta0: FloatArray, length: FloatArray, k0: FloatArray, k1: FloatA
     return out
 
 
-#: A piece's description for :func:`clothoid_chain`: start point (``None``: where the
+#: A piece's description for `clothoid_chain`: start point (``None``: where the
 #: previous piece ends), vehicle heading [rad], length [m], curvatures k0, k1 [1/m], direction.
 PieceSpec = tuple[tuple[float, float] | None, float, float, float, float, int]
 
 
 def end_heading(theta0: float, length: float, k0: float, k1: float) -> float:
-    """Heading at the end of a clothoid piece [rad], as :attr:`ClothoidPiece.end` gives it."""
+    """Heading at the end of a clothoid piece [rad], as `ClothoidPiece.end` gives it."""
     return theta0 + length * (k0 + 0.5 * ((k1 - k0) / length) * length)
 
 
@@ -389,7 +389,7 @@ def turn_integral(a: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray]
 
 
 def segment_spec(seg: Segment, start: tuple[float, float] | None, theta0: float) -> PieceSpec:
-    """The :data:`PieceSpec` of ``seg`` from ``start`` with vehicle heading ``theta0`` [rad]."""
+    """The `PieceSpec` of ``seg`` from ``start`` with vehicle heading ``theta0`` [rad]."""
     d = -1 if seg.reverse else 1
     if isinstance(seg, Line):
         return (start, theta0, seg.length, 0.0, 0.0, d)

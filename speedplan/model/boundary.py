@@ -6,22 +6,22 @@ system.
 
 * **Envelopes.** The slowest motion leaving ``(v0, a0)`` applies ``-j`` down to ``-a_decel``;
   no jerk-limited motion is slower at any ``s`` (one that gets to ``s`` earlier has had less
-  time to lower its acceleration), so it bounds ``w = v²`` from below — :func:`jerk_motion_w`.
+  time to lower its acceleration), so it bounds ``w = v²`` from below — `jerk_motion_w`.
   The largest ``w`` at a distance is *not* the fastest motion in time (``+j`` up to ``a_max``):
   a motion that is slower gets to ``s`` later and may have built up more acceleration by
   then. By Pontryagin's principle the motion that maximises ``v`` at a given distance applies
   ``-j`` then ``+j`` (one switch), and the speed bound ``v >= 0`` makes the extreme either no
   ``-j`` at all or the stop-and-go motion: brake to rest in the shortest distance, then
-  ``+j`` from rest. :func:`fastest_w` is the larger of the two; from rest it is
-  ``(j²/4)(6 s/j)^{4/3}`` up to ``a_max`` (:func:`max_jerk_envelope`). The same at the end,
+  ``+j`` from rest. `fastest_w` is the larger of the two; from rest it is
+  ``(j²/4)(6 s/j)^{4/3}`` up to ``a_max`` (`max_jerk_envelope`). The same at the end,
   time reversed (``a -> -a``).
 * **Reachability.** From ``(v0, a0)`` the speed passes through ``v0 + a0 |a0| / (2 j)`` at
   least (it keeps rising while the acceleration is brought to 0): above ``v_max`` the state
   cannot be met, below 0 it cannot either, and at exactly 0 the vehicle comes to rest on the
-  way (:func:`turnaround_speed`). A stop needs at least the distance of the time-optimal
-  braking profile (:func:`stop_distance`), a move between two states at least
-  :func:`min_distance`. :func:`check_reachable_states` raises
-  :class:`~speedplan.InfeasibleError` naming the state and the limit.
+  way (`turnaround_speed`). A stop needs at least the distance of the time-optimal
+  braking profile (`stop_distance`), a move between two states at least
+  `min_distance`. `check_reachable_states` raises
+  [`InfeasibleError`][speedplan.InfeasibleError] naming the state and the limit.
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ __all__ = [
 #: Relative slack of the reachability tests (rounding of the closed forms).
 _SLACK = 1e-9
 #: Moving boundary states just outside what ``j_max`` reaches are planned with
-#: ``j_max (1 + STATE_JERK_SLACK)`` (:func:`speedplan.strategy.model_request`, with a
+#: ``j_max (1 + STATE_JERK_SLACK)`` (`speedplan.strategy.model_request`, with a
 #: warning).
 STATE_JERK_SLACK = 0.02
 #: A moving boundary state that ``j_max (1 + STATE_JERK_ROUNDING)`` reaches is planned with
@@ -77,7 +77,7 @@ def max_jerk_envelope(d: FloatArray, j_max: float) -> FloatArray:
     """Largest ``w = v²`` at distance ``d >= 0`` from rest (zero speed and acceleration).
 
     The closed form ``(j²/4) (6 d / j)^{4/3}`` of the maximum-jerk start; moving states use
-    :func:`jerk_motion_w`.
+    `jerk_motion_w`.
 
     Examples
     --------
@@ -151,7 +151,7 @@ def jerk_motion_w(d: FloatArray, v: float, a: float, jerk: float, a_limit: float
 
     The motion leaves ``(v, a)`` with constant ``jerk`` until the acceleration reaches
     ``a_limit``, then keeps that acceleration; ``w`` is 0 once the motion has stopped.
-    Closed form: the jerk phase is a cubic in time (:func:`_cubic_time`), the constant
+    Closed form: the jerk phase is a cubic in time (`_cubic_time`), the constant
     acceleration phase is linear in ``w``.
 
     With ``jerk = +j_max`` and ``a_limit = a_max`` it is the fastest motion leaving ``(v, a)``;
@@ -190,8 +190,8 @@ def fastest_w(d: FloatArray, v: float, a: float, j_max: float, a_limit: float,
     """Largest ``w = v²`` a jerk-limited motion leaving ``(v, a)`` can have at distance ``d``.
 
     The upper envelope in distance: the larger of the maximum-jerk motion
-    (:func:`jerk_motion_w` with ``+j_max`` up to ``a_limit``) and the stop-and-go motion,
-    which brakes to rest in the shortest distance (:func:`stop_distance`, deceleration up to
+    (`jerk_motion_w` with ``+j_max`` up to ``a_limit``) and the stop-and-go motion,
+    which brakes to rest in the shortest distance (`stop_distance`, deceleration up to
     ``a_brake``) and then starts again with ``+j_max``. The second is larger far enough
     away: having come to rest it covers the distance later, with more acceleration built up.
     See the module docstring for why no other motion is faster at ``d``.
@@ -356,7 +356,7 @@ def min_distance(v0: float, a0: float, vf: float, af: float, j_max: float, a_max
 
 def check_reachable_states(v0: float, a0: float, vf: float, af: float, length: float,
                            v_max: float, a_max: float, a_decel: float, j_max: float) -> None:
-    """Raise :class:`~speedplan.InfeasibleError` if no jerk-limited motion joins the states.
+    """Raise `InfeasibleError` if no jerk-limited motion joins the states.
 
     The 1-D conditions, in closed form: the speed an accelerating start reaches before its
     acceleration can be brought to 0 (and the speed a decelerating end comes from) must not

@@ -1,12 +1,12 @@
 """From a physical request to discrete problems: legs, bounds, envelopes, grid, jerk rows.
 
-:func:`build_model` is the one place where limits in SI units become the rows of a
-:class:`~speedplan.solve.DiscreteProblem`. A request is split into *legs* at every point
+`build_model` is the one place where limits in SI units become the rows of a
+[`DiscreteProblem`][speedplan.DiscreteProblem]. A request is split into *legs* at every point
 where the vehicle must be at rest: where a boundary state forces a stop on the way (a
 decelerating start whose speed falls exactly to zero: the motion to that point is forced, a
-:class:`ForcedLeg`), and — with the route and cusp support — at cusps and stops. Each
-:class:`Leg` is planned on its own (:mod:`speedplan.strategy` solves it);
-:func:`explain_infeasible` restates a discrete infeasibility of its problem in speeds and
+`ForcedLeg`), and — with the route and cusp support — at cusps and stops. Each
+`Leg` is planned on its own (`speedplan.strategy` solves it);
+`explain_infeasible` restates a discrete infeasibility of its problem in speeds and
 metres. This layer builds data and calls no solver.
 """
 
@@ -53,15 +53,15 @@ __all__ = ["NO_JERK_NODES", "ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
 #: Rounds in which the default no-jerk grid is refined (steps / 4) where the optimum rides a
-#: node bound more than :data:`NO_JERK_BOUND_LOSS` below the bound at the node itself: the
-#: minimum over the adjacent cells (:func:`node_bounds`) costs time there, like ``O(h)``.
+#: node bound more than `NO_JERK_BOUND_LOSS` below the bound at the node itself: the
+#: minimum over the adjacent cells (`node_bounds`) costs time there, like ``O(h)``.
 NO_JERK_REFINEMENTS = 1
 NO_JERK_BOUND_LOSS = 1e-3
 #: A decelerating boundary state whose speed falls to within this fraction of its own speed
 #: (``v - a²/(2 j)``) of zero comes to rest on the way: the gain of passing through at that
 #: speed is below any resolvable time, and the dip could not be gridded.
 TOUCH_ZERO = 1e-6
-#: Newton steps for :func:`lateral_speed_caps` (converged to rounding from its start within
+#: Newton steps for `lateral_speed_caps` (converged to rounding from its start within
 #: about 40 on the sample paths) and the relative margin added to each cap, so that rounding
 #: never cuts a feasible point.
 CAP_NEWTON_STEPS = 60
@@ -69,13 +69,13 @@ CAP_MARGIN = 1e-9
 #: ... or when passing through the dip instead of restarting from rest gains less than this
 #: fraction of the move's least duration (far below the 1e-4 of the optimum plans promise).
 TOUCH_TIME = 1e-6
-#: Nodes of the sampled forced motion of a :class:`ForcedLeg`.
+#: Nodes of the sampled forced motion of a `ForcedLeg`.
 FORCED_NODES = 401
 
 
 @dataclass(frozen=True)
 class TimeLawSpec:
-    """How the time law interpolates the solved ``w`` (see :class:`speedplan.timing.TimeLaw`).
+    """How the time law interpolates the solved ``w`` (see `speedplan.timing.TimeLaw`).
 
     Attributes
     ----------
@@ -86,7 +86,7 @@ class TimeLawSpec:
         Prescribed accelerations at moving ends [m/s²]; ``None`` keeps the discrete slope.
     linear : bool
         ``w`` linear on each cell (no jerk nor lateral-jerk limit): the law stays on the
-        chords, which the node bounds keep under the speed bound (:func:`node_bounds`).
+        chords, which the node bounds keep under the speed bound (`node_bounds`).
     """
 
     j_max: float | None
@@ -166,7 +166,7 @@ class ForcedLeg(_Ends):
     From ``(v0, a0)`` with ``v0 = a0² / (2 j)`` (``a0 < 0``) every jerk-limited motion must
     apply ``+j`` until it is at rest; ``w`` is that motion sampled on ``s`` (or its time
     reversal at the end of a request, arriving at ``(vf, af)`` from rest). ``start``,
-    ``length`` and the boundary states are those of :class:`Leg`.
+    ``length`` and the boundary states are those of `Leg`.
     """
 
     s: FloatArray
@@ -222,9 +222,9 @@ def rest_points(request: PlanRequest) -> tuple[Rest, ...]:
 def build_model(request: PlanRequest) -> Model:
     """Model ``request``: split it into legs and build each leg's discrete problem.
 
-    The path is cut at every :class:`Rest` (:func:`rest_points`); each stretch between two
+    The path is cut at every `Rest` (`rest_points`); each stretch between two
     cuts runs from its start state (the request's at ``s = 0``, rest elsewhere) to its end
-    state, and becomes one :class:`Leg`, preceded (followed) by a :class:`ForcedLeg` where
+    state, and becomes one `Leg`, preceded (followed) by a `ForcedLeg` where
     its start (end) state forces a stop on the way.
 
     Raises
@@ -339,13 +339,13 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
 def coarser_leg(request: PlanRequest, leg: Leg, factor: float) -> Leg | None:
     """``leg`` on its default grid with ``factor`` times its nodes, or ``None``.
 
-    Every step grows in proportion (the node cap of :func:`adaptive_grid`), so the grid
-    stays smoothly graded. :func:`speedplan.plan` plans a leg on such a grid when its
+    Every step grows in proportion (the node cap of `adaptive_grid`), so the grid
+    stays smoothly graded. [`speedplan.plan`][speedplan.plan] plans a leg on such a grid when its
     relaxation backend does not converge on the default grid: on paths with slow zones both
     interior-point methods can stall on a fine default grid (a front of nearly active jerk
     rows next to a zone's edge moves one node per iteration) and converge on a coarser one.
     ``None`` for a user grid (``n`` or ``ds``: the grid is the caller's), without a jerk
-    limit (no solver runs), or where the grid would not get coarser (:data:`MIN_NODES`).
+    limit (no solver runs), or where the grid would not get coarser (`MIN_NODES`).
 
     Examples
     --------
@@ -371,9 +371,9 @@ def coarser_leg(request: PlanRequest, leg: Leg, factor: float) -> Leg | None:
 
 
 def coarsenable(request: PlanRequest, leg: Leg) -> bool:
-    """Whether ``leg`` is on a jerk-limited default grid above :data:`MIN_NODES` nodes.
+    """Whether ``leg`` is on a jerk-limited default grid above `MIN_NODES` nodes.
 
-    The legs :func:`coarser_leg` can rebuild coarser (without building the grid).
+    The legs `coarser_leg` can rebuild coarser (without building the grid).
     """
     return (request.n is None and request.ds is None and request.jerk_limited
             and leg.problem.n > MIN_NODES)
@@ -382,7 +382,7 @@ def coarsenable(request: PlanRequest, leg: Leg) -> bool:
 def _default_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: float,
                   v0: float, a0: float, vf: float, af: float,
                   max_nodes: int = MAX_DEFAULT_NODES) -> FloatArray:
-    """The jerk-limited default grid of the leg ``[lo, hi]`` (:func:`adaptive_grid`)."""
+    """The jerk-limited default grid of the leg ``[lo, hi]`` (`adaptive_grid`)."""
     lim = request.limits
     length = hi - lo
     env = _Envelopes.of(request, v0, a0, vf, af, length)
@@ -401,15 +401,15 @@ def _default_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: fl
 
 def _no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: float,
                   vf: float) -> FloatArray:
-    """:data:`NO_JERK_NODES` uniform nodes, refined where the node bounds cost time.
+    """`NO_JERK_NODES` uniform nodes, refined where the node bounds cost time.
 
     Where the bound falls steeply (a corner's clothoid, a zone's edge) the node bound, the
     minimum over both adjacent cells, lies well below the bound at the node; where the no-jerk
     optimum rides it, those cells and their neighbours are cut in four
-    (:func:`~.refine.subdivided_grid`; the no-jerk law is linear in ``w`` per cell and needs
+    (`subdivided_grid`; the no-jerk law is linear in ``w`` per cell and needs
     no smoothness of the steps). Every other cell is kept to the last bit, so the bound
     already evaluated inside it is looked up, not evaluated again
-    (:meth:`~speedplan.geometry.SpeedBound.memoised`). The O(n) pass makes each round cheap;
+    (`memoised`). The O(n) pass makes each round cheap;
     on the serpentine of ``benchmarks/bench_all.py`` one round takes the duration from 3.9 %
     to 1.0 % above the exact optimum.
     """
@@ -443,7 +443,7 @@ def _cut_out_dips(s: FloatArray, edges: FloatArray) -> FloatArray:
     """``s`` with nodes on the ``edges`` of dips of the bound and steps doubling away from them.
 
     A dip narrower than a step of the no-jerk grid (a hairpin's arc, a narrow zone; its
-    edges from :func:`~speedplan.model.grid.hidden_dips`) was found by the refinements only
+    edges from `hidden_dips`) was found by the refinements only
     where a few quarterings reach it: a 0.55 mm arc on a 1.9 km path was crossed at 18x its
     speed. With nodes on its edges the dip's cells hold its own bound; the node bound of a
     neighbour (the minimum over its cells, the dip's edge included) is the dip's too, so the
@@ -477,7 +477,7 @@ def _transient(request: PlanRequest, v: float, a: float, a_limit: float,
     distance covered while its acceleration is brought to 0, a jerk transition
     ``v min(t_j, √(v / j))`` at the lowest speed it passes (the default grid's scale) and,
     braking, the distance ``v² / (2 |a|)`` to rest at that deceleration. The phases are
-    those under ``v_top``, the leg's top speed (:func:`~speedplan.model.grid.top_speed`).
+    those under ``v_top``, the leg's top speed (`top_speed`).
     """
     j = request.limits.j_max
     if v == 0.0 and a == 0.0:
@@ -625,7 +625,7 @@ def lateral_speed_caps(path: Path, lo: float, s: FloatArray, j_lat_max: float,
                        accel: FloatArray, decel: FloatArray) -> FloatArray:
     """Upper bounds on interior ``w`` that the lateral-jerk and acceleration rows imply.
 
-    The node row ``|κ' w_i + κ w'_i| sqrt(w_i) <= j_lat_max`` (:func:`lateral_jerk_rows`) has
+    The node row ``|κ' w_i + κ w'_i| sqrt(w_i) <= j_lat_max`` (`lateral_jerk_rows`) has
     ``w'_i`` a convex combination of the slopes of the two adjacent cells, each within
     ``[-D, A]`` by the acceleration rows. So ``|κ' w_i + κ w'_i| >= |κ'| w_i - |κ| M_i`` with
     ``M_i`` the larger braking bound ``D`` of the two cells where ``κ' κ > 0`` (braking eases
@@ -659,7 +659,7 @@ def lateral_speed_caps(path: Path, lo: float, s: FloatArray, j_lat_max: float,
 
 def _midpoint_rows(path: Path, lo: float, s: FloatArray, bound: FloatArray
                    ) -> tuple[StencilRows, StencilRows]:
-    """The midpoint rows of :func:`lateral_jerk_rows`, with ``sqrt(w)`` of either end of a cell.
+    """The midpoint rows of `lateral_jerk_rows`, with ``sqrt(w)`` of either end of a cell.
 
     The first family's row at node ``i`` is the cell ``(i, i+1)``'s, the second's the cell
     ``(i-1, i)``'s.
@@ -680,7 +680,7 @@ def _check_moving_ends_resolved(s: FloatArray, lo: float, v0: float, a0: float, 
                                 af: float) -> None:
     """A user grid must let the speed stay positive over the first (last) half cell.
 
-    The grading of user grids (:func:`_transient`, :func:`~.grid.graded_ends`) makes the end
+    The grading of user grids (`_transient`, `graded_ends`) makes the end
     steps shorter than this; what remains refused is a transient below the finest step.
 
     The time law keeps the prescribed acceleration at a moving end; a braking start
@@ -716,7 +716,7 @@ def _zero_cause(bound: SpeedBound) -> str:
 def _end_speeds(request: PlanRequest, bound: SpeedBound, length: float) -> PlanRequest:
     """``request`` with ``v0``, ``vf`` under the speed bound at the ends, or an error.
 
-    A speed above the bound by at most :data:`~speedplan.model.request.STATE_ROUNDING` is
+    A speed above the bound by at most `STATE_ROUNDING` is
     taken at the bound (a state read off a plan: the time law's rounding).
     """
     ends = np.sqrt(bound(np.array([0.0, length])))
@@ -776,7 +776,7 @@ class _Envelopes:
         At rest the cap is the max-jerk start only for a smooth standstill (the paper's free
         standstill lets the acceleration jump there); a moving state is always capped: by
         the max-jerk motion, or with ``in_distance`` by the envelope in distance
-        (:func:`~speedplan.model.boundary.fastest_w`), which is above it where the vehicle
+        (`fastest_w`), which is above it where the vehicle
         could brake to rest and start again (``PlanRequest.reach``).
         """
         lim = self.limits
@@ -817,8 +817,8 @@ def _forced_stop(v: float, a: float, j_max: float, *, end: bool, touch: float,
     """The forced motion to rest when a decelerating start (accelerating end) touches zero.
 
     ``j_max``: the jerk the state may use (``PlanRequest.moving_state_jerk``). It touches
-    zero when the speed falls to within ``touch`` of its own (:data:`TOUCH_ZERO`), or so
-    close to zero that restarting from rest would cost less than :data:`TOUCH_TIME` of
+    zero when the speed falls to within ``touch`` of its own (`TOUCH_ZERO`), or so
+    close to zero that restarting from rest would cost less than `TOUCH_TIME` of
     ``least_duration`` (the stretch's length over ``v_max``): a dip the grid cannot resolve
     (a 1.9 km move from 1.5e-5 m/s braking at 0.019 m/s² dips to 9e-9 m/s).
     """
@@ -867,7 +867,7 @@ def node_bounds(bound: Any, s: FloatArray, per_interval: int = 8) -> FloatArray:
     entry, a curvature peak) at an ``O(h)`` cost where the bound is smooth. Interpolated
     linearly (the law without a jerk limit) ``w`` stays under the larger node value of each
     cell, so under the bound; the jerk-limited law bends away from the chords only by its
-    curvature, ``O(j h²)`` (:mod:`speedplan.timing.law`).
+    curvature, ``O(j h²)`` (`speedplan.timing.law`).
     """
     frac = np.arange(per_interval) / per_interval
     # Every node once (the start of its interval, and the end of the grid), then the points

@@ -9,14 +9,14 @@ Where ``λ(v)`` falls below ``ℓ`` on the stretches next to the ends (the speed
 rest), the steps stay at ``ℓ / per_phase``; a slow stretch farther inside (a slow zone, a
 tight curve) is resolved at its own ``λ(v)``, however short.
 
-Two properties the time law relies on (:mod:`speedplan.timing.law`):
+Two properties the time law relies on (`speedplan.timing.law`):
 
-* **smooth grading**: neighbouring steps differ by at most :data:`GRADING` (1 %) wherever
-  the speed may change, by :data:`CRUISE_GRADING` (10 %) inside long stretches at a constant
+* **smooth grading**: neighbouring steps differ by at most `GRADING` (1 %) wherever
+  the speed may change, by `CRUISE_GRADING` (10 %) inside long stretches at a constant
   speed bound; the law's jerk error is the local step ratio minus one;
 * **cruise is coarse**: far (``> 2 v_max t_j + 2 ℓ``) from any kink of the no-jerk profile
   (where it is linear in ``w``: a cruise, a constant acceleration or braking) the step grows,
-  by 10 % per node, up to :data:`CRUISE_STEP` of the length: a long move costs about 100
+  by 10 % per node, up to `CRUISE_STEP` of the length: a long move costs about 100
   nodes more than a short one, and does not hit the node cap with a coarse transition.
 
 Nodes are placed by inverting the node count ``N(s) = ∫ ds / h(s)`` exactly for a step
@@ -85,10 +85,10 @@ CRUISE_GRADING = 0.1
 #: the 1 000-node uniform grids of three sample paths), so 20 nodes keep it near 2 %, half
 #: the jerk tolerance with the grading's 1 %.
 END_PER_PHASE = 20
-#: Positions at which :func:`adaptive_grid` evaluates the bound for the path's top speed.
+#: Positions at which `adaptive_grid` evaluates the bound for the path's top speed.
 TOP_SPEED_PROBES = 2001
 #: Largest step inside long constant-bound stretches, as a fraction of the length: nothing
-#: changes there, the steps only grow (by :data:`CRUISE_GRADING` per node) from the fine
+#: changes there, the steps only grow (by `CRUISE_GRADING` per node) from the fine
 #: transitions on either side.
 CRUISE_STEP = 0.01
 
@@ -127,11 +127,11 @@ def graded_ends(s: FloatArray, ell_start: float | None,
     """The uniform grid ``s`` with steps of ``ℓ / END_PER_PHASE`` at its ends.
 
     ``ell_start`` (``ell_end``) is the length ``ℓ`` of the first (last) boundary transient
-    (:func:`rest_phase_length` at a rest), ``None`` to keep that end's steps. Where the
+    (`rest_phase_length` at a rest), ``None`` to keep that end's steps. Where the
     uniform step exceeds ``ℓ / END_PER_PHASE`` the steps are that over ``2 ℓ`` from the end
-    and then grow by :data:`GRADING` per node back to the uniform step; the other nodes stay
+    and then grow by `GRADING` per node back to the uniform step; the other nodes stay
     those of ``s``. Without it the first law of a coarse grid exceeds ``j_max`` (or the
-    speed bound) there and :func:`speedplan.plan` refines the grid and solves again — or,
+    speed bound) there and `speedplan.plan` refines the grid and solves again — or,
     where three refinements do not reach the transient, reports ``limits_exceeded``.
 
     Examples
@@ -176,7 +176,7 @@ def _graded(lo: float, hi: float, h: float, zones: list[tuple[int, float, float]
             length: float) -> FloatArray:
     """Nodes on ``[lo, hi]``: steps ``fine`` up to ``reach`` from each graded end, then ``h``.
 
-    In between, the steps grow by :data:`GRADING` per node.
+    In between, the steps grow by `GRADING` per node.
     """
     pre = [np.linspace(lo, hi, 2001)]
     for end, fine, _ in zones:
@@ -219,7 +219,7 @@ def nodes_from_steps(s: FloatArray, h: FloatArray,
     logarithmic count), after scaling ``h`` so that ``N(length)`` is an integer: consecutive
     steps then follow ``h`` smoothly. With ``anchors`` (points of the pre-grid ``s``) the
     scaling is done between consecutive anchors, so that each anchor is a node; an anchor
-    closer than :data:`MIN_ANCHOR_NODES` steps to the previous one is skipped (the change of
+    closer than `MIN_ANCHOR_NODES` steps to the previous one is skipped (the change of
     scale there would break the grading).
 
     Examples
@@ -283,9 +283,9 @@ def top_speed(w_bound: Callable[[FloatArray], FloatArray], length: float, v_max:
     (a zone or span over the whole path, an edge's ``maxSpeed``, a yaw limit on an arc) the
     first jerk phase from rest is far shorter. Sized from ``v_max`` the default grid missed
     it: a 172.9 m move capped at 0.06 m/s (``v_max`` 4.9) took 1.2e-3 longer than the
-    optimum. The bound is read at :data:`TOP_SPEED_PROBES` positions: a narrow fast stretch
+    optimum. The bound is read at `TOP_SPEED_PROBES` positions: a narrow fast stretch
     between them is missed, and the transitions come out shorter (finer steps), the cruise
-    margin of :func:`adaptive_grid` narrower.
+    margin of `adaptive_grid` narrower.
 
     Pass the path's own bound, not one capped by the boundary envelopes: a short move is
     slow because it is short, and its grid sized from that lower speed came out less
@@ -341,14 +341,14 @@ def adaptive_grid(
     max_nodes : int
         Node cap; beyond it every step grows in proportion.
     anchors : ndarray, optional
-        Positions [m] that should be nodes (see :func:`nodes_from_steps`).
+        Positions [m] that should be nodes (see `nodes_from_steps`).
     breakpoints : ndarray, optional
         Positions [m] where the bound may dip, step or kink
-        (:func:`~speedplan.geometry.bound_breakpoints`): those where the bound dips between
-        two points of the first scan (a hairpin on a long path, :func:`hidden_dips`) join
+        (`bound_breakpoints`): those where the bound dips between
+        two points of the first scan (a hairpin on a long path, `hidden_dips`) join
         the scan, so that the dip sets the steps around it.
     v_top : float, optional
-        The fastest speed the path's own bound allows (:func:`top_speed`, without the
+        The fastest speed the path's own bound allows (`top_speed`, without the
         boundary envelopes); the transitions are sized under ``min(v_max, v_top)``.
     """
     a = min(a_max, a_decel)
@@ -435,7 +435,7 @@ def adaptive_grid(
     return grid
 
 
-#: A breakpoint of the bound joins the first scan of :func:`adaptive_grid` where the bound
+#: A breakpoint of the bound joins the first scan of `adaptive_grid` where the bound
 #: there is below this fraction of the bound at both neighbouring scan points: a dip the
 #: scan steps over (a dip of 0.1 % would change the steps by less than that).
 HIDDEN_DIP = 1.0 - 1e-3

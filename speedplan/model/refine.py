@@ -20,9 +20,9 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
 
     ``knots`` are the law's knots (nodes and cell midpoints) and ``excess`` flags each piece
     between them. The steps are multiplied by ``factor`` (in ``(0, 1)``) over the flagged
-    cells padded by :data:`PAD_CELLS` on each side (never below the default grids' finest
-    step, :data:`~speedplan.model.grid.MIN_RELATIVE_STEP` of the length), and graded back to
-    the old steps at the rate :data:`~speedplan.model.grid.GRADING`, so the new grid is as
+    cells padded by `PAD_CELLS` on each side (never below the default grids' finest
+    step, `MIN_RELATIVE_STEP` of the length), and graded back to
+    the old steps at the rate `GRADING`, so the new grid is as
     smooth as the old one; ``anchors`` (nodes of ``s``) stay nodes. A law without jerk rows
     needs no smoothness: ``grading`` may then be coarser.
 
@@ -54,7 +54,7 @@ def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
 
 
 def subdivided_grid(s: FloatArray, cells: np.ndarray, parts: int = 4) -> FloatArray:
-    """The grid ``s`` with the flagged ``cells`` and :data:`PAD_CELLS` on each side split.
+    """The grid ``s`` with the flagged ``cells`` and `PAD_CELLS` on each side split.
 
     Each such cell is cut into ``parts`` equal steps; every other node and cell of ``s`` is
     kept to the last bit, so what was evaluated on them (the speed bound inside the cells)

@@ -1,4 +1,4 @@
-"""A planning request: the arguments of :func:`speedplan.plan`, validated once."""
+"""A planning request: the arguments of [`speedplan.plan`][speedplan.plan], validated once."""
 
 from __future__ import annotations
 
@@ -25,8 +25,8 @@ STANDSTILL_MODES = ("smooth", "free")
 #: ``"max_jerk"``, the fastest motion in time (``+j_max`` at once), tight and keeping the
 #: relaxation exact, but below the speed of some feasible motions where the speed first dips;
 #: ``"distance"``, the exact largest ``w`` at each distance
-#: (:func:`~speedplan.model.boundary.fastest_w`), whose kinks can leave the relaxation
-#: inexact. :func:`speedplan.plan` uses the first and falls back to the second when the first
+#: (`fastest_w`), whose kinks can leave the relaxation
+#: inexact. `speedplan.plan` uses the first and falls back to the second when the first
 #: refuses the boundary states.
 REACH_MODES = ("max_jerk", "distance")
 #: Shortest path planned, relative to ``v_max² / a_max`` (4e-9 m for v_max = 2 m/s, a_max = 1
@@ -43,9 +43,9 @@ STATE_ROUNDING = 1e-6
 
 
 def within_limit(name: str, value: float, limit: float, unit: str, what: str) -> float:
-    """``value``, or ``limit`` if ``value`` exceeds it by at most :data:`STATE_ROUNDING`.
+    """``value``, or ``limit`` if ``value`` exceeds it by at most `STATE_ROUNDING`.
 
-    Raises :class:`~speedplan.InvalidInputError` naming ``name`` beyond that; ``what`` says
+    Raises `InvalidInputError` naming ``name`` beyond that; ``what`` says
     which limit it is. ``limit`` may be negative (a lower limit, as ``-a_decel``: then
     "exceeds" means "falls below").
 
@@ -71,10 +71,10 @@ def within_limit(name: str, value: float, limit: float, unit: str, what: str) ->
 
 @dataclass(frozen=True)
 class PlanRequest:
-    """What :func:`speedplan.plan` was asked, after validation (see its parameters).
+    """What [`speedplan.plan`][speedplan.plan] was asked, after validation (see its parameters).
 
-    Build it with :meth:`create`, which raises :class:`~speedplan.InvalidInputError` naming
-    the argument at fault; :func:`speedplan.plan_many` uses it to check every job before
+    Build it with `create`, which raises [`InvalidInputError`][speedplan.InvalidInputError] naming
+    the argument at fault; `speedplan.plan_many` uses it to check every job before
     shipping any.
 
     Examples
@@ -114,7 +114,7 @@ class PlanRequest:
                zones: Sequence[SpeedZone] | None = None, v_limit: Any = None,
                refine: str = "auto", standstill: str = "smooth", backend: str = "auto",
                stops: Any = None, spans: Any = None) -> PlanRequest:
-        """Check every argument; raise :class:`~speedplan.InvalidInputError` naming a bad one."""
+        """Check every argument; raise `InvalidInputError` naming a bad one."""
         if not isinstance(path, Path):
             raise InvalidInputError(
                 f"`path` must be a speedplan.Path; got {type(path).__name__} (build one with "
@@ -205,6 +205,6 @@ def _check_stops(stops: Any, length: float) -> tuple[float, ...]:
 
 
 def _acceleration(name: str, a: float, lim: Limits) -> float:
-    """A boundary acceleration within ``[-a_decel, a_max]`` (see :func:`within_limit`)."""
+    """A boundary acceleration within ``[-a_decel, a_max]`` (see `within_limit`)."""
     a = within_limit(name, a, lim.a_max, "m/s²", "a_max")
     return within_limit(name, a, -lim.a_decel, "m/s²", "-a_decel")

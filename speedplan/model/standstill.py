@@ -10,7 +10,7 @@ from .boundary import max_jerk_envelope
 
 __all__ = ["STANDSTILL_ROWS", "calibrate_standstill_rows"]
 
-#: Jerk rows recalibrated next to a standstill (see :func:`calibrate_standstill_rows`).
+#: Jerk rows recalibrated next to a standstill (see `calibrate_standstill_rows`).
 STANDSTILL_ROWS = 8
 
 

@@ -1,4 +1,4 @@
-"""Structural checks of a route, shared by :class:`Route` and the VDA 5050 reader.
+"""Structural checks of a route, shared by [`Route`][speedplan.Route] and the VDA 5050 reader.
 
 Each check takes the field names to put in its messages, so that a route built in Python
 names ``nodes[2].sequence_id`` and an order names ``nodes[2].sequenceId``.

@@ -20,7 +20,7 @@ from .route import Route
 
 __all__ = ["RouteProfile", "RouteTrajectory", "RouteTurn"]
 
-#: Samples per turn where :meth:`RouteProfile.verify` evaluates its yaw rate and acceleration
+#: Samples per turn where `RouteProfile.verify` evaluates its yaw rate and acceleration
 #: (the ends of the speed-up and slow-down included).
 TURN_SAMPLES = 64
 
@@ -37,7 +37,7 @@ class RouteTurn:
     s : float
         Its position along the route [m].
     turn : Turn
-        The rotation (:class:`~speedplan.timing.rotation.Turn`: ``start``, ``angle``,
+        The rotation ([`Turn`][speedplan.timing.rotation.Turn]: ``start``, ``angle``,
         ``duration``, ``at(t)``).
     rate_limit : float
         The yaw-rate limit it was planned under [rad/s]: the smaller of ``Limits.yaw_rate_max``
@@ -57,7 +57,7 @@ class RouteTurn:
 
 @dataclass(frozen=True)
 class RouteTrajectory(Trajectory):
-    """A :class:`~speedplan.Trajectory` along a route, with the edge each sample is on.
+    """A [`Trajectory`][speedplan.Trajectory] along a route, with the edge each sample is on.
 
     Attributes
     ----------
@@ -70,23 +70,23 @@ class RouteTrajectory(Trajectory):
 
     @property
     def units(self) -> dict[str, str]:
-        """:data:`~speedplan.timing.trajectory.COLUMNS` and ``edge``."""
+        """`COLUMNS` and ``edge``."""
         return {**COLUMNS, "edge": "1"}
 
 
 @dataclass(frozen=True, eq=False)
 class RouteProfile:
-    """The minimum-time motion along a route: one :class:`~speedplan.SpeedProfile` per leg.
+    """The minimum-time motion along a route: one [`SpeedProfile`][speedplan.SpeedProfile] per leg.
 
-    The vehicle stops between legs (at :attr:`Route.stop_s`) and drives through every other
-    node; each leg was planned on its own (see :func:`speedplan.plan_route`).
+    The vehicle stops between legs (at `Route.stop_s`) and drives through every other
+    node; each leg was planned on its own (see [`speedplan.plan_route`][speedplan.plan_route]).
 
     Attributes
     ----------
     route : Route
         What was planned.
     legs : tuple of SpeedProfile
-        One per stop-to-stop leg from :attr:`start_s` on, in order.
+        One per stop-to-stop leg from [`start_s`][speedplan.RouteProfile] on, in order.
     leg_starts : tuple of float
         Where each leg starts along ``route.path`` [m]; the last leg ends at the route's end.
     start_s : float
@@ -94,8 +94,8 @@ class RouteProfile:
     turns : tuple of RouteTurn
         The turns on the spot, in order: where the heading must change on a node the vehicle
         stands still and rotates (a corner it may not cut, a node ``theta``, a change of edge
-        orientation); their time is in :attr:`node_times`, :attr:`node_leave_times`, every
-        later time and :meth:`sample`.
+        orientation); their time is in `node_times`, `node_leave_times`, every
+        later time and [`sample`][speedplan.RouteProfile.sample].
     """
 
     route: Route
@@ -110,7 +110,7 @@ class RouteProfile:
 
     @property
     def duration(self) -> float:
-        """Time from :attr:`start_s` to the end of the route [s], the last turn included."""
+        """Time from `start_s` to the end of the route [s], the last turn included."""
         return float(self._phases[1][-1])
 
     @cached_property
@@ -154,7 +154,7 @@ class RouteProfile:
 
     @cached_property
     def turn_times(self) -> FloatArray:
-        """Start time of each of :attr:`turns` [s]."""
+        """Start time of each of [`turns`][speedplan.RouteProfile] [s]."""
         order, times, _ = self._phases
         out = np.zeros(len(self.turns))
         for p, (kind, i) in enumerate(order):
@@ -191,9 +191,9 @@ class RouteProfile:
     def node_times(self) -> FloatArray:
         """When the vehicle arrives on each released node [s from the start], in order.
 
-        ``NaN`` for the nodes behind :attr:`start_s` (already passed when an order update
+        ``NaN`` for the nodes behind `start_s` (already passed when an order update
         took over); non-decreasing from there. Where the vehicle turns on the spot on a node,
-        it leaves at :attr:`node_leave_times`; every later time includes the turn.
+        it leaves at `node_leave_times`; every later time includes the turn.
         """
         return self._node_arrive_leave[0]
 
@@ -202,7 +202,7 @@ class RouteProfile:
         """When the vehicle leaves each released node [s].
 
         Its arrival plus its turns on the spot (the time of blocking actions is not known to
-        the planner and not included); the last entry is :attr:`duration`.
+        the planner and not included); the last entry is `duration`.
         """
         return self._node_arrive_leave[1]
 
@@ -238,20 +238,20 @@ class RouteProfile:
         """The legs' checks of the continuous trajectory against every limit, and the turns'.
 
         Each turn on the spot is checked for its yaw rate (against
-        :attr:`RouteTurn.rate_limit`), yaw acceleration (``"yaw_acc"``, against
+        `RouteTurn.rate_limit`), yaw acceleration (``"yaw_acc"``, against
         ``Limits.yaw_acc_max``) and, with a ``Limits.yaw_jerk_max``, yaw jerk (``"yaw_jerk"``),
-        sampled at :data:`TURN_SAMPLES` times and the ends of its pieces.
+        sampled at `TURN_SAMPLES` times and the ends of its pieces.
         """
         return Verification.merged([leg.verify() for leg in self.legs] + self._turn_checks())
 
     @property
     def verification(self) -> Verification:
-        """The checks :func:`speedplan.plan` made of each leg, merged with the turns'."""
+        """The checks `speedplan.plan` made of each leg, merged with the turns'."""
         return Verification.merged([leg.verification or leg.verify() for leg in self.legs]
                                    + self._turn_checks())
 
     def _turn_checks(self) -> list[Verification]:
-        """One :class:`Verification` per turn: its yaw rate, acceleration and jerk.
+        """One `Verification` per turn: its yaw rate, acceleration and jerk.
 
         Rate and acceleration sampled (the ends of every piece included), the jerk from
         differences of the sampled acceleration.

@@ -60,7 +60,7 @@ class RouteNode:
         between two edges with trajectories).
     theta : float or None
         Heading the vehicle shall have on the node [rad] (``nodePosition.theta``): where the
-        path's heading there differs by more than :attr:`theta_tolerance`, the vehicle stops
+        path's heading there differs by more than `theta_tolerance`, the vehicle stops
         on the node and turns to ``theta`` (and then to the next edge's heading).
     allowed_deviation_xy : float
         How far [m] the vehicle may pass from ``position`` (VDA 5050 2.x ``allowedDeviationXY``;
@@ -72,7 +72,7 @@ class RouteNode:
         Part of the base (``True``) or of the horizon.
     allowed_deviation_theta : float or None
         How far [rad] the heading may differ from ``theta`` (``allowedDeviationTheta``);
-        ``None`` or 0: :data:`THETA_TOLERANCE`.
+        ``None`` or 0: `THETA_TOLERANCE`.
     deviation_ellipse : (a, b, angle) or None
         VDA 5050 3.0's ``allowedDeviationXY`` ellipse: semi-axes ``a``, ``b`` [m] and the
         angle [rad] of the ``a`` axis to the map's x axis. A corner on the node is rounded
@@ -122,13 +122,13 @@ class RouteNode:
 
     @property
     def theta_tolerance(self) -> float:
-        """How far [rad] the heading on the node may differ from :attr:`theta`."""
+        """How far [rad] the heading on the node may differ from `theta`."""
         return max(self.allowed_deviation_theta or 0.0, THETA_TOLERANCE)
 
     def deviation_towards(self, direction: float) -> float:
         """Allowed deviation [m] from the node in the map direction ``direction`` [rad].
 
-        The ellipse's radius in that direction, else :attr:`allowed_deviation_xy`.
+        The ellipse's radius in that direction, else `allowed_deviation_xy`.
         """
         if self.deviation_ellipse is None:
             return self.allowed_deviation_xy
@@ -257,7 +257,7 @@ def corner_deviation(before: RouteEdge, node: RouteNode, after: RouteEdge) -> fl
     The corner's point nearest the node lies on the inner bisector of the two edges: it must
     lie inside the node's allowed deviation (the 3.0 ellipse's radius in that direction) and,
     at ``d cos(δ/2)`` from each edge's line for a turn ``δ``, inside the inner side of each
-    edge's :attr:`~RouteEdge.corridor`.
+    edge's [`corridor`][speedplan.route.RouteEdge].
     """
     d_in = float(before.path.heading(before.path.length))
     d_out = float(after.path.heading(0.0))
@@ -275,8 +275,8 @@ def _can_round(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
     """Whether the corner on ``node`` between two straight edges is rounded (G2).
 
     Both edges run straight between node positions, the corner may pass the node at some
-    distance (:func:`corner_deviation`), the turn is not a reversal
-    (:data:`~speedplan.geometry.corners.CUSP_ANGLE`), the vehicle keeps its driving
+    distance (`corner_deviation`), the turn is not a reversal
+    (`CUSP_ANGLE`), the vehicle keeps its driving
     direction, may rotate on both edges and need not reach the next edge's heading before
     entering it, and the corner's heading on the node meets the node's ``theta``.
     """
@@ -296,9 +296,9 @@ def _join_at_node(before: RouteEdge, node: RouteNode, after: RouteEdge) -> bool:
     """Whether the vehicle must stop on ``node`` to pass from ``before`` to ``after``.
 
     The one place that decides how a route passes a node between two edges: where the
-    heading changes by more than :data:`HEADING_TOLERANCE`, the corner is rounded within
-    the node's allowed deviation and the edges' corridors when :func:`_can_round` allows it
-    (a G2 clothoid–arc–clothoid corner, as :meth:`Path.from_waypoints` builds them), else the
+    heading changes by more than `HEADING_TOLERANCE`, the corner is rounded within
+    the node's allowed deviation and the edges' corridors when `_can_round` allows it
+    (a G2 clothoid–arc–clothoid corner, as `Path.from_waypoints` builds them), else the
     vehicle stops there (it turns on the spot).
     """
     if _heading_change(before.path, after.path) <= HEADING_TOLERANCE:
@@ -329,9 +329,9 @@ class Route:
     """A route: nodes and the edges between them, as in a VDA 5050 order.
 
     ``edges[i]`` runs from ``nodes[i]`` to ``nodes[i + 1]``. The planning quantities
-    (:attr:`length`, :attr:`node_s`, :attr:`edge_spans`, :attr:`stop_s`, :meth:`legs`) cover
+    ([`length`][speedplan.Route.length], `node_s`, `edge_spans`, `stop_s`, `legs`) cover
     the **released base** only — the vehicle plans it and must be able to stop at its end;
-    the horizon (``released`` false) is kept in :attr:`nodes` and :attr:`edges` for
+    the horizon (``released`` false) is kept in [`nodes`][speedplan.Route] and `edges` for
     information. Arc length ``s`` [m] runs along the base from its first node; the edges'
     paths are chained end to start (each within its node's allowed deviation of the next).
 
@@ -339,7 +339,7 @@ class Route:
     with a blocking (SOFT or HARD) action, at the start node of an edge with such an action,
     where the driving direction changes (an edge driven backwards after one driven forwards,
     or the reverse: a cusp) and where the heading jumps between two edges (see
-    :data:`HEADING_TOLERANCE`).
+    `HEADING_TOLERANCE`).
 
     Parameters
     ----------
@@ -351,7 +351,7 @@ class Route:
         The order's ``orderId``, ``orderUpdateId`` and protocol ``version`` when read from one.
     notes : tuple of str
         What of the order the planner does not honour as written, one line per field naming
-        its node or edge and why (:meth:`from_vda5050` also warns them, once per order).
+        its node or edge and why (`from_vda5050` also warns them, once per order).
 
     Raises
     ------
@@ -474,7 +474,7 @@ class Route:
         """Per released node, the headings [rad] the vehicle turns through on it, standing.
 
         The heading it arrives with, the node's ``theta`` where that differs by more than
-        :attr:`RouteNode.theta_tolerance`, and the heading the next edge starts with
+        `RouteNode.theta_tolerance`, and the heading the next edge starts with
         (the vehicle's: the tangent, plus π on an edge driven backwards); one entry where it
         does not turn, none on a rounded node. On the first node the vehicle is taken to
         stand at its ``theta`` (else at the first edge's heading); on the last it turns to
@@ -484,7 +484,7 @@ class Route:
                      for k in range(len(self.base_nodes)))
 
     def node_headings(self, k: int, arrive: float | None = None) -> tuple[float, ...]:
-        """:attr:`turn_headings` of released node ``k`` for a given arrival heading.
+        """[`turn_headings`][speedplan.Route] of released node ``k`` for a given arrival heading.
 
         ``arrive`` [rad] defaults to the heading of the edge into the node; on the first node
         to its ``theta``, else the first edge's heading.
@@ -509,12 +509,12 @@ class Route:
     # ---- the released base ------------------------------------------------------------------
     @cached_property
     def base_edges(self) -> tuple[RouteEdge, ...]:
-        """The released edges (a prefix of :attr:`edges`)."""
+        """The released edges (a prefix of [`edges`][speedplan.Route])."""
         return tuple(e for e in self.edges if e.released)
 
     @property
     def base_nodes(self) -> tuple[RouteNode, ...]:
-        """The released nodes (a prefix of :attr:`nodes`, one more than :attr:`base_edges`)."""
+        """The released nodes (a prefix of `nodes`, one more than `base_edges`)."""
         return self.nodes[: len(self.base_edges) + 1]
 
     @cached_property
@@ -557,7 +557,7 @@ class Route:
 
     @property
     def path(self) -> Path:
-        """The released base as one :class:`~speedplan.Path`: what ``plan_route`` plans.
+        """The released base as one [`Path`][speedplan.Path]: what ``plan_route`` plans.
 
         The edges' paths in order (driven in reverse where the edge says so), with the corners
         between straight edges rounded within their node's allowed deviation.
@@ -566,16 +566,16 @@ class Route:
 
     @property
     def node_s(self) -> FloatArray:
-        """Arc length [m] of each released node along :attr:`path`.
+        """Arc length [m] of each released node along [`path`][speedplan.Route.path].
 
-        0 first, :attr:`length` last; on a rounded corner, the corner's middle (its point
+        0 first, `length` last; on a rounded corner, the corner's middle (its point
         nearest the node).
         """
         return self._geometry[1]
 
     @property
     def rounded_nodes(self) -> tuple[int, ...]:
-        """Indices of the released nodes whose corner is rounded (see :attr:`path`)."""
+        """Indices of the released nodes whose corner is rounded (see `path`)."""
         return self._geometry[2]
 
     @property
@@ -604,7 +604,7 @@ class Route:
 
     @property
     def stop_reasons(self) -> tuple[str, ...]:
-        """Why the vehicle stops at each entry of :attr:`stop_s`."""
+        """Why the vehicle stops at each entry of [`stop_s`][speedplan.Route.stop_s]."""
         return tuple(reason for _, reason in self._stops)
 
     def legs(self) -> list[tuple[RouteEdge, ...]]:
@@ -631,7 +631,7 @@ class Route:
         Route
             Edges with a ``trajectory`` become NURBS paths (3.0 defaults: ``degree`` 1,
             uniform clamped knots, weights 1); edges without one run straight between their
-            node positions. See :mod:`speedplan.route.vda5050` for the fields read per version.
+            node positions. See `speedplan.route.vda5050` for the fields read per version.
 
         Raises
         ------

@@ -1,4 +1,4 @@
-"""VDA 5050 orders (2.0, 2.1, 3.0) to a :class:`~speedplan.route.Route`.
+"""VDA 5050 orders (2.0, 2.1, 3.0) to a [`Route`][speedplan.Route].
 
 Field names follow the official JSON schemas and specification of the VDA5050/VDA5050
 repository (``json_schemas/order.schema`` and ``VDA5050_EN.md``); where the versions differ:
@@ -32,8 +32,8 @@ Nothing is dropped without a word: every field the planner does not honour as wr
 height fields, ``zoneSetId``, an ``orientation`` at an angle to the path (crabbing), a
 ``CONTOUR`` corridor, ``rotationAllowed`` false on an edge whose geometry turns, an unknown
 field name, a field the schema requires but the order lacks (``actions`` lists, header
-fields, ``mapId``; planned without) — is one line of :attr:`Route.notes`, and the reader warns
-them once per order (:class:`OrderWarning`). ``docs/vda5050.md`` lists every field.
+fields, ``mapId``; planned without) — is one line of `Route.notes`, and the reader warns
+them once per order (`OrderWarning`). ``docs/vda5050.md`` lists every field.
 
 What is derived:
 
@@ -92,7 +92,7 @@ class OrderWarning(SpeedplanWarning):
     """An order holds fields the planner does not honour as written.
 
     One warning per order, one line per field naming its node or edge and why; the same
-    lines are in :attr:`Route.notes`.
+    lines are in [`Route.notes`][speedplan.Route].
     """
 
 
@@ -202,7 +202,7 @@ def load_order(order: Any) -> tuple[str, Any]:
 
 
 def route_from_vda5050(order: Any) -> Route:
-    """The :class:`Route` of a VDA 5050 order; see :meth:`Route.from_vda5050`.
+    """The [`Route`][speedplan.Route] of a VDA 5050 order; see `Route.from_vda5050`.
 
     Examples
     --------

@@ -1,7 +1,7 @@
 """The discrete problem and its solvers.
 
-:func:`solve_discrete` is the paper's problem verbatim; :func:`solve_problem` takes a
-:class:`DiscreteProblem` on any grid (used by :func:`speedplan.plan`).
+`solve_discrete` is the paper's problem verbatim; `solve_problem` takes a
+[`DiscreteProblem`][speedplan.DiscreteProblem] on any grid (used by `speedplan.plan`).
 """
 
 from .discrete import BACKENDS, REFINE_MODES, RELAXATION_BACKENDS, solve_discrete, solve_problem

@@ -1,11 +1,11 @@
-"""Compiled iteration of the banded interior-point method (see :mod:`speedplan.solve.banded`).
+"""Compiled iteration of the banded interior-point method (see `speedplan.solve.banded`).
 
-Everything here runs under :func:`numba.njit`. One interior-point iteration at ``n = 1000``
+Everything here runs under `numba.njit`. One interior-point iteration at ``n = 1000``
 is a few hundred small vector operations, which as separate numpy calls cost more than the
 arithmetic itself; written as loops over nodes they compile to a few passes over memory.
-Every array is allocated once per solve, by the Python driver, with :func:`empty`
+Every array is allocated once per solve, by the Python driver, with `empty`
 (``empty(Point, lay)``, ``empty(Factor, lay)``, ...; ``Scaling.identity(lay)``), whose shapes
-:func:`check_sizes` verifies before the kernel runs: with bounds checks off, a wrongly sized
+`check_sizes` verifies before the kernel runs: with bounds checks off, a wrongly sized
 array would be silent memory corruption. Compiled code is cached on disk (``cache=True``), so
 only the first use after installation pays the compilation. Arithmetic follows numpy's error model
 (division by zero gives ``inf``/``nan``, which the iteration detects and reports as a
@@ -15,7 +15,7 @@ Notation follows CVXOPT's ``coneqp``: ``G x + s = b``, ``s ∈ K``, ``G' y + c =
 with ``x = (w, t, z)`` over the ``m`` interior nodes. ``K`` is a product of nonnegative
 orthants (the linear rows) and ``2 m`` three-dimensional second-order cones, stored
 column-wise in arrays of shape ``(3, 2 m)``: first the node cones ``z² <= w``, then the
-cones ``t z >= 1``. The linear rows are ordered in blocks whose offsets :class:`Layout`
+cones ``t z >= 1``. The linear rows are ordered in blocks whose offsets `Layout`
 holds: acceleration (``m + 1``), braking (``m + 1``), upper bounds (``m``), lower bounds
 (``kl``, nodes ``lk``), positive jerk rows (``k``, by node: ``jstart``), negative jerk rows
 (``k``). Functions named ``*_into`` write their result into the trailing array arguments.
@@ -38,9 +38,9 @@ tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 _T = TypeVar("_T")
 
-#: numba options of every kernel here but :func:`iterate`: called only from compiled code,
+#: numba options of every kernel here but `iterate`: called only from compiled code,
 #: they need no Python or C entry point, whose generation cost a sixth of the module's
-#: compile time (measured: 28 s of CPU instead of 34 s). :func:`python_callable` calls one
+#: compile time (measured: 28 s of CPU instead of 34 s). `python_callable` calls one
 #: from Python.
 _INNER: dict[str, Any] = {"cache": True, "error_model": "numpy", "no_cpython_wrapper": True,
                           "no_cfunc_wrapper": True}
@@ -65,7 +65,7 @@ REFINE_RESIDUAL = 0.01
 #: Iterations without halving the relative gap after which the method is declared stalled.
 STALL_ITERATIONS = 5
 #: Relative gap below which a stalled method reports STALLED; also the certified relative gap
-#: with which :mod:`~speedplan.solve.banded` accepts any stop short of ``tol`` ("AlmostSolved").
+#: with which `banded` accepts any stop short of ``tol`` ("AlmostSolved").
 ALMOST_GAP = 1e-6
 #: Iterations without halving the relative gap or either relative residual after which the
 #: method gives up at any gap (seen on a few long, strongly graded grids, where it jams near a
@@ -75,13 +75,13 @@ ALMOST_GAP = 1e-6
 #: (fuzz_zones seed 2 case 98: stopped at iteration 56 by the gap alone, solved at 117).
 NO_PROGRESS_ITERATIONS = 20
 
-#: How :func:`g_adjoint_into` writes ``G' y`` into its output.
+#: How `g_adjoint_into` writes ``G' y`` into its output.
 ADJ_SET, ADJ_SUBTRACT, ADJ_ADD, ADJ_DUAL_RESIDUAL = 0, 1, 2, 3
 
-#: Columns of :func:`iterate`'s log, one row per iteration.
+#: Columns of `iterate`'s log, one row per iteration.
 LOG_COLUMNS = ("pcost", "dcost", "relgap", "pres", "dres", "sigma", "step")
 
-#: Status codes returned by :func:`iterate`.
+#: Status codes returned by `iterate`.
 SOLVED, MAX_ITERATIONS, STALLED, NUMERICAL_ERROR, NO_PROGRESS = 0, 1, 2, 3, 4
 STATUS_NAMES = ("Solved", "MaxIterations", "Stalled", "NumericalError", "NoProgress")
 
@@ -90,7 +90,7 @@ STATUS_NAMES = ("Solved", "MaxIterations", "Stalled", "NumericalError", "NoProgr
 
 
 class Layout(NamedTuple):
-    """Sizes and row-block offsets of one problem, computed once by :func:`layout`."""
+    """Sizes and row-block offsets of one problem, computed once by `layout`."""
 
     m: int  # interior nodes
     k: int  # stencil (jerk-type) rows of each sign, all families
@@ -134,7 +134,7 @@ def empty(cls: type[_T], lay: Layout) -> _T:
 
 
 def _check(obj: tuple[Any, ...], lay: Layout) -> None:
-    """Raise :class:`ValueError` unless every array of ``obj`` has its shape for ``lay``."""
+    """Raise `ValueError` unless every array of ``obj`` has its shape for ``lay``."""
     kinds = _KINDS[type(obj)]
     for name, arr in zip(obj._fields, obj, strict=True):  # type: ignore[attr-defined]
         if name not in kinds:
@@ -149,7 +149,7 @@ def _check(obj: tuple[Any, ...], lay: Layout) -> None:
 
 
 class Data(NamedTuple):
-    """Problem data in internal units (see :func:`speedplan.solve.banded._prepare`).
+    """Problem data in internal units (see `speedplan.solve.banded._prepare`).
 
     The stencil rows of every family (jerk, lateral jerk) are listed together, ordered by
     node: the rows of node ``i`` are ``r`` in ``jstart[i]:jstart[i + 1]``, and row ``r`` reads
@@ -167,12 +167,12 @@ class Data(NamedTuple):
     lay: Layout
 
     def rhs_lin(self) -> FloatArray:
-        """The right-hand side of every linear row, shape ``(n_lin,)`` (see :func:`_b_lin`)."""
+        """The right-hand side of every linear row, shape ``(n_lin,)`` (see `_b_lin`)."""
         lay = self.lay
         return np.concatenate((self.b_lin, -self.b_lin[lay.jp : lay.jm]))
 
     def check(self) -> None:
-        """Raise :class:`ValueError` unless every array has its shape for ``self.lay``."""
+        """Raise `ValueError` unless every array has its shape for ``self.lay``."""
         _check(self, self.lay)
         js = self.jstart
         if not (js[0] == 0 and js[-1] == self.lay.k and bool(np.all(np.diff(js) >= 0))):
@@ -185,9 +185,9 @@ class Data(NamedTuple):
 class Point(NamedTuple):
     """Primal–dual iterate: ``x = (w, t, z)``, linear slacks ``sl`` and multipliers ``y``.
 
-    The cones' slacks are not stored: they are kept equal to ``b - G x`` (:func:`_cone_s`),
+    The cones' slacks are not stored: they are kept equal to ``b - G x`` (`_cone_s`),
     which the start makes strictly interior, so the cone rows' primal residual is zero
-    throughout and their ``Δs = -G Δx`` (:func:`_cone_ds`).
+    throughout and their ``Δs = -G Δx`` (`_cone_ds`).
     """
 
     w: FloatArray
@@ -204,7 +204,7 @@ class Residual(NamedTuple):
 
     The primal residual of the linear rows is the same number on every row (the start's
     shift, scaled by ``1 - α`` at each step), carried as a scalar ``rp``; the cone rows
-    have none (see :class:`Point`).
+    have none (see `Point`).
     """
 
     gw: FloatArray
@@ -230,7 +230,7 @@ class Scaling(NamedTuple):
 
     The linear rows' scaling ``W = diag(sqrt(s / y))`` is never formed: only ``W² = s / y``
     and ``λ² = s y`` enter the Newton system. The scaled point ``λ = W y = W⁻¹ s`` is
-    computed where it is used (:func:`_lambda`).
+    computed where it is used (`_lambda`).
     """
 
     beta: FloatArray  # cones: W = β (2 v v' - J)
@@ -277,7 +277,7 @@ _KINDS: dict[type, dict[str, str]] = {
 def check_sizes(d: Data, *parts: tuple[Any, ...]) -> None:
     """Check the shapes of ``d`` and of every array tuple against ``d.lay``.
 
-    Call :meth:`Data.check` (shapes and row order) once before allocating the kernel's
+    Call `Data.check` (shapes and row order) once before allocating the kernel's
     arrays: its temporaries would otherwise add to the solve's peak memory.
     """
     _check(d, d.lay)
@@ -314,7 +314,7 @@ def _stencil_dot(d: Data, w: FloatArray, i: int, r: int) -> float:
 
 @_inner
 def _scatter_stencil(d: Data, i: int, r: int, value: float, out: FloatArray) -> None:
-    """``out += value * jc_r`` at ``w_{i-1:i+2}`` (the adjoint of :func:`_stencil_dot`)."""
+    """``out += value * jc_r`` at ``w_{i-1:i+2}`` (the adjoint of `_stencil_dot`)."""
     if i > 0:
         out[i - 1] += value * d.jc[0, r]
     out[i] += value * d.jc[1, r]
@@ -407,7 +407,7 @@ def _cone_s(w: FloatArray, t: FloatArray, z: FloatArray, c: int) -> tuple[float,
 def _cone_ds(
     dw: FloatArray, dt: FloatArray, dz: FloatArray, c: int
 ) -> tuple[float, float, float]:
-    """Cone ``c``'s ``Δs = -G Δx``, the change of :func:`_cone_s` along ``Δx``."""
+    """Cone ``c``'s ``Δs = -G Δx``, the change of `_cone_s` along ``Δx``."""
     m = dw.size
     if c < m:
         return dw[c], 2.0 * dz[c], dw[c]
@@ -461,7 +461,7 @@ def g_adjoint_into(
 
     ``ADJ_SET`` (and any other value): ``g = G' y``; ``ADJ_SUBTRACT``: ``g -= G' y``;
     ``ADJ_ADD``: ``g += G' y``; ``ADJ_DUAL_RESIDUAL``: ``g = -(G' y + c)`` (``c`` is ``ct``
-    on ``t``). The floors ``lk`` must be strictly increasing (:meth:`Data.check`). Each entry is
+    on ``t``). The floors ``lk`` must be strictly increasing (`Data.check`). Each entry is
     formed whole, node by node, before it is written: the stencil rows of nodes ``i - 1``,
     ``i`` and ``i + 1`` are gathered in row order, so the modes round as the finished
     ``G' y`` combined with ``g``, one pass over memory where a separate pass would add a
@@ -542,7 +542,7 @@ def max_step_soc(u: FloatArray, du: FloatArray) -> float:
 
 @_inner
 def max_step_slack_soc(pt: Point, dn: Direction) -> float:
-    """:func:`max_step_soc` for the cones' slacks ``s = b - G x`` along ``Δs = -G Δx``."""
+    """`max_step_soc` for the cones' slacks ``s = b - G x`` along ``Δs = -G Δx``."""
     best = np.inf
     for c in range(pt.ys.shape[1]):
         s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
@@ -822,7 +822,7 @@ def _v_into(
 
 @_inner
 def _recover_v_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
-    """Put back the ``v`` of :func:`_v_into` into ``(dyl, dys)`` from the direction ``dn``.
+    """Put back the ``v`` of `_v_into` into ``(dyl, dys)`` from the direction ``dn``.
 
     ``Δy = H G Δx - v`` with ``G Δx = by - Δs``: so ``v = H (by - Δs) - Δy`` on the linear
     rows and ``v = H G Δx - Δy`` on the cones, without the right-hand side ``bs``.
@@ -860,10 +860,10 @@ def newton_into(
 ) -> None:
     """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs`` into ``dn``.
 
-    ``bx`` is the residual ``res``, which must be the iterate's (:func:`dual_residual_into`:
+    ``bx`` is the residual ``res``, which must be the iterate's (`dual_residual_into`:
     the refinement forms its own right-hand side in ``res``, then forms ``bx`` again from
     ``pt``), ``by`` is ``rp`` on the linear rows and zero on the cones,
-    ``bs`` as :func:`_v_into` says (``corrector``, ``sigma_mu``; the corrector reads the
+    ``bs`` as `_v_into` says (``corrector``, ``sigma_mu``; the corrector reads the
     predictor's direction from ``dn``). One round of iterative refinement follows if the
     2-norm of the residual ``bx - G'Δy`` exceeds ``refine_above`` (``inf``: no refinement,
     and the residual is not computed).
@@ -911,7 +911,7 @@ def _dot(a: FloatArray, b: FloatArray) -> float:
 
 @_inner
 def _dot2(a: FloatArray, b: FloatArray) -> float:
-    """``a · b`` over all entries of two 2-D arrays, row by row (as :func:`_dot` of them flat)."""
+    """``a · b`` over all entries of two 2-D arrays, row by row (as `_dot` of them flat)."""
     acc = 0.0
     for r in range(a.shape[0]):
         for c in range(a.shape[1]):
@@ -947,7 +947,7 @@ def _shift(worst: float, nrm: float) -> float:
 
 @_inner
 def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
-    """Add :func:`_shift` of ``(ul, us)`` to every linear entry and every cone's axis."""
+    """Add `_shift` of ``(ul, us)`` to every linear entry and every cone's axis."""
     worst = np.inf
     for i in range(ul.size):
         worst = min(worst, ul[i])
@@ -967,7 +967,7 @@ def start_into(
     """Slacks and multipliers of the start, given the primal point ``(w, t, z)`` in ``pt``.
 
     ``s = b - G x``, with the linear rows shifted into the orthant by CVXOPT's rule (the
-    cones' slacks are not shifted: they stay ``b - G x``, see :class:`Point`), and CVXOPT's
+    cones' slacks are not shifted: they stay ``b - G x``, see `Point`), and CVXOPT's
     default dual start (least-norm ``y`` of ``G' y = -c``, with ``W = I``) shifted into the
     cones. ``sc`` must be the identity scaling. Returns whether ``b - G x`` is strictly
     inside every cone (else nothing else is valid) and the linear rows' primal residual
@@ -1015,7 +1015,7 @@ def residuals_into(
     """Dual residual (negated) into ``res``; returns ``(pcost, dcost, gap, |r_y|², |r_x|²)``.
 
     ``|r_y|²`` is the linear rows' primal residual ``b - G x - s`` of the iterate itself,
-    computed in ``scratch`` (the cones have none, see :class:`Point`).
+    computed in ``scratch`` (the cones have none, see `Point`).
     """
     m = d.lay.m
     rx2 = dual_residual_into(d, pt, res)
@@ -1183,9 +1183,9 @@ def iterate(
 
 
 def signatures() -> dict[str, Any]:
-    """The kernel called from Python and its signature (see :mod:`speedplan.core.jit`).
+    """The kernel called from Python and its signature (see `speedplan.core.jit`).
 
-    The types of :func:`iterate`'s arguments as :mod:`speedplan.solve.banded` builds them;
+    The types of `iterate`'s arguments as `speedplan.solve.banded` builds them;
     only their types matter, so the arrays here are of the smallest sizes.
     """
     import numba
@@ -1202,7 +1202,7 @@ def signatures() -> dict[str, Any]:
 def python_callable(kernel: Any) -> Any:
     """``kernel`` (any of this module's) callable from Python: for tests and diagnostics.
 
-    The kernels other than :func:`iterate` have no Python entry point (see ``_INNER``); this
+    The kernels other than `iterate` have no Python entry point (see ``_INNER``); this
     wraps one in a compiled trampoline (compiled on first call, not cached).
 
     Examples

@@ -1,9 +1,9 @@
-"""Compiled (numba) per-iteration work of :mod:`speedplan.solve.banded_nlp`.
+"""Compiled (numba) per-iteration work of `speedplan.solve.banded_nlp`.
 
 The interior-point method's control flow (barrier update, filter line search, restoration)
 stays in Python; what an iteration computes on arrays of ``n`` runs here, one call per step
 of the method, so the ~100 numpy passes of an iteration become a handful of fused loops.
-The formulas are those of the numpy path in :mod:`~speedplan.solve.banded_nlp` (which runs
+The formulas are those of the numpy path in `banded_nlp` (which runs
 until these kernels are compiled); ``tests/test_refine.py`` checks that both agree.
 
 Layout (``m`` interior nodes, ``na = m + 1`` acceleration rows, ``R`` rows in all):
@@ -15,7 +15,7 @@ Layout (``m`` interior nodes, ``na = m + 1`` acceleration rows, ``R`` rows in al
 - the objective is ``mode`` 0, ``Σ a_i / sqrt(x_i)`` (travel time), or ``mode`` 1,
   ``Σ a_i (x_i - b_i)² / 2`` (the restoration's proximity term).
 
-Every kernel has one explicit signature (:data:`SIGNATURES`): the caller loads them from
+Every kernel has one explicit signature (`SIGNATURES`): the caller loads them from
 numba's cache or compiles them once, never per call.
 """
 
@@ -261,7 +261,7 @@ def _cholesky(
 def _band_solve(
     f: FloatArray, b: FloatArray
 ) -> None:  # pragma: no cover - compiled
-    """Solve ``L L' x = b`` in place with the factor of :func:`_cholesky`."""
+    """Solve ``L L' x = b`` in place with the factor of `_cholesky`."""
     m = b.size
     for j in range(m):
         v = b[j]
@@ -458,5 +458,5 @@ def tiny(
 
 
 def signatures() -> dict[str, str]:
-    """Every kernel and its signature, :data:`SIGNATURES` (see :mod:`speedplan.core.jit`)."""
+    """Every kernel and its signature, `SIGNATURES` (see `speedplan.core.jit`)."""
     return dict(SIGNATURES)

@@ -1,6 +1,6 @@
 """Structure-exploiting interior-point solver for the SOCP relaxation (O(n) per iteration).
 
-The relaxation (paper eq. ``relax``, our :func:`~speedplan.solve.clarabel_.build_socp`) is
+The relaxation (paper eq. ``relax``, our `build_socp`) is
 
     minimise   Σ t_i
     subject to (w_{i+1} - w_i) <= A_i h_i,   (w_i - w_{i+1}) <= D_i h_i,   w_i <= w_max_i,
@@ -21,15 +21,15 @@ three-point stencils; ``t_i`` and ``z_i`` appear only in rows of node ``i``. So 
 the 2×2 block of ``(t_i, z_i)`` per node (a closed-form Schur complement) and are left with a
 pentadiagonal symmetric positive-definite system in ``w``, factored once per iteration as
 ``L D L'`` and solved twice (predictor and corrector); ``docs/banded-ipm.md`` derives it.
-The iteration itself is compiled (:mod:`speedplan.solve._banded_ipm`, numba): an iteration
+The iteration itself is compiled (`speedplan.solve._banded_ipm`, numba): an iteration
 costs O(n) time and memory with no per-operation interpreter overhead.
 
-The problem is solved in the units of :func:`unit_scales` (``w_max <= 1``, unit mean step),
+The problem is solved in the units of `unit_scales` (``w_max <= 1``, unit mean step),
 with every variable further scaled per node from the O(n) no-jerk profile ``w_ref``
 (``w = w_ref ŵ``, ``z = sqrt(w_ref) ẑ``, ``t = τ / sqrt(w_ref) t̂``) so that every node's cones
 become the same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``. The
 primal start is the midpoint of the slowest and fastest feasible profiles (see
-:func:`_start`), the dual start CVXOPT's default (least-norm, shifted into the cones);
+`_start`), the dual start CVXOPT's default (least-norm, shifted into the cones);
 each Newton solve gets one round of iterative refinement once the gap is small and the
 solve's own residual could matter.
 
@@ -39,9 +39,9 @@ the paper's families, and on fine grids, where the reduced matrix inherits the c
 of the fourth difference ``D̂'D̂``). Whatever stopped the iteration (a stall, a matrix that
 no longer factors, the iteration limit), the method reports ``status="AlmostSolved"`` (as
 Clarabel does) if the certified relative gap below is at most 1e-6 and ``w`` is feasible,
-and raises :class:`~speedplan.errors.SolverError` otherwise. Grids finer than double
-precision resolves (:func:`check_grid_resolvable`) are refused by
-:func:`~speedplan.solve.solve_problem` before any solver runs.
+and raises `SolverError` otherwise. Grids finer than double
+precision resolves (`check_grid_resolvable`) are refused by
+`solve_problem` before any solver runs.
 
 The returned ``dual_objective`` is a rigorous lower bound, independent of how well the
 iterates satisfy the dual equations: the Lagrangian of the relaxation with the solver's
@@ -53,7 +53,7 @@ closed form over the box ``w_min <= w <= w_max``, node by node. The ``primal_obj
 
 The kernel is compiled on first use after installation (or by ``speedplan compile``); until
 then ``backend="auto"`` answers with Clarabel while a background process compiles it
-(:func:`kernel_ready`, :mod:`speedplan.core.jit`).
+(`kernel_ready`, `speedplan.core.jit`).
 """
 
 from __future__ import annotations
@@ -118,7 +118,7 @@ MAX_ITERATIONS = 200
 
 
 class _Rows(NamedTuple):
-    """Family and node of each stencil row of :class:`~speedplan.solve._banded_ipm.Data`."""
+    """Family and node of each stencil row of `Data`."""
 
     family: IntArray
     node: IntArray
@@ -145,7 +145,7 @@ def _prepare(p: DiscreteProblem, w_ref: FloatArray) -> ipm.Data:
     ``cw = w_ref`` and ``ct = τ / sqrt(cw)``, which turns both cones of every node into the
     same unit cones ``ẑ² <= ŵ`` and ``t̂ ẑ >= 1``; the acceleration rows get the coefficients
     ``cw``, the stencil rows (every finite row of every family of
-    :meth:`~speedplan.solve.problem.DiscreteProblem.stencil_families`) the stencil times
+    [`stencil_families`][speedplan.DiscreteProblem.stencil_families]) the stencil times
     ``cw`` and are divided by ``ct``. The rows are not normalised further:
     normalising the jerk rows to unit norm (as an earlier version did) made the method jam on
     grids finer than about 7 mm, e.g. ``paths/u_turn.json`` at ``n = 5000`` (NoProgress after
@@ -261,7 +261,7 @@ def _start(p: DiscreteProblem, d: ipm.Data) -> tuple[FloatArray, FloatArray, Flo
     """Primal starting point ``(ŵ, t̂, ẑ)`` in the middle of the linear rows' feasible set.
 
     ``w`` is the mean of the fastest feasible profile ``w_ref`` and the slowest one
-    (:func:`~speedplan.solve.nojerk.min_feasible_w`); both meet every acceleration row, so
+    (`min_feasible_w`); both meet every acceleration row, so
     their mean does too, strictly inside the speed bounds wherever they differ. ``z`` and
     ``t`` are then strictly inside their cones and above the stencil rows. Measured on
     ``plan()`` grids (with the jerk-row normalisation of the time) this more than halved the
@@ -306,7 +306,7 @@ def _row_multipliers(
 def _kernel_args(
     p: DiscreteProblem, d: ipm.Data
 ) -> tuple[ipm.Data, ipm.Point, ipm.Residual, ipm.Direction, ipm.Scaling, ipm.Factor]:
-    """The kernel's arrays for ``d``, sizes checked, with :func:`_start` in the point.
+    """The kernel's arrays for ``d``, sizes checked, with `_start` in the point.
 
     The start is copied into the point before the other arrays are allocated, and its own
     arrays are freed at once: alive during the iteration they would add 24 bytes per node.
@@ -324,7 +324,7 @@ def _kernel_args(
 def _run_kernel(
     p: DiscreteProblem, d: ipm.Data, tol: float, max_iter: int
 ) -> tuple[FloatArray, FloatArray, int, int]:
-    """Iterate from :func:`_start`; ``(w, yl, iterations, status code)``, internal units."""
+    """Iterate from `_start`; ``(w, yl, iterations, status code)``, internal units."""
     args = _kernel_args(p, d)
     log = np.full((max_iter + 1, len(ipm.LOG_COLUMNS)), np.nan)
     iterations, code = ipm.iterate(*args, log, tol, max_iter)
@@ -335,14 +335,14 @@ def _run_kernel(
 
 # --- first use: load, compile, or compile in the background ---------------------------------
 
-#: The compiled kernel's family (:mod:`speedplan.core.jit` loads, compiles or starts it).
+#: The compiled kernel's family (`speedplan.core.jit` loads, compiles or starts it).
 KERNELS = FAMILIES["relaxation"]
 
 
 class _Diagnostics:
     """The iteration log of the last solve in this process, for diagnostics and benchmarks.
 
-    Rows: iterations; columns: :data:`~speedplan.solve._banded_ipm.LOG_COLUMNS`. Empty (no
+    Rows: iterations; columns: `LOG_COLUMNS`. Empty (no
     columns) until the first solve: sizing it would import the kernel.
     """
 
@@ -360,7 +360,7 @@ def compile_kernel() -> None:
     """Make the compiled kernel available in this process now: load it, or compile it.
 
     ``backend="auto"`` answers with Clarabel while the kernel is not available (see
-    :func:`kernel_ready`); call this first for runs whose backend must not depend on timing
+    `kernel_ready`); call this first for runs whose backend must not depend on timing
     (or run ``speedplan compile`` once after installing, which compiles every kernel).
 
     Examples
@@ -378,7 +378,7 @@ def kernel_ready(*, start: bool = True) -> bool:
     The kernel is loaded from numba's cache when it is there. When it is not (first use
     after installation), and ``start`` is true, a background Python process compiles it into
     the cache, unless the environment variable ``SPEEDPLAN_BACKGROUND_COMPILE`` is ``0``;
-    later calls load it once that process is done (:meth:`speedplan.core.jit.Kernels.ready`).
+    later calls load it once that process is done (`speedplan.core.jit.Kernels.ready`).
     """
     return KERNELS.ready(start=start)
 
@@ -386,7 +386,7 @@ def kernel_ready(*, start: bool = True) -> bool:
 def kernel_for_auto(*, wait: bool) -> bool:
     """Whether ``backend="auto"`` should use the banded kernel now.
 
-    True when it is available (:func:`kernel_ready`, which starts a background compilation
+    True when it is available (`kernel_ready`, which starts a background compilation
     if needed), or after compiling it here when ``wait`` is true or background compilation
     is off (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could be started).
     """
@@ -409,7 +409,7 @@ def ramp_steps(problem: DiscreteProblem) -> float:
     Node ``i``'s jerk row lets ``w'`` change by at most ``r_i = J_i τ_i / sqrt(w_i)`` per
     step (``|w''| sqrt(w) <= J``), fewest at the fastest feasible ``w``. From node ``i`` on,
     count the steps until the ``r`` add up to ``max(A, D)`` there; a node without a jerk row
-    ends the count. Invariant under :meth:`DiscreteProblem.scaled`.
+    ends the count. Invariant under [`DiscreteProblem.scaled`][speedplan.DiscreteProblem].
     """
     finite = np.isfinite(problem.jerk)
     if problem.n < 3 or not finite.any():
@@ -424,9 +424,9 @@ def ramp_steps(problem: DiscreteProblem) -> float:
 
 
 def check_grid_resolvable(problem: DiscreteProblem) -> None:
-    """Raise :class:`InvalidInputError` if the grid is too fine for the relaxation to resolve.
+    """Raise `InvalidInputError` if the grid is too fine for the relaxation to resolve.
 
-    See :data:`MAX_RAMP_STEPS`; the message gives the finest step supported for these bounds.
+    See `MAX_RAMP_STEPS`; the message gives the finest step supported for these bounds.
 
     Examples
     --------
@@ -459,7 +459,7 @@ def check_grid_resolvable(problem: DiscreteProblem) -> None:
 def unit_scales(problem: DiscreteProblem) -> tuple[float, float]:
     """``(s_scale, w_scale)`` of the relaxation's units: unit mean step and ``w_max <= 1``.
 
-    :func:`~speedplan.solve.solve_problem` hands every relaxation backend
+    `solve_problem` hands every relaxation backend
     ``problem.scaled(*unit_scales(problem))``.
     """
     return float(np.mean(problem.h)), float(np.max(problem.w_max))
@@ -530,11 +530,11 @@ def solve_relaxation_banded(
 def solve_unit_relaxation(
     unit: DiscreteProblem, *, tol: float = 1e-8, max_iter: int = MAX_ITERATIONS
 ) -> RelaxationResult:
-    """:func:`solve_relaxation_banded` of a problem already in units and checked.
+    """`solve_relaxation_banded` of a problem already in units and checked.
 
-    ``unit`` is in the units of :func:`unit_scales` (``w_max <= 1``, unit mean step) and its
-    boundary values are reachable (:func:`~speedplan.solve.nojerk.check_reachable`), as
-    :func:`~speedplan.solve.solve_problem` hands it to every relaxation backend; results are
+    ``unit`` is in the units of `unit_scales` (``w_max <= 1``, unit mean step) and its
+    boundary values are reachable (`check_reachable`), as
+    `solve_problem` hands it to every relaxation backend; results are
     in the same units.
     """
     t_start = time.perf_counter()

@@ -18,9 +18,9 @@ plain ones, ``(c · w) sqrt(w_i) ∈ [-B_i, B_i]``. The answer is re-checked by 
 never trusted.
 
 Each iteration's array work (rows, condensed matrix and its factor, direction, step rules,
-errors, barrier) runs in compiled kernels (:mod:`speedplan.solve._banded_nlp_kernels`, numba)
+errors, barrier) runs in compiled kernels (`speedplan.solve._banded_nlp_kernels`, numba)
 once they are in numba's cache, and in the numpy methods below until then (a background
-process compiles them meanwhile, see :func:`nlp_kernels_ready`); the control flow is the same
+process compiles them meanwhile, see `nlp_kernels_ready`); the control flow is the same
 code for both.
 """
 
@@ -91,7 +91,7 @@ class Start:
     gradient_scaling: bool
 
 
-#: The starts :func:`speedplan.solve.refine.refine` runs, in this order, each a different path
+#: The starts `speedplan.solve.refine.refine` runs, in this order, each a different path
 #: to a local optimum (the problem is nonconvex). ``near`` and ``nearer`` stay close to the
 #: relaxed ``w`` (small push, small first barrier parameter); ``ipopt-default`` is IPOPT's
 #: default start and scaling, slower, and it reaches feasibility where the near starts stall.
@@ -107,7 +107,7 @@ STARTS = (
 #: near starts stall there: on the 88 refinements of ``benchmarks/lateral_exactness.py
 #: --cases 40`` ``near`` ended at the iteration limit on 39 and ``nearer`` on 64, while both
 #: scaled starts (``scaled`` is IPOPT's start and scaling with the first barrier parameter of
-#: ``near``) were accepted on 87 and agreed to :data:`~speedplan.solve.refine.AGREE` on 86, there
+#: ``near``) were accepted on 87 and agreed to `AGREE` on 86, there
 #: within 4e-8 of the best of all four starts. The near starts remain the safeguard when
 #: the scaled ones disagree or fail.
 LATERAL_STARTS = (
@@ -120,7 +120,7 @@ LATERAL_STARTS = (
 
 @dataclass(frozen=True)
 class BandedNlpResult:
-    """Raw result of :func:`solve_banded_nlp` (``w`` on the full grid, problem units).
+    """Raw result of `solve_banded_nlp` (``w`` on the full grid, problem units).
 
     Attributes
     ----------
@@ -664,7 +664,7 @@ class _FastEval(NamedTuple):
 
 
 class _FastRows:
-    """:class:`_Rows` (scaled as it is) with the family rows flattened for the kernels."""
+    """`_Rows` (scaled as it is) with the family rows flattened for the kernels."""
 
     def __init__(self, rows: _Rows, kernels: ModuleType) -> None:
         self.rows, self.kn = rows, kernels
@@ -693,7 +693,7 @@ class _FastRows:
 
 
 class _FastPhase(_Phase):
-    """:class:`_Phase` with each step's array work done by the compiled kernels.
+    """`_Phase` with each step's array work done by the compiled kernels.
 
     Same method, same formulas (the kernels' module docstring); only the rounding of sums
     differs. ``objective`` is given as the kernels' ``(mode, a, b)``.
@@ -823,14 +823,14 @@ def _elastic_split(r: FloatArray, a: float) -> tuple[FloatArray, FloatArray]:
 # --- the compiled kernels: load from numba's cache, or compile in the background ------------
 
 
-#: The compiled kernels' family (:mod:`speedplan.core.jit` loads, compiles or starts it).
+#: The compiled kernels' family (`speedplan.core.jit` loads, compiles or starts it).
 KERNELS = FAMILIES["refinement"]
 
 
 def compile_nlp_kernels() -> None:
     """Make the compiled kernels available in this process now: load them, or compile them.
 
-    :func:`solve_banded_nlp` uses its numpy path until they are (:func:`nlp_kernels_ready`).
+    `solve_banded_nlp` uses its numpy path until they are (`nlp_kernels_ready`).
 
     Examples
     --------
@@ -857,7 +857,7 @@ def nlp_kernels_ready(*, start: bool = True) -> bool:
     Returns
     -------
     bool
-        Whether :func:`solve_banded_nlp` uses the compiled kernels now.
+        Whether `solve_banded_nlp` uses the compiled kernels now.
 
     Examples
     --------
@@ -869,7 +869,7 @@ def nlp_kernels_ready(*, start: bool = True) -> bool:
 
 
 def _kernels() -> ModuleType | None:
-    """The kernels module if it is available now (see :func:`nlp_kernels_ready`).
+    """The kernels module if it is available now (see `nlp_kernels_ready`).
 
     Without background compilation (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could
     be started) they are compiled here, as the relaxation's kernel is.
@@ -887,18 +887,18 @@ def solve_banded_nlp(
     ----------
     problem : DiscreteProblem
         The problem, best in units where ``max(w_max) = 1`` and the mean step is 1 (as
-        :func:`speedplan.solve.solve_problem` passes it).
+        `speedplan.solve.solve_problem` passes it).
     w0 : ndarray, shape (n,)
         Start (the relaxed ``w``); clipped into the bounds.
     start : Start
-        One of :data:`STARTS`.
+        One of `STARTS`.
     max_iter : int
         Iteration limit, restoration included.
     compiled : bool, optional
         Do each iteration's array work in the compiled kernels
-        (:mod:`speedplan.solve._banded_nlp_kernels`, compiling them here if needed) or in
+        (`speedplan.solve._banded_nlp_kernels`, compiling them here if needed) or in
         numpy; by default the kernels when they are available without compiling (see
-        :func:`nlp_kernels_ready`), numpy otherwise. Same method either way.
+        `nlp_kernels_ready`), numpy otherwise. Same method either way.
 
     Returns
     -------

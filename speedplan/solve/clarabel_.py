@@ -6,7 +6,7 @@ cones per node: ``z² <= w`` as ``||(2z, w - 1)|| <= w + 1`` and ``t z >= τ`` a
 ``||(2 sqrt(τ), t - z)|| <= t + z`` (one cone fewer than the paper's three). The whole matrix is
 assembled with vectorised numpy in COO form.
 
-Friction-ellipse rows (:attr:`DiscreteProblem.grip`) add one variable per cell, ``u_i`` at
+Friction-ellipse rows (`DiscreteProblem.grip`) add one variable per cell, ``u_i`` at
 least the cell's acceleration and braking as fractions of their limits (two linear rows),
 and two 3-D cones per cell, ``||(u_i, g_j w_j)|| <= 1`` at either end ``j``.
 """
@@ -182,7 +182,7 @@ def _grip_cones(grip: FloatArray, iw: int, iu: int
 
 
 def default_settings() -> clarabel.DefaultSettings:
-    """Clarabel settings used by :func:`solve_relaxation` (printing off, default tolerances)."""
+    """Clarabel settings used by `solve_relaxation` (printing off, default tolerances)."""
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.max_iter = 200
@@ -198,7 +198,7 @@ def retry_settings() -> clarabel.DefaultSettings:
 
 
 def _within_deadline(settings: clarabel.DefaultSettings) -> clarabel.DefaultSettings:
-    """``settings`` stopping at the plan's deadline, if any (:mod:`~speedplan.core.deadline`)."""
+    """``settings`` stopping at the plan's deadline, if any (`deadline`)."""
     left = remaining()
     if left is not None:
         settings.time_limit = min(float(settings.time_limit), left)

@@ -30,7 +30,7 @@ from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 __all__ = ["BACKENDS", "REFINE_MODES", "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
 
 #: Relaxation backends by name; each maps a problem in the units of
-#: :func:`~speedplan.solve.banded.unit_scales`, boundary values checked, to a RelaxationResult.
+#: `unit_scales`, boundary values checked, to a RelaxationResult.
 RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = {
     "clarabel": solve_relaxation,
     "banded": solve_unit_relaxation,
@@ -40,7 +40,7 @@ RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = 
 #: milliseconds and Clarabel, the reference, is used.
 AUTO_BANDED_FROM = 100
 #: Until the banded kernel is compiled (first use after installation, 20-30 s; see
-#: :func:`~speedplan.solve.banded.kernel_ready`), ``"auto"`` answers with Clarabel below this
+#: `kernel_ready`), ``"auto"`` answers with Clarabel below this
 #: many nodes while a background process compiles it; from this size on Clarabel would take
 #: about as long as the compilation (16 s at 10^5 nodes), so ``"auto"`` waits for it.
 AUTO_WAIT_FROM = 100_000
@@ -69,7 +69,7 @@ def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArr
 
 
 def _auto_backend(problem: DiscreteProblem) -> str:
-    """``backend="auto"``: banded from :data:`AUTO_BANDED_FROM` nodes on, once it is compiled.
+    """``backend="auto"``: banded from `AUTO_BANDED_FROM` nodes on, once it is compiled.
 
     Friction-ellipse rows are Clarabel's alone (the banded kernel holds no cone of them).
     """
@@ -124,16 +124,16 @@ def solve_problem(
     problem: DiscreteProblem, *, refine: str = "auto", backend: str = "clarabel",
     fallback: bool = True,
 ) -> DiscreteSolution:
-    """Solve a validated :class:`DiscreteProblem` (any grid) and certify the result.
+    """Solve a validated `DiscreteProblem` (any grid) and certify the result.
 
     If the relaxation backend fails, the other one is tried, unless ``fallback`` is False
-    (:func:`speedplan.plan` first tries a coarser default grid with the same backend).
+    ([`speedplan.plan`][speedplan.plan] first tries a coarser default grid with the same backend).
 
     Raises
     ------
     InvalidInputError
         If the grid is finer than the relaxation can resolve for these jerk bounds
-        (:func:`~speedplan.solve.banded.check_grid_resolvable`).
+        (`check_grid_resolvable`).
     InfeasibleError
         If the boundary values cannot be met.
     SolverError
@@ -290,9 +290,9 @@ def solve_discrete(
         warns).
     backend : {"auto", "clarabel", "banded"}
         Relaxation backend: Clarabel (reference), the structure-exploiting banded
-        interior-point method, or ``"auto"`` (banded from :data:`AUTO_BANDED_FROM` nodes on;
+        interior-point method, or ``"auto"`` (banded from `AUTO_BANDED_FROM` nodes on;
         Clarabel while the banded kernel is being compiled on first use, see
-        :func:`~speedplan.solve.banded.kernel_ready`).
+        `kernel_ready`).
 
     Returns
     -------

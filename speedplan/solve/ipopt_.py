@@ -2,9 +2,9 @@
 
 Started from the relaxed ``w``, IPOPT searches a feasible point of the true problem with
 jerk-type rows ``|c_i · w_{i-1:i+2}| sqrt(w_i) <= B_i``. Its answer is re-checked by our own
-code (:meth:`DiscreteProblem.jerk_violation`, :meth:`DiscreteProblem.linear_violation`), never
-trusted. :func:`speedplan.solve.refine.refine` runs it when the banded interior-point method
-(:mod:`speedplan.solve.banded_nlp`) returns no acceptable point.
+code (`DiscreteProblem.jerk_violation`, `DiscreteProblem.linear_violation`), never
+trusted. `speedplan.solve.refine.refine` runs it when the banded interior-point method
+(`speedplan.solve.banded_nlp`) returns no acceptable point.
 """
 
 from __future__ import annotations
@@ -50,11 +50,11 @@ class RefineResult:
     w : ndarray, shape (n,)
         The refined point, ends included.
     status : str
-        The solver's status: IPOPT's return status from :func:`refine_ipopt`; from
-        :func:`~speedplan.solve.refine.refine`, the solver that produced ``w`` and its status,
+        The solver's status: IPOPT's return status from `refine_ipopt`; from
+        `refine`, the solver that produced ``w`` and its status,
         e.g. ``"banded/near: Solved"`` or ``"ipopt: Solve_Succeeded"``.
     success : bool
-        Whether the solver converged (and, from :func:`~speedplan.solve.refine.refine`,
+        Whether the solver converged (and, from `refine`,
         whether the caller's acceptance test passed).
     iterations : int
         Iterations, summed over every run made.

@@ -33,7 +33,7 @@ def max_feasible_w(problem: DiscreteProblem, *, pin_ends: bool = True) -> FloatA
     """Largest ``w`` meeting the bounds and the acceleration/braking rows.
 
     With ``pin_ends`` the end values are capped at ``w_start`` and ``w_end``; the result then
-    equals them exactly when the boundary values are reachable (see :func:`check_reachable`).
+    equals them exactly when the boundary values are reachable (see `check_reachable`).
 
     Examples
     --------
@@ -54,7 +54,7 @@ def max_feasible_w(problem: DiscreteProblem, *, pin_ends: bool = True) -> FloatA
 
 
 def positive_feasible_w(problem: DiscreteProblem) -> FloatArray:
-    """:func:`max_feasible_w`; :class:`InfeasibleError` unless it is positive inside.
+    """`max_feasible_w`; `InfeasibleError` unless it is positive inside.
 
     With jerk rows the travel time of a ``w`` that vanishes at an interior node is infinite,
     and no solver can find a finite one there: a zero speed bound inside, or bounds and
@@ -113,7 +113,7 @@ def min_feasible_w(problem: DiscreteProblem) -> FloatArray:
 
 
 def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
-    """Raise :class:`InfeasibleError` if ``w_start`` / ``w_end`` cannot be met.
+    """Raise `InfeasibleError` if ``w_start`` / ``w_end`` cannot be met.
 
     The message names the bound that cannot be reached and where (grid position ``s``).
     """

@@ -59,7 +59,7 @@ class StencilRows:
     bound: FloatArray
 
     def scaled(self, s_scale: float, w_scale: float) -> StencilRows:
-        """The rows in units ``s/s_scale`` and ``w/w_scale`` (as :meth:`DiscreteProblem.scaled`)."""
+        """The rows in units ``s/s_scale`` and ``w/w_scale`` (as `DiscreteProblem.scaled`)."""
         return StencilRows(coef=self.coef * s_scale**2,
                            bound=self.bound * s_scale**2 / w_scale**1.5)
 
@@ -150,7 +150,7 @@ class DiscreteProblem:
 
     @property
     def has_grip(self) -> bool:
-        """Whether the problem has friction-ellipse rows (:attr:`grip`)."""
+        """Whether the problem has friction-ellipse rows ([`grip`][speedplan.DiscreteProblem])."""
         return self.grip is not None
 
     def grip_load(self, w: FloatArray) -> FloatArray:
@@ -285,7 +285,7 @@ class DiscreteProblem:
 
     @cached_property
     def jerk_tol(self) -> float:
-        """Exactness threshold on :meth:`jerk_violation`: ``1e-7 × max(w_max)``."""
+        """Exactness threshold on `jerk_violation`: ``1e-7 × max(w_max)``."""
         return JERK_TOL_REL * max(float(np.max(self.w_max)), self.w_start, self.w_end)
 
     def jerk_violation(self, w: FloatArray) -> float:

@@ -1,13 +1,13 @@
 """The refinement step: a feasible point of the original problem near the relaxed ``w``.
 
-:func:`refine` runs the banded interior-point method (:mod:`speedplan.solve.banded_nlp`) from
-each of its :data:`~speedplan.solve.banded_nlp.STARTS` and keeps the best point the caller's
+`refine` runs the banded interior-point method (`speedplan.solve.banded_nlp`) from
+each of its `STARTS` and keeps the best point the caller's
 acceptance test passes; only when none passes does it run IPOPT
-(:func:`~speedplan.solve.ipopt_.refine_ipopt`). The problem is nonconvex, so different starts
+(`refine_ipopt`). The problem is nonconvex, so different starts
 can end in different local optima (up to 3 % apart on the benchmark corpus): the best of the
 starts is the safeguard. Each run costs a few milliseconds per thousand nodes, and the last
 start is skipped when the first two agree. Problems with lateral-jerk rows run
-:data:`~speedplan.solve.banded_nlp.LATERAL_STARTS` instead (the scaled starts first).
+`LATERAL_STARTS` instead (the scaled starts first).
 """
 
 from __future__ import annotations
@@ -40,20 +40,20 @@ def refine(
     Parameters
     ----------
     problem : DiscreteProblem
-        The problem, best in the units :func:`~speedplan.solve.banded_nlp.solve_banded_nlp`
+        The problem, best in the units `solve_banded_nlp`
         asks for.
     w0 : ndarray, shape (n,)
         The relaxed ``w``.
     accept : callable, optional
         ``accept(w) -> bool``, the caller's feasibility test of a candidate ``w`` (full grid,
         problem units). By default a candidate must meet the rows within
-        :attr:`DiscreteProblem.jerk_tol` and its bounds to ``1e-9 max(w_max)``.
+        `DiscreteProblem.jerk_tol` and its bounds to ``1e-9 max(w_max)``.
 
     Returns
     -------
     RefineResult
         The accepted candidate of least travel time, ``success=True`` (the starts are run in
-        order until two accepted ones agree to :data:`AGREE`); if none is accepted, the last
+        order until two accepted ones agree to `AGREE`); if none is accepted, the last
         candidate with ``success=False``. ``status`` names the solver and its start,
         ``iterations`` and ``solve_time`` cover every run.
 

@@ -12,7 +12,7 @@ __all__ = ["STATUSES", "DiscreteSolution", "RefinementInfo", "RelaxationInfo", "
 #: ``DiscreteSolution.status``: a closed set of values.
 Status = Literal["optimal", "refined", "scaled", "relaxed"]
 
-#: What each :data:`Status` means.
+#: What each `Status` means.
 STATUSES: dict[str, str] = {
     "optimal": "globally optimal: the relaxation is exact (or there are no jerk rows)",
     "refined": "feasible local optimum from IPOPT; the optimum lies in [lower_bound, objective]",
@@ -103,7 +103,7 @@ class DiscreteSolution:
     refined : bool
         Whether the nonconvex refinement ran.
     status : str
-        One of :data:`STATUSES`.
+        One of `STATUSES`.
     solve_time : float
         Wall time of the whole solve [s].
     backend : str
@@ -137,7 +137,7 @@ class DiscreteSolution:
 
     @property
     def message(self) -> str:
-        """What :attr:`status` means."""
+        """What [`status`][speedplan.DiscreteSolution] means."""
         return STATUSES[self.status]
 
     def __repr__(self) -> str:

@@ -1,8 +1,8 @@
 """The time law's quadrature, inversion and kinematics in numpy.
 
-The interface of :mod:`speedplan.core._law_kernel`, the compiled version.
+The interface of `speedplan.core._law_kernel`, the compiled version.
 
-Used until numba's compiled code can run without compiling (:func:`backend`): the first
+Used until numba's compiled code can run without compiling (`backend`): the first
 ``plan()`` of a fresh environment answers with Clarabel while a background process compiles
 the banded kernel, and compiling the time-law kernel in the foreground too would cost it
 seconds. The two agree to rounding (``tests/test_timing_law.py``
@@ -27,7 +27,7 @@ def backend() -> ModuleType:
 
     Only once numba is loaded for the relaxation's kernel (a process that plans only without
     jerk never loads it); then the time law's kernel loads from numba's cache in ~20 ms, or
-    a background process compiles it (:mod:`speedplan.core.jit`, family ``"time law"``) and
+    a background process compiles it (`speedplan.core.jit`, family ``"time law"``) and
     numpy answers meanwhile.
     """
     from ..core.jit import FAMILIES

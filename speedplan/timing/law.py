@@ -39,7 +39,7 @@ A last, local correction (piecewise quadratic over the final stretch, curvature
 smoothing would cost the speed bound: where the discrete ``w`` bends upwards (braking onto a
 bound step, at a corner) the dual-cell law rises above both adjacent nodes over the half cell
 after the kink, by up to an eighth of the neighbour's excess, so the node bounds (the
-minimum of ``mu+`` over the two adjacent cells, :func:`speedplan.model.build.node_bounds`)
+minimum of ``mu+`` over the two adjacent cells, `speedplan.model.build.node_bounds`)
 no longer keep it under the bound. The law is then ``w`` linear on each cell (``linear=True``,
 constant acceleration per cell as in the discrete problem): it passes through every node, lies
 on the chord, so under ``mu+`` wherever both ends are, and its time is the discrete problem's
@@ -48,8 +48,8 @@ on each piece): no quadrature and no compiled kernel, so a process that plans on
 jerk limit never loads numba (loading the cached kernel costs ~1 s in a fresh process).
 
 Everything is a chain of quadratic pieces in ``w`` or ``u``: speed, acceleration and jerk
-follow in closed form, their extremes over each piece too (:meth:`TimeLaw.extremes`, what
-:meth:`SpeedProfile.verify` checks), and ``t(s) = ∫ ds / v`` by Gauss–Legendre quadrature
+follow in closed form, their extremes over each piece too (`TimeLaw.extremes`, what
+`SpeedProfile.verify` checks), and ``t(s) = ∫ ds / v`` by Gauss–Legendre quadrature
 (with the substitutions ``σ = y²`` and ``σ = y³`` on pieces ending at standstill, where the
 integrand is singular).
 """
@@ -182,7 +182,7 @@ class TimeLaw:
         """Build the pieces region by region, with every node offset local.
 
         1. Each region (leading ``u``, middle ``w``, trailing ``u``) is built by
-           :func:`_fill_region` from its first knot's slope (the start slope, or the previous
+           `_fill_region` from its first knot's slope (the start slope, or the previous
            region's end slope converted).
         2. The ``w``-region is anchored: its node offsets telescope to the local terms
            ``c⁺_k h_k² / 8`` plus one constant, which is removed (a uniform shift of the
@@ -190,7 +190,7 @@ class TimeLaw:
            the junction through a parabola added to it (its start slope at rest is free:
            the acceleration is 0 at ``u = 0`` whatever ``u'``); a moving start keeps its
            exact value and slope and takes the shift through a short window of two opposite
-           curvatures (:func:`_shift_after`).
+           curvatures (`_shift_after`).
         3. A trailing ``u``-region reaches ``u = 0`` through a parabola added to it; a moving
            end takes its exact value through a window at the end.
         """
@@ -316,7 +316,7 @@ class TimeLaw:
 
         The three broadcast together. Each piece is evaluated from the nearer knot: accurate
         relative to its own size next to a standstill, where ``y`` tends to 0. Compiled
-        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded); a ``linear`` law
+        (`speedplan.core._law_kernel`; numpy before numba is loaded); a ``linear`` law
         is two lines of numpy.
         """
         if self.linear:
@@ -393,7 +393,7 @@ class TimeLaw:
         relative precision. A stretch that starts at a standstill end is integrated with
         ``σ = y²`` (``w`` linear there, ``1/v ~ σ^{-1/2}``) or ``σ = y³`` (``u`` linear,
         ``1/v ~ σ^{-2/3}``): the integrand becomes smooth. Compiled
-        (:mod:`speedplan.core._law_kernel`; numpy before numba is loaded).
+        (`speedplan.core._law_kernel`; numpy before numba is loaded).
         """
         right = np.zeros(j.shape, dtype=bool) if from_right is None else from_right
         if self.linear:  # w linear: 2 (hi - lo) / (v(lo) + v(hi)), from the anchoring knot
@@ -455,7 +455,7 @@ class TimeLaw:
 
         A ``w``-piece moving at both ends, whose knot times the 16-point rule computes to
         rounding: the nearest root of ``w`` lies outside the Bernstein ellipse of parameter
-        :data:`EXACT_RULE_RHO` around the piece (the rule's error on ``1/sqrt(w)`` then falls
+        `EXACT_RULE_RHO` around the piece (the rule's error on ``1/sqrt(w)`` then falls
         as ``ρ^{-32}``). Elsewhere the inversion iterates on the rule itself, which keeps the
         sampled positions continuous at the knots the rule placed (the exact offset would
         jump there where the rule is off). On ``plan()``'s grids the moving pieces have
@@ -472,14 +472,14 @@ class TimeLaw:
 
         On a ``w``-piece moving at both ends, the exact solution of ``dσ/dτ = sqrt(w)``
         (closed form in ``sinh`` or ``sin``, from the knot nearer in time;
-        :attr:`_exact_inverse`). Elsewhere a safeguarded Newton iteration on the time
+        `_exact_inverse`). Elsewhere a safeguarded Newton iteration on the time
         within each piece, in the offset from the piece's standstill end when it has one (else
         from its left knot): next to a stop the offset keeps full relative precision, where
         an arc length near a long path's end would be quantised to 1e-16 of the path (and
         the speed with it). It starts from the piece's own power law (``σ = τ³`` in ``u``,
         ``τ²`` in ``w`` at a standstill, else linear, or in the compiled kernel the
         third-order kinematic expansion at the left knot); Newton steps are kept only inside
-        the bracket, bisection otherwise. Compiled (:mod:`speedplan.core._law_kernel`; numpy
+        the bracket, bisection otherwise. Compiled (`speedplan.core._law_kernel`; numpy
         before numba is loaded).
         """
         p = self._pieces
@@ -502,7 +502,7 @@ class TimeLaw:
         return q, w, v, a, jerk
 
     def position_at(self, t: FloatArray) -> FloatArray:
-        """Arc length ``s(t)`` at times ``t`` [m] (see :meth:`state_at`)."""
+        """Arc length ``s(t)`` at times ``t`` [m] (see `state_at`)."""
         return self.state_at(t)[0]
 
 
@@ -619,7 +619,7 @@ def _shift_after(x: FloatArray, c: FloatArray, g: FloatArray, y: FloatArray, p0:
                  shift: float, *, start: bool) -> None:
     """Shift the values by ``shift`` through a window at the start (end) of ``p0 .. p1``.
 
-    Curvatures ``+c1`` then ``-c2`` over the window (:data:`_END_WINDOW` pieces, or the
+    Curvatures ``+c1`` then ``-c2`` over the window (`_END_WINDOW` pieces, or the
     region if shorter) change the value by ``shift`` and leave the slope at its far end
     unchanged; at the start, the values after the window move by ``shift``; at the end, the
     window ends on the exact end value. The added curvature is ``O(shift / window²)``.
@@ -652,7 +652,7 @@ class LawChain:
     """Laws of consecutive legs that meet at rest, as one law along the whole path.
 
     Leg ``i`` covers ``[offsets[i], offsets[i] + laws[i].length]`` of the path and starts at
-    time ``start_times[i]``; every method of :class:`TimeLaw` is available with the path's arc
+    time ``start_times[i]``; every method of `TimeLaw` is available with the path's arc
     length and the time from the start of the first leg.
 
     Examples
@@ -717,7 +717,7 @@ class LawChain:
 
     def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
                                                 FloatArray]:
-        """``s, w, v, a, jerk`` at times ``t`` (see :meth:`TimeLaw.state_at`)."""
+        """``s, w, v, a, jerk`` at times ``t`` (see `TimeLaw.state_at`)."""
         t = np.atleast_1d(np.clip(np.asarray(t, dtype=np.float64), 0.0, self.duration))
         leg = np.clip(np.searchsorted(self.start_times, t, side="right") - 1, 0,
                       len(self.laws) - 1)

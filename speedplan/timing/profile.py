@@ -34,7 +34,7 @@ MAX_SAMPLES = 50_000_000
 #: ``SpeedProfile.status``: the solution statuses, and one that says the limits are exceeded.
 ProfileStatus = Literal["optimal", "refined", "scaled", "relaxed", "limits_exceeded"]
 
-#: What each :data:`ProfileStatus` means.
+#: What each `ProfileStatus` means.
 PROFILE_STATUSES: dict[str, str] = {
     **SOLUTION_STATUSES,
     "limits_exceeded": "the continuous trajectory exceeds a limit beyond its tolerance even "
@@ -106,7 +106,7 @@ def combine(solutions: list[DiscreteSolution]) -> DiscreteSolution:
 class SpeedProfile:
     """Minimum-time speed law along a path, with its certificate and time law.
 
-    Built by :func:`speedplan.plan`; not usually constructed by hand. A path with cusps, or a
+    Built by `speedplan.plan`; not usually constructed by hand. A path with cusps, or a
     boundary state that forces a stop on the way, is planned as several *legs* that meet at
     rest (``legs``); every array here covers the whole path.
 
@@ -121,17 +121,17 @@ class SpeedProfile:
     speed_bound : callable
         ``s -> mu+(s)``, the squared-speed bound from limits, curvature and zones [m²/s²].
     request : PlanRequest or None
-        The validated arguments :func:`speedplan.plan` was called with.
+        The validated arguments [`speedplan.plan`][speedplan.plan] was called with.
     verification : Verification or None
-        The check :func:`speedplan.plan` ran.
+        The check [`speedplan.plan`][speedplan.plan] ran.
     limits_exceeded : bool
-        Whether that check still failed after local refinement (then :attr:`status` is
+        Whether that check still failed after local refinement (then `status` is
         ``"limits_exceeded"``).
     attempts : tuple of Attempt
-        The attempts of the planning strategy, in order (:mod:`speedplan.strategy`): for
+        The attempts of the planning strategy, in order (`speedplan.strategy`): for
         the request and for each leg, which one answered (``outcome == "answered"``) and
         why each other failed or was replaced
-        (:class:`~speedplan.core.attempts.Attempt`). Empty for a profile built by hand.
+        ([`Attempt`][speedplan.core.attempts.Attempt]). Empty for a profile built by hand.
     objective : float
         Discrete objective ``Σ τ_i / sqrt(w_i)`` that the solver minimised [s].
     lower_bound : float
@@ -198,12 +198,12 @@ class SpeedProfile:
 
     @property
     def status(self) -> ProfileStatus:
-        """One of :data:`PROFILE_STATUSES`: the solution's, or ``"limits_exceeded"``."""
+        """One of `PROFILE_STATUSES`: the solution's, or ``"limits_exceeded"``."""
         return "limits_exceeded" if self.limits_exceeded else self.solution.status
 
     @property
     def message(self) -> str:
-        """What :attr:`status` means."""
+        """What [`status`][speedplan.SpeedProfile.status] means."""
         return PROFILE_STATUSES[self.status]
 
     # ---- sampling in time -------------------------------------------------------------------
@@ -239,7 +239,7 @@ class SpeedProfile:
     def sample(self, dt: float = 0.01) -> Trajectory:
         """Trajectory sampled every ``dt`` seconds from 0; the last sample is at ``duration``.
 
-        Its ``metadata`` records how it was made (:attr:`metadata`, and ``dt``), so an exported
+        Its ``metadata`` records how it was made (`metadata`, and ``dt``), so an exported
         file can be interpreted later.
 
         Parameters
@@ -265,7 +265,7 @@ class SpeedProfile:
 
         Keys: ``speedplan_version``, ``status``, ``duration`` [s], ``objective`` and
         ``lower_bound`` [s], ``gap``, ``grid_nodes``, ``backend``, ``refined``, ``limits``,
-        and, for a profile from :func:`speedplan.plan`, ``boundary`` (``v0``, ``a0``, ``vf``,
+        and, for a profile from `speedplan.plan`, ``boundary`` (``v0``, ``a0``, ``vf``,
         ``af``) and ``standstill``.
         """
         meta: dict[str, Any] = {
@@ -288,7 +288,7 @@ class SpeedProfile:
 
     # ---- checks ---------------------------------------------------------------------------
     def verify(self) -> Verification:
-        """Compare the continuous trajectory with the limits (see :mod:`speedplan.timing.verify`).
+        """Compare the continuous trajectory with the limits (see `speedplan.timing.verify`).
 
         Acceleration and jerk: exact extremes of every piece of the law. Speed bound, lateral
         acceleration, yaw rate and lateral jerk: at 8 points per grid cell, at each piece's
@@ -306,7 +306,7 @@ class SpeedProfile:
 
     @cached_property
     def _bound_breaks(self) -> FloatArray:
-        """Breakpoints of the speed bound (:func:`bound_breakpoints`), once for every leg."""
+        """Breakpoints of the speed bound (`bound_breakpoints`), once for every leg."""
         return bound_breakpoints(self.path, self.speed_bound)
 
     def __repr__(self) -> str:
@@ -317,7 +317,7 @@ class SpeedProfile:
 
 
 def law_for(s: FloatArray, w: FloatArray, spec: Any) -> TimeLaw:
-    """The :class:`TimeLaw` of a leg's solution under its :class:`~speedplan.model.TimeLawSpec`."""
+    """The `TimeLaw` of a leg's solution under its `TimeLawSpec`."""
     return TimeLaw(s, w, accel_start=spec.accel_start, accel_end=spec.accel_end,
                    j_max=spec.j_max, linear=spec.linear)
 

@@ -1,6 +1,6 @@
 """A time-sampled trajectory and its export to CSV, JSON and plain arrays.
 
-Every writer iterates over :data:`COLUMNS`, the single list of columns and their units: a
+Every writer iterates over `COLUMNS`, the single list of columns and their units: a
 column added there is exported everywhere.
 """
 
@@ -146,7 +146,7 @@ def _comment_value(value: Any) -> str:
 def text_output(file: TextFile, what: str) -> Iterator[IO[str]]:
     """An open text handle: ``file`` itself when it has ``write``, else the file it names.
 
-    A missing directory or an unwritable file raises :class:`InvalidInputError` naming
+    A missing directory or an unwritable file raises `InvalidInputError` naming
     ``what`` is being written and where.
     """
     if hasattr(file, "write"):
@@ -186,8 +186,8 @@ class Trajectory:
 
     Notes
     -----
-    The exports (:meth:`to_csv`, :meth:`to_json`) write the heading wrapped to ``[-π, π)``,
-    the yaw convention of ROS and most controllers; :meth:`to_dict` and the attribute keep
+    The exports (`to_csv`, `to_json`) write the heading wrapped to ``[-π, π)``,
+    the yaw convention of ROS and most controllers; `to_dict` and the attribute keep
     it continuous, which is what differentiating or interpolating it needs.
     """
 
@@ -221,13 +221,13 @@ class Trajectory:
     def units(self) -> dict[str, str]:
         """Column names with their units, in export order.
 
-        :data:`COLUMNS`; a subclass such as :class:`speedplan.route.RouteTrajectory` appends
+        `COLUMNS`; a subclass such as `speedplan.route.RouteTrajectory` appends
         its own.
         """
         return dict(COLUMNS)
 
     def to_dict(self) -> dict[str, FloatArray]:
-        """Arrays by column name, heading continuous (see :attr:`units`)."""
+        """Arrays by column name, heading continuous (see [`units`][speedplan.Trajectory.units])."""
         return {name: getattr(self, name) for name in self.units}
 
     def _export_columns(self) -> dict[str, FloatArray]:
@@ -249,7 +249,7 @@ class Trajectory:
         significant digits instead (smaller files, values rounded). The heading is wrapped to
         ``[-π, π)``. Metadata values
         that are not strings are JSON (``null`` for an absent limit). To read the file:
-        :func:`speedplan.io.read_trajectory`, ``pandas.read_csv(f, comment="#")``, or in
+        `speedplan.io.read_trajectory`, ``pandas.read_csv(f, comment="#")``, or in
         plain numpy skip the ``#`` lines and the header (``numpy.genfromtxt(names=True)``
         would take the first comment line for the header).
 
@@ -307,12 +307,12 @@ class Trajectory:
         Parameters
         ----------
         file : str, os.PathLike or text file object, optional
-            Where to write, as for :meth:`to_csv`; by default only the string is returned.
+            Where to write, as for `to_csv`; by default only the string is returned.
 
         Raises
         ------
         InvalidInputError
-            As :meth:`to_csv` raises it, when ``file`` cannot be written.
+            As [`to_csv`][speedplan.Trajectory.to_csv] raises it, when ``file`` cannot be written.
 
         Examples
         --------

@@ -1,13 +1,13 @@
 """Measure a planned law against its limits, piece by piece.
 
-The law is a chain of quadratic pieces (:mod:`speedplan.timing.law`), so the extremes of
-acceleration and jerk over each piece are exact closed forms (:meth:`TimeLaw.extremes`):
+The law is a chain of quadratic pieces (`speedplan.timing.law`), so the extremes of
+acceleration and jerk over each piece are exact closed forms (`TimeLaw.extremes`):
 nothing between samples can escape. What depends on the path — the speed bound (curvature,
 zones, ``v_limit``), lateral acceleration ``κ v²``, yaw rate ``κ v`` and lateral jerk
-``v (κ' w + 2 κ a)`` — is evaluated at :data:`SAMPLES_PER_PIECE` points of every piece
+``v (κ' w + 2 κ a)`` — is evaluated at `SAMPLES_PER_PIECE` points of every piece
 (both ends included: 8 per grid cell, as dense as the discrete problem's own bound sampling),
 at the piece's speed maximum, and at every breakpoint of the speed bound inside the leg
-(:func:`bound_breakpoints`: knots of ``v_limit``, ends of spans, zone entries and exits, joins
+(`bound_breakpoints`: knots of ``v_limit``, ends of spans, zone entries and exits, joins
 of path pieces), where a narrow dip or a step of the bound can fall between two samples.
 """
 
@@ -66,12 +66,12 @@ class Verification:
         ``inf`` give 0, and so does the grip without ``grip="ellipse"``. A ratio above
         ``1 + TOLERANCES[name]`` is a violation. ``"yaw_acc"`` [rad/s²] and ``"yaw_jerk"``
         [rad/s³] of turns on the spot appear in the checks of routes that turn
-        (:meth:`speedplan.RouteProfile.verify`).
+        ([`speedplan.RouteProfile.verify`][speedplan.RouteProfile.verify]).
     where : dict
         Arc length [m] at which each ratio is largest.
     unset : frozenset of str
         The quantities whose limit is not set (``inf`` or ``None``): their ratio is 0 and
-        :meth:`summary` says "not set".
+        [`summary`][speedplan.Verification.summary] says "not set".
     max_speed, max_accel, max_decel, max_jerk, max_lateral : float
         Largest speed [m/s], acceleration, braking deceleration [m/s²], absolute jerk [m/s³]
         and absolute lateral acceleration [m/s²]: the entries of ``maxima``.
@@ -153,7 +153,7 @@ class Verification:
 
 @dataclass(frozen=True)
 class LegCheck:
-    """:class:`Verification` of one leg, and which of its pieces exceed a tolerance."""
+    """`Verification` of one leg, and which of its pieces exceed a tolerance."""
 
     verification: Verification
     excess: np.ndarray  # bool per law piece
@@ -181,7 +181,7 @@ def check_law(law: TimeLaw, offset: float, path: Path,
               breaks: FloatArray | None = None) -> LegCheck:
     """Check the law of one leg that covers ``[offset, offset + law.length]`` of ``path``.
 
-    ``breaks``: arc lengths of ``path`` (:func:`bound_breakpoints`, computed here when not
+    ``breaks``: arc lengths of ``path`` (`bound_breakpoints`, computed here when not
     given) where the path-dependent quantities are evaluated too, besides the samples.
     """
     ex = law.extremes()
