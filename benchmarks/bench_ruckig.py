@@ -15,26 +15,25 @@ median wall time of each call (ruckig's ``calculate``; ``plan()`` on its default
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
+import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from ruckig import InputParameter, Result, Ruckig, Trajectory
 
 import speedplan as sp
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_plan
+
 LIMITS = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 
 
 def median_time(call: Callable[[], Any], repeats: int) -> tuple[float, Any]:
+    """``bench_plan.median_time`` after one warm-up call."""
     call()
-    times, result = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        result = call()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), result
+    return bench_plan.median_time(call, repeats)
 
 
 def ruckig_duration(length: float, lim: sp.Limits) -> float:
