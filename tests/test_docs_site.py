@@ -50,6 +50,11 @@ EXTRA_PUBLIC = (
     "speedplan.route_plan.route_jobs",
     "speedplan.solve.problem.StencilRows",
     "speedplan.solve.paper.paper_instance",
+    "speedplan.core.attempts.Attempt",
+    "speedplan.route.RouteTurn",
+    "speedplan.timing.rotation.Turn",
+    "speedplan.route.vda5050.OrderWarning",
+    "speedplan.route_plan.route_turns",
 )
 #: Members of public classes that are implementation details (the paper's scaled constants,
 #: the solver's internals) and stay off the reference.
@@ -59,12 +64,14 @@ INTERNAL_MEMBERS = {
     "StencilRows": {"scaled"},
     "SpeedProfile": {"law", "solution", "check_leg", "legs", "speed_bound", "request"},
     "Verification": {"merged"},
-    "Route": {"base_edges", "base_nodes", "rounded_nodes"},
+    "Route": {"base_edges", "base_nodes", "rounded_nodes", "turn_headings", "node_headings",
+              "turn_rate_limit"},
     "RouteProfile": {"leg_starts", "start_s"},
     "DiscreteProblem": {"tau", "uniform", "has_lower_bounds", "lateral_families",
                         "second_difference_weights", "second_difference", "jerk_tol",
                         "stencil_matrix", "stencil_apply", "stencil_adjoint", "jerk_rows",
-                        "lateral_rows", "linear_violation", "scaled"},
+                        "lateral_rows", "linear_violation", "scaled", "has_grip", "grip_load",
+                        "grip_violation"},
 }
 
 
