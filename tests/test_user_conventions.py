@@ -29,7 +29,7 @@ def test_summary_says_not_set_for_limits_that_are_not_set(corner_profile):
     lines = dict(line.split(None, 1) for line in corner_profile.verify().summary().splitlines())
     assert lines["yaw_rate"] == "not set" and lines["lateral_jerk"] == "not set"
     assert lines["jerk"].split()[1:3] == ["of", "limit"]  # set limits keep their ratio
-    comfort = sp.Limits(2, 1, 1, 0.5, j_lat_max=0.8, yaw_rate_max=1.0)
+    comfort = sp.Limits(2, 1, 1, 0.5, j_lat_max=0.8, yaw_rate_max=1.0, grip="ellipse")
     summary = sp.plan(sp.Path.from_waypoints([[0, 0], [10, 0], [12, 3]]), comfort).verify()
     assert "not set" not in summary.summary()
     no_jerk = sp.plan(sp.Path.from_waypoints([[0, 0], [10, 0]], kind="polyline"),

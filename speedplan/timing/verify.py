@@ -118,8 +118,8 @@ class Verification:
         >>> from speedplan import Limits, Path, plan
         >>> prof = plan(Path.from_waypoints([[0, 0], [10, 0]], kind="polyline"),
         ...             Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
-        >>> print(prof.verify().summary().splitlines()[-1])
-        lateral_jerk  not set
+        >>> prof.verify().summary().splitlines()[-2:]
+        ['lateral_jerk  not set', 'grip          not set']
         """
         lines = []
         for k, r in self.ratios.items():
@@ -285,7 +285,8 @@ def check_law(law: TimeLaw, offset: float, path: Path,
     ratios = dict(sorted(ratios.items(), key=lambda kv: order[kv[0]]))
     limit_of = {"speed": limits.v_max, "accel": limits.a_max, "decel": limits.a_decel,
                 "lateral": limits.a_lat_max, "jerk": limits.j_max,
-                "yaw_rate": limits.yaw_rate_max, "lateral_jerk": limits.j_lat_max}
+                "yaw_rate": limits.yaw_rate_max, "lateral_jerk": limits.j_lat_max,
+                "grip": 1.0 if limits.ellipse else np.inf}
     unset = frozenset(k for k, lim in limit_of.items() if not np.isfinite(lim))
     return LegCheck(Verification(maxima=maxima, ratios=ratios, where=where, unset=unset),
                     excess, knots)
