@@ -169,8 +169,8 @@ def solve_problem(
     w_relaxed[0], w_relaxed[-1] = problem.w_start, problem.w_end
     lower = min(relax.dual_objective, relax.primal_objective) * time_scale
     relaxed_violation = problem.jerk_violation(w_relaxed)
-    # An interior-point answer meets the convex rows to its tolerance; a friction ellipse
-    # held by 1e-7 less is still exact (the convex rows are not relaxed).
+    # An interior-point answer meets the convex rows to its own tolerance: a friction
+    # ellipse met to GRIP_TOL is exact (the convex rows are not relaxed).
     exact = relaxed_violation <= problem.jerk_tol and problem.grip_violation(
         w_relaxed) <= GRIP_TOL
     relaxation = RelaxationInfo(
