@@ -61,6 +61,8 @@ NO_JERK_BOUND_LOSS = 1e-3
 #: (``v - a²/(2 j)``) of zero comes to rest on the way: the gain of passing through at that
 #: speed is below any resolvable time, and the dip could not be gridded.
 TOUCH_ZERO = 1e-6
+#: ``κ``, and ``κ'`` after and before each interior node of a leg's grid.
+NodeCurvature = tuple[FloatArray, FloatArray, FloatArray]
 #: Newton steps for `lateral_speed_caps` (converged to rounding from its start within
 #: about 40 on the sample paths) and the relative margin added to each cap, so that rounding
 #: never cuts a feasible point.
@@ -514,9 +516,11 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
         )
     m = s.size
     accel, decel = np.full(m - 1, lim.A), np.full(m - 1, lim.A_decel)
+    curvature = None
     if np.isfinite(lim.j_lat_max):
+        curvature = _node_curvature(request.path, lo, s)  # for the caps and the rows alike
         w_max[1:-1] = np.minimum(w_max[1:-1], lateral_speed_caps(
-            request.path, lo, s, lim.j_lat_max, accel, decel))
+            request.path, lo, s, lim.j_lat_max, accel, decel, node_curvature=curvature))
     floor = env.floor(s)
     if floor is not None:
         # Against the bound at the nodes themselves: the node bound (its minimum over the
@@ -533,7 +537,8 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     problem = DiscreteProblem(
         s=s, w_max=w_max, accel=accel, decel=decel,
         jerk=jerk, w_start=v0 * v0, w_end=vf * vf, w_min=floor,
-        lateral=lateral_jerk_rows(request.path, lo, s, lim.j_lat_max),
+        lateral=lateral_jerk_rows(request.path, lo, s, lim.j_lat_max,
+                                  node_curvature=curvature),
         grip=np.abs(request.path.curvature(lo + s)) / lim.a_lat_max if lim.ellipse else None,
     )
     law = TimeLawSpec(
@@ -561,7 +566,8 @@ def grid_anchors(request: PlanRequest, lo: float, hi: float) -> FloatArray:
     return out
 
 
-def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float
+def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float, *,
+                      node_curvature: NodeCurvature | None = None
                       ) -> tuple[StencilRows, ...] | None:
     """Rows ``|κ' w + κ w'| sqrt(w) <= j_lat_max`` at the nodes and the cells' midpoints.
 
@@ -586,7 +592,7 @@ def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float
     """
     if not np.isfinite(j_lat_max):
         return None
-    kappa, after, before = _node_curvature(path, lo, s)
+    kappa, after, before = node_curvature or _node_curvature(path, lo, s)
     h = np.diff(s)
     h0, h1 = h[:-1], h[1:]
     first = np.column_stack((-h1 / (h0 * (h0 + h1)), (h1 - h0) / (h0 * h1),
@@ -603,8 +609,7 @@ def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float
     return tuple(families)
 
 
-def _node_curvature(path: Path, lo: float, s: FloatArray
-                    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+def _node_curvature(path: Path, lo: float, s: FloatArray) -> NodeCurvature:
     """``κ``, and ``κ'`` after and before each interior node (they differ on piece joins)."""
     q = lo + s[1:-1]
     kappa = np.asarray(path.curvature(q), dtype=np.float64)
@@ -622,7 +627,8 @@ def _node_curvature(path: Path, lo: float, s: FloatArray
 
 
 def lateral_speed_caps(path: Path, lo: float, s: FloatArray, j_lat_max: float,
-                       accel: FloatArray, decel: FloatArray) -> FloatArray:
+                       accel: FloatArray, decel: FloatArray, *,
+                       node_curvature: NodeCurvature | None = None) -> FloatArray:
     """Upper bounds on interior ``w`` that the lateral-jerk and acceleration rows imply.
 
     The node row ``|κ' w_i + κ w'_i| sqrt(w_i) <= j_lat_max`` (`lateral_jerk_rows`) has
@@ -637,7 +643,7 @@ def lateral_speed_caps(path: Path, lo: float, s: FloatArray, j_lat_max: float,
     certified gap falls from a few per cent to about 0.1 % (``benchmarks/bench_comfort.py``).
     ``inf`` where the curvature rate is 0.
     """
-    kappa, after, before = _node_curvature(path, lo, s)
+    kappa, after, before = node_curvature or _node_curvature(path, lo, s)
     caps = np.full(s.size - 2, np.inf)
     for rate in (after, before):
         eases = rate * kappa > 0
