@@ -17,8 +17,7 @@ import warnings
 
 import speedplan as sp
 from speedplan.geometry import Line
-from speedplan.model import PlanRequest, build_model
-from speedplan.model.build import Leg
+from speedplan.model import Leg, PlanRequest, build_model
 from speedplan.solve.banded import ramp_steps
 
 LGV = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)

@@ -52,14 +52,16 @@ from .core.errors import (
 )
 from .model import ForcedLeg, Leg, Model, PlanRequest, build_model
 from .model.boundary import STATE_JERK_ROUNDING, STATE_JERK_SLACK, state_jerk
-from .model.build import coarsenable, coarser_leg, explain_infeasible, leg_on_grid
-from .model.refine import refined_grid
+from .model.build import leg_on_grid
+from .model.grid import MIN_NODES, refined_grid
+from .model.leg_grid import default_grid
+from .model.legs import explain_infeasible
 from .solve import DiscreteSolution, solve_problem
 from .timing import TOLERANCES, LegResult, SpeedProfile, Verification, law_for
 
 __all__ = ["ATTEMPTS", "COARSER_GRIDS", "MAX_REFINEMENTS", "REFINE_FACTORS",
-           "STATE_CONSTRAINTS", "Budget", "Record", "model_request", "refine_factor",
-           "solve_leg", "solve_legs", "verified_profile"]
+           "STATE_CONSTRAINTS", "Budget", "Record", "coarsenable", "coarser_leg", "model_request",
+           "refine_factor", "solve_leg", "solve_legs", "verified_profile"]
 
 #: What the reachability checks of boundary states name when they refuse one.
 STATE_CONSTRAINTS = ("jerk", "v_max", "length", "speed_bound")
@@ -173,6 +175,51 @@ class Record:
             f"spent); tried: {describe_attempts(self.entries)}. Pass a larger time_limit, or "
             "time_limit=None to run every attempt", time_limit=limit,
             attempts=tuple(self.entries))
+
+
+
+def coarser_leg(request: PlanRequest, leg: Leg, factor: float) -> Leg | None:
+    """``leg`` on its default grid with ``factor`` times its nodes, or ``None``.
+
+    Every step grows in proportion (the node cap of `adaptive_grid`), so the grid
+    stays smoothly graded. [`speedplan.plan`][speedplan.plan] plans a leg on such a grid when its
+    relaxation backend does not converge on the default grid: on paths with slow zones both
+    interior-point methods can stall on a fine default grid (a front of nearly active jerk
+    rows next to a zone's edge moves one node per iteration) and converge on a coarser one.
+    ``None`` for a user grid (``n`` or ``ds``: the grid is the caller's), without a jerk
+    limit (no solver runs), or where the grid would not get coarser (`MIN_NODES`).
+
+    Examples
+    --------
+    >>> from speedplan import Limits, Path
+    >>> from speedplan.model import PlanRequest, build_model
+    >>> path = Path.from_waypoints([[0, 0], [30, 0]], kind="polyline")
+    >>> model = build_model(PlanRequest.create(path, Limits(2, 1, 1, 0.5)))
+    >>> leg = model.legs[0]
+    >>> from speedplan.strategy import coarser_leg
+    >>> half = coarser_leg(model.request, leg, 0.5)
+    >>> bool(half.problem.n <= leg.problem.n // 2 + 1), bool(half.problem.s[-1] == 30.0)
+    (True, True)
+    """
+    if not coarsenable(request, leg):
+        return None
+    nodes = max(int(leg.problem.n * factor), MIN_NODES)
+    if nodes >= leg.problem.n:
+        return None
+    lo, hi = leg.start, leg.start + leg.length
+    s = default_grid(request, leg.bound, lo, hi, leg.v0, leg.a0, leg.vf, leg.af, nodes)
+    if s.size >= leg.problem.n:
+        return None
+    return leg_on_grid(request, leg.bound, s, lo, leg.v0, leg.a0, leg.vf, leg.af)
+
+
+def coarsenable(request: PlanRequest, leg: Leg) -> bool:
+    """Whether ``leg`` is on a jerk-limited default grid above `MIN_NODES` nodes.
+
+    The legs `coarser_leg` can rebuild coarser (without building the grid).
+    """
+    return (request.n is None and request.ds is None and request.jerk_limited
+            and leg.problem.n > MIN_NODES)
 
 
 def _reason(exc: Exception) -> str:

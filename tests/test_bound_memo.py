@@ -14,7 +14,7 @@ from shared import LGV
 import speedplan as sp
 from speedplan.geometry import SpeedBound
 from speedplan.io import read_path, read_zones
-from speedplan.model.refine import PAD_CELLS, subdivided_grid
+from speedplan.model.grid import PAD_CELLS, subdivided_grid
 
 NO_JERK = sp.Limits(v_max=LGV.v_max, a_max=LGV.a_max, a_lat_max=LGV.a_lat_max, j_max=math.inf)
 

@@ -17,8 +17,8 @@ from oracles import measure, no_jerk_lower_bound, within_promise
 from speedplan import Limits, Path, SpeedZone, plan
 from speedplan.geometry import SpeedBound
 from speedplan.model import PlanRequest, build_model
-from speedplan.model.build import coarser_leg
 from speedplan.solve.banded import solve_relaxation_banded
+from speedplan.strategy import coarser_leg
 
 WAYPOINTS = [[43.83288979232604, 262.4054815071551], [206.12640702422482, 321.78604603717207],
              [177.5647570904682, 246.52852110317002], [519.0855872387414, 443.21044154192805],

@@ -100,7 +100,7 @@ def test_no_jerk_plans_are_under_the_bound_and_never_beat_the_exact_optimum(path
     # Durations: a feasible law cannot beat the exact continuous optimum; the uniform grid
     # costs O(h) where the bound falls steeply (a node takes the minimum over both adjacent
     # cells): 3.9 % on the serpentine, so the default grid is refined once where the optimum
-    # rides such a node bound (model.build._no_jerk_grid): 1.0 % there.
+    # rides such a node bound (model.leg_grid.no_jerk_grid): 1.0 % there.
     bound = planned.speed_bound
     t_exact, _, _ = no_jerk_lower_bound(bound, path.length, lim.a_max, lim.a_decel)
     assert t_exact <= planned.duration

@@ -135,7 +135,7 @@ def _law_check(path, lim, **kw):
 @pytest.fixture
 def ungraded(monkeypatch):
     """User grids exactly uniform: without the grading at the rests (``graded_ends``)."""
-    build = importlib.import_module("speedplan.model.build")
+    build = importlib.import_module("speedplan.model.leg_grid")
     monkeypatch.setattr(build, "graded_ends", lambda s, ell_start, ell_end: s)
 
 

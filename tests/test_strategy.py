@@ -48,7 +48,7 @@ def test_a_plan_records_which_attempt_answered():
 @pytest.fixture
 def ungraded(monkeypatch):
     """User grids exactly uniform: their first law breaks the jerk tolerance at the rests."""
-    build = importlib.import_module("speedplan.model.build")
+    build = importlib.import_module("speedplan.model.leg_grid")
     monkeypatch.setattr(build, "graded_ends", lambda s, ell_start, ell_end: s)
 
 

@@ -20,8 +20,8 @@ from oracles import measure, no_jerk_lower_bound, ruckig_move, within_promise
 from speedplan import Limits, Path, SpeedZone, plan
 from speedplan.geometry import SpeedBound
 from speedplan.model import PlanRequest, build_model
-from speedplan.model.build import coarser_leg
 from speedplan.model.grid import GRADING, MIN_NODES
+from speedplan.strategy import coarser_leg
 
 plan_module = importlib.import_module("speedplan.plan")
 

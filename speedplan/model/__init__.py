@@ -1,4 +1,4 @@
-"""Model: a physical planning request becomes a discrete problem.
+"""Model: a physical planning request becomes data — legs and their discrete problems.
 
 Modules, one job each:
 
@@ -6,18 +6,21 @@ Modules, one job each:
   [`speedplan.plan`][speedplan.plan];
 * `boundary` — what jerk-limited motions can do from a boundary state
   (envelopes, reachability);
-* `grid` — the default arc-length grids;
+* `grid` — arc-length grids: uniform, graded, the adaptive default grid, and grids made
+  finer where a planned law exceeds a limit;
+* `leg_grid` — the grid of one leg, as the request asks for it (user, default, no-jerk);
+* `rows` — node bounds, boundary envelopes, lateral-jerk rows and the speed caps they imply;
 * `standstill` — jerk rows next to a standstill;
-* `refine` — local grid refinement where a law exceeds a limit;
-* `build` — `build_model`: request -> `Model` (speed bound,
-  [`DiscreteProblem`][speedplan.DiscreteProblem], time-law options); the problems are solved by
-  `speedplan.strategy`, and `explain_infeasible` restates
-  their infeasibilities in physical terms.
+* `legs` — the data of a model: `Leg`, `ForcedLeg`, `Rest`, `TimeLawSpec`, `Model`, and
+  `explain_infeasible`, which restates a leg's infeasibility in physical terms;
+* `build` — `build_model`: request -> `Model`. The problems are solved by
+  `speedplan.strategy`; nothing here calls a solver.
 
-This layer imports ``core``, ``geometry`` and ``solve``.
+This layer imports ``core``, ``geometry`` and the data of ``solve`` (`speedplan.solve.problem`).
 """
 
-from .build import ForcedLeg, Leg, Model, Rest, TimeLawSpec, build_model, rest_points
+from .build import build_model, rest_points
+from .legs import ForcedLeg, Leg, Model, Rest, TimeLawSpec
 from .request import STANDSTILL_MODES, PlanRequest
 
 __all__ = ["STANDSTILL_MODES", "ForcedLeg", "Leg", "Model", "PlanRequest", "Rest", "TimeLawSpec",

@@ -23,6 +23,9 @@ Nodes are placed by inverting the node count ``N(s) = ∫ ds / h(s)`` exactly fo
 ``h(s)`` piecewise linear on a fine pre-grid: consecutive steps follow ``h(s)``, with no jump
 where the pre-grid cells meet (the old grid inverted a piecewise-linear count and its steps
 jumped by up to 19 % there).
+
+Where a planned law exceeds a limit, `refined_grid` makes the steps finer around the flagged
+cells (smoothly graded again) and `subdivided_grid` cuts cells in equal parts.
 """
 
 from __future__ import annotations
@@ -34,8 +37,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.checks import FloatArray, grid_size
-from ..solve.nojerk import max_feasible_w
-from ..solve.problem import DiscreteProblem
+from ..core.rates import largest_under_rates
 
 __all__ = [
     "CRUISE_GRADING",
@@ -48,13 +50,16 @@ __all__ = [
     "MIN_ANCHOR_NODES",
     "MIN_NODES",
     "MIN_RELATIVE_STEP",
+    "PAD_CELLS",
     "TOP_SPEED_PROBES",
     "adaptive_grid",
     "graded_ends",
     "graded_steps",
     "hidden_dips",
     "nodes_from_steps",
+    "refined_grid",
     "rest_phase_length",
+    "subdivided_grid",
     "top_speed",
     "uniform_grid",
 ]
@@ -369,12 +374,9 @@ def adaptive_grid(
     def steps(sf: FloatArray) -> FloatArray:
         """The graded step on the pre-grid ``sf``."""
         wb = w_bound(sf)
-        pre = DiscreteProblem(
-            s=sf, w_max=wb, accel=np.full(sf.size - 1, 2 * a_max),
-            decel=np.full(sf.size - 1, 2 * a_decel), jerk=np.full(sf.size - 2, np.inf),
-            w_start=w_start, w_end=w_end,
-        )
-        w_est = max_feasible_w(pre, pin_ends=False)
+        hf = np.diff(sf)  # the exact no-jerk optimum at twice the limits (speedplan.solve.nojerk)
+        w_est = largest_under_rates(wb, np.full(sf.size - 1, 2 * a_max) * hf,
+                                    np.full(sf.size - 1, 2 * a_decel) * hf)
         # The floor keeps the steps from vanishing where the speed falls to the ends' states:
         # on the stretches next to each end where λ(v) is below it. A slow stretch farther
         # inside (a zone, a tight curve) has transitions of its own, which may be shorter
@@ -492,3 +494,75 @@ def _distance_to(mask: np.ndarray, s: FloatArray) -> FloatArray:
     right = np.minimum.accumulate(np.where(mask, s, np.inf)[::-1])[::-1]
     out: FloatArray = np.minimum(s - left, right - s)
     return out
+
+
+#: Cells added on each side of a flagged stretch before halving the steps there.
+PAD_CELLS = 4
+
+
+def refined_grid(s: FloatArray, knots: FloatArray, excess: np.ndarray,
+                 anchors: FloatArray | None = None, factor: float = 0.5,
+                 grading: float = GRADING) -> FloatArray:
+    """The grid ``s`` with its steps times ``factor`` around the pieces flagged in ``excess``.
+
+    ``knots`` are the law's knots (nodes and cell midpoints) and ``excess`` flags each piece
+    between them. The steps are multiplied by ``factor`` (in ``(0, 1)``) over the flagged
+    cells padded by `PAD_CELLS` on each side (never below the default grids' finest
+    step, `MIN_RELATIVE_STEP` of the length), and graded back to
+    the old steps at the rate `GRADING`, so the new grid is as
+    smooth as the old one; ``anchors`` (nodes of ``s``) stay nodes. A law without jerk rows
+    needs no smoothness: ``grading`` may then be coarser.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.linspace(0.0, 10.0, 101)
+    >>> knots = np.sort(np.concatenate((s, s[:-1] + 0.05)))
+    >>> flag = np.zeros(knots.size - 1, dtype=bool); flag[100] = True  # around s = 5
+    >>> g = refined_grid(s, knots, flag)
+    >>> bool(g.size > s.size and np.diff(g).min() < 0.06 and g[0] == 0 and g[-1] == 10)
+    True
+    """
+    h = np.diff(s)
+    node_h = np.concatenate(([h[0]], 0.5 * (h[:-1] + h[1:]), [h[-1]]))
+    cell = (np.flatnonzero(excess) // 2).astype(np.intp)  # piece 2k, 2k+1 lie in cell k
+    flagged = np.zeros(s.size, dtype=bool)
+    for k in np.unique(cell):
+        lo, hi = max(k - PAD_CELLS, 0), min(k + 1 + PAD_CELLS, s.size - 1)
+        flagged[lo:hi + 1] = True
+    # Never below the default grids' finest step: finer steps lose the digits of w.
+    finest = MIN_RELATIVE_STEP * float(s[-1] - s[0])
+    target = np.where(flagged, np.maximum(factor * node_h, np.minimum(node_h, finest)), node_h)
+    target = graded_steps(s, target, np.full(s.size, grading))
+    kept = None if anchors is None or not len(anchors) else np.intersect1d(anchors, s)
+    grid = nodes_from_steps(s, target, kept)
+    grid_size("n", grid.size)
+    return grid
+
+
+def subdivided_grid(s: FloatArray, cells: np.ndarray, parts: int = 4) -> FloatArray:
+    """The grid ``s`` with the flagged ``cells`` and `PAD_CELLS` on each side split.
+
+    Each such cell is cut into ``parts`` equal steps; every other node and cell of ``s`` is
+    kept to the last bit, so what was evaluated on them (the speed bound inside the cells)
+    still holds. For a law without jerk rows, which needs no smoothness of the steps.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.linspace(0.0, 10.0, 11)
+    >>> flag = np.zeros(10, dtype=bool); flag[5] = True
+    >>> g = subdivided_grid(s, flag, parts=2)
+    >>> g.size, bool(np.isin(s, g).all()), float(np.diff(g).min())
+    (20, True, 0.5)
+    """
+    m = s.size - 1
+    split = np.zeros(m, dtype=bool)
+    for k in np.flatnonzero(cells):
+        split[max(k - PAD_CELLS, 0):min(k + PAD_CELLS + 1, m)] = True
+    lo = s[:-1][split]
+    width = np.diff(s)[split]
+    inner = (lo[:, None] + width[:, None] * (np.arange(1, parts) / parts)[None, :]).ravel()
+    grid = np.unique(np.concatenate((s, inner)))  # sorted; a cell of a few ulps adds none
+    grid_size("n", grid.size)
+    return grid

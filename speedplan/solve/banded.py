@@ -71,8 +71,8 @@ from ..core.checks import FloatArray, IntArray
 from ..core.errors import InvalidInputError, SolverError
 from ..core.jit import FAMILIES
 from .clarabel_ import RelaxationResult
-from .nojerk import check_reachable, max_feasible_w, min_feasible_w, positive_feasible_w
-from .problem import DiscreteProblem
+from .nojerk import check_reachable, min_feasible_w, positive_feasible_w
+from .problem import MAX_RAMP_STEPS, DiscreteProblem, ramp_steps
 
 __all__ = [
     "ACCEPT_GAP", "KERNELS", "MAX_ITERATIONS", "MAX_RAMP_STEPS",
@@ -391,36 +391,6 @@ def kernel_for_auto(*, wait: bool) -> bool:
     is off (``SPEEDPLAN_BACKGROUND_COMPILE=0``, or no process could be started).
     """
     return KERNELS.available(wait=wait) is not None
-
-
-#: Longest jerk-limited change of acceleration, in grid steps, that the relaxation resolves.
-#: The reduced Newton matrix carries the fourth difference ``D̂'D̂`` over such a stretch of
-#: active jerk rows, whose condition number grows like its length to the fourth power; in
-#: double precision both backends lose the dual equations beyond a few thousand steps
-#: (measured on straights with steps of 0.17-2 mm, ``benchmarks/bench_fine_grids.py``: every
-#: case up to 4 000 steps solved; from 5 000 on some stalled, a 10 m straight already at
-#: 5 000, a 30 m one at 8 000; docs/banded-ipm.md). The grid is refused above this count.
-MAX_RAMP_STEPS = 4000
-
-
-def ramp_steps(problem: DiscreteProblem) -> float:
-    """Most grid steps a jerk-limited change of ``w'`` by its bound can take, over all nodes.
-
-    Node ``i``'s jerk row lets ``w'`` change by at most ``r_i = J_i τ_i / sqrt(w_i)`` per
-    step (``|w''| sqrt(w) <= J``), fewest at the fastest feasible ``w``. From node ``i`` on,
-    count the steps until the ``r`` add up to ``max(A, D)`` there; a node without a jerk row
-    ends the count. Invariant under [`DiscreteProblem.scaled`][speedplan.DiscreteProblem].
-    """
-    finite = np.isfinite(problem.jerk)
-    if problem.n < 3 or not finite.any():
-        return 0.0
-    w = np.maximum(max_feasible_w(problem)[1:-1], 1e-300)
-    a = np.maximum.reduce([problem.accel[:-1], problem.accel[1:], problem.decel[:-1],
-                           problem.decel[1:]])
-    rate = np.where(finite, problem.jerk * problem.tau / np.sqrt(w), np.inf)
-    reached = np.concatenate(([0.0], np.cumsum(rate)))
-    end = np.searchsorted(reached, reached[:-1] + a, side="left")
-    return float(np.max(end - np.arange(rate.size)))
 
 
 def check_grid_resolvable(problem: DiscreteProblem) -> None:

@@ -1,9 +1,8 @@
 """Exact O(n) solution of the problem without jerk rows: a forward and a backward pass.
 
 Without jerk rows the pointwise largest feasible ``w`` is optimal, because the objective
-decreases in every ``w_i``. Chaining ``w_{i+1} <= w_i + A_i h_i`` from every node ``j`` gives
-``w_i <= w_max_j + c_i - c_j`` with ``c`` the cumulative sum of ``A h``, so the forward pass is
-``c + minimum.accumulate(w_max - c)``; the backward pass is the same on the reversed grid.
+decreases in every ``w_i``: the largest sequence under ``w_max`` whose rises are at most
+``A_i h_i`` and falls at most ``D_i h_i`` (`speedplan.core.rates`).
 """
 
 from __future__ import annotations
@@ -12,21 +11,10 @@ import numpy as np
 
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
+from ..core.rates import cumulative, largest_under_rates
 from .problem import DiscreteProblem
 
 __all__ = ["check_reachable", "max_feasible_w", "min_feasible_w", "positive_feasible_w"]
-
-
-def _cumulative(rate_h: FloatArray) -> FloatArray:
-    """``c_i = Σ_{k<i} rate_h_k`` (n values for n - 1 segments): the bound on ``w_i - w_0``."""
-    out: FloatArray = np.concatenate(([0.0], np.cumsum(rate_h)))
-    return out
-
-
-def _forward(bound: FloatArray, rate_h: FloatArray) -> FloatArray:
-    c = _cumulative(rate_h)
-    out: FloatArray = c + np.minimum.accumulate(bound - c)
-    return np.minimum(out, bound)
 
 
 def max_feasible_w(problem: DiscreteProblem, *, pin_ends: bool = True) -> FloatArray:
@@ -48,9 +36,7 @@ def max_feasible_w(problem: DiscreteProblem, *, pin_ends: bool = True) -> FloatA
     if pin_ends:
         bound[0] = min(bound[0], problem.w_start)
         bound[-1] = min(bound[-1], problem.w_end)
-    w = _forward(bound, problem.accel * problem.h)
-    w = _forward(w[::-1], (problem.decel * problem.h)[::-1])[::-1]
-    return np.maximum(w, 0.0)
+    return largest_under_rates(bound, problem.accel * problem.h, problem.decel * problem.h)
 
 
 def positive_feasible_w(problem: DiscreteProblem) -> FloatArray:
@@ -103,8 +89,8 @@ def min_feasible_w(problem: DiscreteProblem) -> FloatArray:
     >>> min_feasible_w(p).tolist()
     [3.0, 2.0, 1.0, 0.0, 0.0]
     """
-    braking = problem.w_start - _cumulative(problem.decel * problem.h)
-    accel = _cumulative(problem.accel * problem.h)
+    braking = problem.w_start - cumulative(problem.decel * problem.h)
+    accel = cumulative(problem.accel * problem.h)
     accelerating = problem.w_end - (accel[-1] - accel)
     w: FloatArray = np.maximum(np.maximum(braking, accelerating), 0.0)
     if problem.w_min is not None:
@@ -131,7 +117,7 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
                 s=float(where),
             )
     # Braking from w_start: the backward pass alone says how fast each node may be.
-    c = _cumulative(problem.decel * problem.h)  # w_0 <= w_max_j + c_j - c_0
+    c = cumulative(problem.decel * problem.h)  # w_0 <= w_max_j + c_j - c_0
     _check_pass(problem, tol, units, "decel", problem.w_start, c, -1, problem.w_end,
                 "cannot brake from w_start={w_start:.6g} down to w_max={w:.6g} at s={s:.6g}"
                 "{units} under the braking bound")
@@ -141,7 +127,7 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
         if (short > tol).any():
             j = int(np.argmax(short > tol))
             # The bound ahead that the braking from node j cannot reach in time.
-            c = _cumulative(problem.decel * problem.h)
+            c = cumulative(problem.decel * problem.h)
             k = j + int(np.argmin(problem.w_max[j:] + c[j:]))
             raise InfeasibleError(
                 f"cannot slow down in time for the bound w_max={problem.w_max[k]:.6g} at "
@@ -151,7 +137,7 @@ def check_reachable(problem: DiscreteProblem, *, units: str = "") -> None:
                 s=float(s[k]),
             )
     # Accelerating into w_end: the forward pass, likewise.
-    c = _cumulative(problem.accel * problem.h)  # w_end <= w_max_j + (c_end - c_j)
+    c = cumulative(problem.accel * problem.h)  # w_end <= w_max_j + (c_end - c_j)
     _check_pass(problem, tol, units, "accel", problem.w_end, c[-1] - c, 0, problem.w_start,
                 "cannot accelerate from w_max={w:.6g} at s={s:.6g}{units} up to "
                 "w_end={w_end:.6g} under the acceleration bound")

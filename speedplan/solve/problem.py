@@ -20,11 +20,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..core.checks import FloatArray
+from ..core.rates import largest_under_rates
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
 
-__all__ = ["DiscreteProblem", "StencilRows"]
+__all__ = ["MAX_RAMP_STEPS", "DiscreteProblem", "StencilRows", "ramp_steps"]
 
 #: Paper's exactness test: a jerk row may be violated by at most 1e-5 (``h = 1``, ``w_max``
 #: up to 100). We apply it relative to the largest bound, which is the same number at the
@@ -358,3 +359,36 @@ class DiscreteProblem:
             lateral=tuple(f.scaled(s_scale, w_scale) for f in self.lateral_families) or None,
             grip=None if self.grip is None else self.grip * w_scale,
         )
+
+
+#: Longest jerk-limited change of acceleration, in grid steps, that the relaxation resolves.
+#: The reduced Newton matrix carries the fourth difference ``D̂'D̂`` over such a stretch of
+#: active jerk rows, whose condition number grows like its length to the fourth power; in
+#: double precision both backends lose the dual equations beyond a few thousand steps
+#: (measured on straights with steps of 0.17-2 mm, ``benchmarks/bench_fine_grids.py``: every
+#: case up to 4 000 steps solved; from 5 000 on some stalled, a 10 m straight already at
+#: 5 000, a 30 m one at 8 000; docs/banded-ipm.md). The grid is refused above this count.
+MAX_RAMP_STEPS = 4000
+
+
+def ramp_steps(problem: DiscreteProblem) -> float:
+    """Most grid steps a jerk-limited change of ``w'`` by its bound can take, over all nodes.
+
+    Node ``i``'s jerk row lets ``w'`` change by at most ``r_i = J_i τ_i / sqrt(w_i)`` per
+    step (``|w''| sqrt(w) <= J``), fewest at the fastest feasible ``w``. From node ``i`` on,
+    count the steps until the ``r`` add up to ``max(A, D)`` there; a node without a jerk row
+    ends the count. Invariant under [`DiscreteProblem.scaled`][speedplan.DiscreteProblem].
+    """
+    finite = np.isfinite(problem.jerk)
+    if problem.n < 3 or not finite.any():
+        return 0.0
+    bound = problem.w_max.copy()  # the fastest feasible w without jerk rows (solve.nojerk)
+    bound[0], bound[-1] = min(bound[0], problem.w_start), min(bound[-1], problem.w_end)
+    fastest = largest_under_rates(bound, problem.accel * problem.h, problem.decel * problem.h)
+    w = np.maximum(fastest[1:-1], 1e-300)
+    a = np.maximum.reduce([problem.accel[:-1], problem.accel[1:], problem.decel[:-1],
+                           problem.decel[1:]])
+    rate = np.where(finite, problem.jerk * problem.tau / np.sqrt(w), np.inf)
+    reached = np.concatenate(([0.0], np.cumsum(rate)))
+    end = np.searchsorted(reached, reached[:-1] + a, side="left")
+    return float(np.max(end - np.arange(rate.size)))

@@ -39,7 +39,7 @@ A last, local correction (piecewise quadratic over the final stretch, curvature
 smoothing would cost the speed bound: where the discrete ``w`` bends upwards (braking onto a
 bound step, at a corner) the dual-cell law rises above both adjacent nodes over the half cell
 after the kink, by up to an eighth of the neighbour's excess, so the node bounds (the
-minimum of ``mu+`` over the two adjacent cells, `speedplan.model.build.node_bounds`)
+minimum of ``mu+`` over the two adjacent cells, `speedplan.model.rows.node_bounds`)
 no longer keep it under the bound. The law is then ``w`` linear on each cell (``linear=True``,
 constant acceleration per cell as in the discrete problem): it passes through every node, lies
 on the chord, so under ``mu+`` wherever both ends are, and its time is the discrete problem's
