@@ -19,8 +19,8 @@ from .core.errors import (
     SpeedplanError,
 )
 from .core.limits import Limits
+from .core.numerics import wrap_angle
 from .geometry import SpanLimit
-from .geometry._checks import wrap_angle
 from .plan import plan
 from .route import THETA_TOLERANCE, Route, RouteProfile
 from .route.profile import RouteTurn

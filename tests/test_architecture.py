@@ -67,3 +67,67 @@ def test_every_layer_is_a_package():
     for layer in LAYERS:
         if layer != "route" or (PACKAGE / layer).exists():
             assert (PACKAGE / layer / "__init__.py").exists(), layer
+
+
+def _module_graph() -> dict[str, set[str]]:
+    """Module -> the ``speedplan`` modules it imports (packages by their ``__init__``)."""
+    names = {_module_name(f): f for f in FILES}
+
+    def owner(target: str) -> str:
+        while target not in names and "." in target:
+            target = target.rsplit(".", 1)[0]
+        return target
+
+    return {m: {owner(t) for t in _imports(f.read_text(encoding="utf-8"), m,
+                                           f.name == "__init__.py")} - {m}
+            for m, f in names.items()}
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_module_imports_itself_through_others():
+    assert _cycles(_module_graph()) == []
+
+
+def test_the_cycle_check_sees_a_circle():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
+    assert _cycles(graph) == [["a", "b", "c"]]
+
+
+def test_the_model_builds_data_and_calls_no_solver():
+    # From solve/ the model reads the problem's data class and its resolution limit only.
+    for file in (PACKAGE / "model").glob("*.py"):
+        module = _module_name(file)
+        solve = {m for m in _imports(file.read_text(encoding="utf-8"), module,
+                                     file.name == "__init__.py") if m.startswith("speedplan.solve")}
+        assert solve <= {"speedplan.solve.problem"}, f"{module} imports {sorted(solve)}"

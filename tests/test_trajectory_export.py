@@ -11,8 +11,9 @@ import pytest
 from shared import LGV
 
 import speedplan as sp
+from speedplan.core.numerics import wrap_heading
 from speedplan.io import read_path, read_trajectory
-from speedplan.timing.trajectory import COLUMNS, wrap_angle
+from speedplan.timing.trajectory import COLUMNS
 
 
 @pytest.fixture(scope="module")
@@ -49,9 +50,9 @@ def test_csv_round_trip_is_bitwise_exact_except_the_wrapped_heading(loop_traj, t
     assert inside.any() and np.array_equal(h_file[inside], h_mem[inside])
 
 
-def test_wrap_angle_against_atan2():
+def test_wrap_heading_against_atan2():
     theta = np.concatenate([np.linspace(-20, 20, 4001), [np.pi, -np.pi, 3 * np.pi, 1e-300]])
-    w = wrap_angle(theta)
+    w = wrap_heading(theta)
     assert np.all((w >= -np.pi) & (w < np.pi))
     # Same angle on the circle (compared as angular distance: at ±π a rounding-level
     # difference may land on either side of the cut).

@@ -9,13 +9,7 @@ import numpy as np
 from ..core.checks import FloatArray, as_array
 from ..core.errors import InvalidInputError
 
-__all__ = ["as_direction", "as_int", "as_reverse", "check_waypoints", "wrap_angle"]
-
-
-def wrap_angle(a: Any) -> FloatArray:
-    """Angles wrapped into ``[-π, π)`` [rad]."""
-    out: FloatArray = (np.asarray(a, dtype=np.float64) + np.pi) % (2.0 * np.pi) - np.pi
-    return out
+__all__ = ["as_direction", "as_int", "as_reverse", "check_waypoints"]
 
 
 def as_int(name: str, value: Any, *, minimum: int) -> int:

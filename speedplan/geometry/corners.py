@@ -40,7 +40,7 @@ import numpy as np
 
 from ..core.checks import FloatArray, as_scalar
 from ..core.errors import InvalidInputError
-from ._checks import wrap_angle
+from ..core.numerics import wrap_angle
 from .primitives import ClothoidPiece, PieceSpec, clothoid_chain, end_heading
 
 __all__ = ["CUSP_ANGLE", "DEFAULT_DEVIATION", "DEFAULT_TRANSITION", "CornerShape",

@@ -14,7 +14,8 @@ import numpy as np
 
 from ..core.checks import FloatArray, as_array, as_scalar, choice
 from ..core.errors import InvalidInputError
-from ._checks import check_waypoints, wrap_angle
+from ..core.numerics import wrap_angle
+from ._checks import check_waypoints
 from .corners import CUSP_ANGLE, as_deviation, find_reversal, g2_corners, leg_turns
 from .pieces import CurvePiece, Piece
 from .primitives import ClothoidPiece

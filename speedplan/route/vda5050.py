@@ -64,13 +64,13 @@ import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path as FsPath
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from ..core.errors import InvalidInputError, SpeedplanWarning
+from ..core.numerics import wrap_angle
 from ..geometry import Line, Path
-from ..geometry._checks import wrap_angle
 from ._checks import (
     boolean,
     check_meets_node,
@@ -82,9 +82,9 @@ from ._checks import (
     positive,
     string,
 )
-from .route import THETA_TOLERANCE, Route, RouteEdge, RouteNode
+from .elements import THETA_TOLERANCE, RouteEdge, RouteNode
 
-__all__ = ["OrderWarning", "load_order", "route_from_vda5050", "trajectory_path",
+__all__ = ["OrderRead", "OrderWarning", "load_order", "read_order", "trajectory_path",
            "uniform_clamped_knots"]
 
 
@@ -201,13 +201,27 @@ def load_order(order: Any) -> tuple[str, Any]:
     )
 
 
-def route_from_vda5050(order: Any) -> Route:
-    """The [`Route`][speedplan.Route] of a VDA 5050 order; see `Route.from_vda5050`.
+class OrderRead(NamedTuple):
+    """What an order says about its route: the nodes, the edges and the header fields."""
+
+    nodes: tuple[RouteNode, ...]
+    edges: tuple[RouteEdge, ...]
+    order_id: str | None
+    order_update_id: int | None
+    version: str
+    notes: tuple[str, ...]
+
+
+def read_order(order: Any) -> OrderRead:
+    """The nodes, edges and header of a VDA 5050 order; see `Route.from_vda5050`.
+
+    Fields not honoured as written are warned about (`OrderWarning`, once per order) and
+    listed in ``notes``.
 
     Examples
     --------
-    >>> from speedplan.route.vda5050 import route_from_vda5050
-    >>> r = route_from_vda5050('''{"version": "2.1.0",
+    >>> from speedplan.route.vda5050 import read_order
+    >>> read = read_order('''{"version": "2.1.0",
     ...   "nodes": [{"nodeId": "A", "sequenceId": 0, "released": true, "actions": [],
     ...              "nodePosition": {"x": 0, "y": 0, "allowedDeviationXY": 0.1, "mapId": "m"}},
     ...             {"nodeId": "B", "sequenceId": 2, "released": true, "actions": [],
@@ -218,21 +232,21 @@ def route_from_vda5050(order: Any) -> Route:
     ...              "startNodeId": "A", "endNodeId": "B", "maxSpeed": 0.5},
     ...             {"edgeId": "BC", "sequenceId": 3, "released": false, "actions": [],
     ...              "startNodeId": "B", "endNodeId": "C"}]}''')
-    >>> len(r.edges), r.length, r.stop_reasons  # the horizon edge BC is not planned
-    (2, 10.0, ('start', 'end of the released base'))
+    >>> [e.edge_id for e in read.edges], [e.released for e in read.edges], read.version
+    (['AB', 'BC'], [True, False], '2.1.0')
     """
     name, doc = load_order(order)
     try:
-        route = _route(doc)
+        read = _read(doc)
     except InvalidInputError as exc:
         if name:
             raise InvalidInputError(f"{name}: {exc}") from exc
         raise
-    if route.notes:
-        lines = "\n".join(f"  - {note}" for note in route.notes)
-        warnings.warn(f"{name or 'order'}: {len(route.notes)} field(s) not honoured as "
+    if read.notes:
+        lines = "\n".join(f"  - {note}" for note in read.notes)
+        warnings.warn(f"{name or 'order'}: {len(read.notes)} field(s) not honoured as "
                       f"written:\n{lines}", OrderWarning, stacklevel=3)
-    return route
+    return read
 
 
 def _dialect(doc: dict[str, Any]) -> _Dialect:
@@ -249,7 +263,7 @@ def _dialect(doc: dict[str, Any]) -> _Dialect:
     return _DIALECTS[key]
 
 
-def _route(doc: Any) -> Route:
+def _read(doc: Any) -> OrderRead:
     doc = _obj(doc, "order")
     dialect = _dialect(doc)
     notes: list[str] = []
@@ -293,8 +307,8 @@ def _route(doc: Any) -> Route:
     edges = [_edge(e, i, nodes[i], nodes[i + 1], ids, dialect, notes)
              for i, e in enumerate(edges_obj)]
     _note_rotations(edges, notes)
-    return Route(tuple(nodes), tuple(edges), order_id=order_id, order_update_id=update,
-                 version=string(doc["version"], "version"), notes=tuple(notes))
+    return OrderRead(tuple(nodes), tuple(edges), order_id=order_id, order_update_id=update,
+                     version=string(doc["version"], "version"), notes=tuple(notes))
 
 
 def _turning(path: Path) -> float:

@@ -21,8 +21,9 @@ from .._version import __version__
 from ..core.checks import FloatArray
 from ..core.errors import InvalidInputError
 from ..core.log import logger
+from ..core.numerics import wrap_heading
 
-__all__ = ["COLUMNS", "HEADING_RANGE", "Trajectory", "wrap_angle"]
+__all__ = ["COLUMNS", "HEADING_RANGE", "Trajectory"]
 
 #: Column names with their units, in export order.
 COLUMNS: dict[str, str] = {
@@ -45,24 +46,6 @@ COLUMNS: dict[str, str] = {
 HEADING_RANGE = "[-pi, pi)"
 
 TextFile = str | PathLike[str] | IO[str]
-
-
-def wrap_angle(theta: Any) -> FloatArray:
-    """Angles [rad] wrapped to ``[-π, π)``; values already in that range are returned unchanged.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from speedplan.timing.trajectory import wrap_angle
-    >>> wrap_angle([0.5, np.pi, 1.5 * np.pi, -np.pi]).round(12).tolist()
-    [0.5, -3.14159265359, -1.570796326795, -3.14159265359]
-    """
-    th = np.asarray(theta, dtype=np.float64)
-    wrapped = np.mod(th + np.pi, 2.0 * np.pi) - np.pi
-    wrapped = np.where(wrapped >= np.pi, -np.pi, wrapped)  # guard against rounding up to π
-    # Leave in-range values bitwise alone: wrapping through mod would perturb their last bits.
-    out: FloatArray = np.where((th >= -np.pi) & (th < np.pi), th, wrapped)
-    return out
 
 
 class _FrozenDict(Mapping[str, Any]):
@@ -232,7 +215,7 @@ class Trajectory:
 
     def _export_columns(self) -> dict[str, FloatArray]:
         cols = self.to_dict()
-        cols["heading"] = wrap_angle(cols["heading"])
+        cols["heading"] = wrap_heading(cols["heading"])
         return cols
 
     def _export_metadata(self) -> dict[str, Any]:
