@@ -33,6 +33,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -360,58 +361,93 @@ def adaptive_grid(
     v_max = v_max if v_top is None else min(v_max, v_top)
     t_j = min(a / j_max, np.sqrt(v_max / j_max))
     ell = rest_phase_length(a, v_max, j_max)
+    rule = _StepRule(w_bound, length, a_max, a_decel, j_max, t_j, per_phase,
+                     floor=min(ell, 0.25 * length), margin=2.0 * (v_max * t_j + ell))
+    # A move shorter than its jerk phases is made of (up to) four of them: resolve each.
+    if v_low is not None and v_low > 0:
+        rule = replace(rule, floor=min(rule.floor, float(rule.scale(np.array(v_low)))))
+    inner_anchors = np.zeros(0) if anchors is None else np.asarray(anchors, dtype=np.float64)
+    inner_anchors = inner_anchors[(inner_anchors > 0.0) & (inner_anchors < length)]
+    sf = _pre_grid(length, rule.floor, inner_anchors)
+    if breakpoints is not None:
+        sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
+    sf, h = _followed(sf, rule)
+    h = _capped(sf, h, length, max_nodes)
+    grid = nodes_from_steps(sf, h, inner_anchors if inner_anchors.size else None)
+    grid_size("n", grid.size)
+    return grid
 
-    def scale(v: FloatArray) -> FloatArray:
-        out: FloatArray = v * np.minimum(t_j, np.sqrt(v / j_max))
+
+@dataclass(frozen=True)
+class _StepRule:
+    """The graded step of `adaptive_grid` on a pre-grid: ``λ(v) / per_phase``, coarse in cruise.
+
+    ``floor``: the transition length the steps keep next to the ends; ``margin``: how far
+    from any kink of the no-jerk profile a stretch counts as cruise.
+    """
+
+    w_bound: Callable[[FloatArray], FloatArray]
+    length: float
+    a_max: float
+    a_decel: float
+    j_max: float
+    t_j: float
+    per_phase: float
+    floor: float
+    margin: float
+
+    def scale(self, v: FloatArray) -> FloatArray:
+        """``λ(v) = v min(t_j, sqrt(v / j))``: the length of a jerk transition at speed ``v``."""
+        out: FloatArray = v * np.minimum(self.t_j, np.sqrt(v / self.j_max))
         return out
 
-    # A move shorter than its jerk phases is made of (up to) four of them: resolve each.
-    floor = min(ell, 0.25 * length)
-    if v_low is not None and v_low > 0:
-        floor = min(floor, float(scale(np.array(v_low))))
-    margin = 2.0 * (v_max * t_j + ell)
-
-    def steps(sf: FloatArray) -> FloatArray:
+    def __call__(self, sf: FloatArray) -> FloatArray:
         """The graded step on the pre-grid ``sf``."""
-        wb = w_bound(sf)
+        length = self.length
+        wb = self.w_bound(sf)
         hf = np.diff(sf)  # the exact no-jerk optimum at twice the limits (speedplan.solve.nojerk)
-        w_est = largest_under_rates(wb, np.full(sf.size - 1, 2 * a_max) * hf,
-                                    np.full(sf.size - 1, 2 * a_decel) * hf)
+        w_est = largest_under_rates(wb, np.full(sf.size - 1, 2 * self.a_max) * hf,
+                                    np.full(sf.size - 1, 2 * self.a_decel) * hf)
         # The floor keeps the steps from vanishing where the speed falls to the ends' states:
         # on the stretches next to each end where λ(v) is below it. A slow stretch farther
         # inside (a zone, a tight curve) has transitions of its own, which may be shorter
         # than the floor: they are resolved like any other.
-        lam = scale(np.sqrt(w_est))
-        h = np.maximum(np.maximum(lam, np.where(_end_runs(lam < floor), floor, 0.0))
-                       / per_phase, MIN_RELATIVE_STEP * length)
+        lam = self.scale(np.sqrt(w_est))
+        h = np.maximum(np.maximum(lam, np.where(_end_runs(lam < self.floor), self.floor, 0.0))
+                       / self.per_phase, MIN_RELATIVE_STEP * length)
         # Long stretches where the no-jerk optimum is linear in w (a cruise, a constant
         # acceleration or braking) hold nothing to resolve: coarse, graded faster. The no-jerk
         # pass sums A h along the path, so it is linear (or meets a constant bound) only to
         # ~1e-16 of that sum, which on a long slow move is far above 1e-12 of the bound.
         top = max(float(np.max(wb)), 1e-300)
-        tol = 1e-9 * top + 1e-15 * 2.0 * max(a_max, a_decel) * length
+        tol = 1e-9 * top + 1e-15 * 2.0 * max(self.a_max, self.a_decel) * length
         flat = np.zeros(sf.size, dtype=bool)
         d_left, d_right = np.diff(w_est)[:-1], np.diff(w_est)[1:]
         cells = np.diff(sf)
         curv = np.abs(d_right / cells[1:] - d_left / cells[:-1]) * np.minimum(cells[1:],
                                                                              cells[:-1])
         flat[1:-1] = curv <= tol
-        far = _distance_to(~flat, sf) > margin
+        far = _distance_to(~flat, sf) > self.margin
         h = np.where(far, np.maximum(h, CRUISE_STEP * length), h)
         return graded_steps(sf, h, np.where(far, CRUISE_GRADING, GRADING))
 
-    # Pre-grid: uniform, with geometric clusters at both ends (where the standstill and the
-    # boundary states put the shortest transitions), refined where it cannot follow h.
+
+def _pre_grid(length: float, floor: float, anchors: FloatArray) -> FloatArray:
+    """Uniform, with geometric clusters at both ends and the anchors.
+
+    The ends are where the standstill and the boundary states put the shortest transitions.
+    """
     n_pre = int(np.clip(4 * length / max(floor, 1e-12), 2001, 200_001))
     ends = np.geomspace(max(floor / 8.0, 1e-12 * length), 0.5 * length, 200)
-    inner_anchors = np.zeros(0) if anchors is None else np.asarray(anchors, dtype=np.float64)
-    inner_anchors = inner_anchors[(inner_anchors > 0.0) & (inner_anchors < length)]
     sf = np.unique(np.concatenate((np.linspace(0.0, length, n_pre), ends, length - ends,
-                                   inner_anchors)))
-    sf = sf[(sf >= 0.0) & (sf <= length)]
-    if breakpoints is not None:
-        sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
-    h = steps(sf)
+                                   anchors)))
+    out: FloatArray = sf[(sf >= 0.0) & (sf <= length)]
+    return out
+
+
+def _followed(sf: FloatArray, rule: _StepRule) -> tuple[FloatArray, FloatArray]:
+    """The pre-grid refined where its cells are too coarse to follow the steps, and the steps."""
+    h = rule(sf)
     for _ in range(3):
         cell = np.diff(sf)
         need = np.ceil(cell / (2.0 * np.minimum(h[:-1], h[1:]))).astype(np.int64)
@@ -421,7 +457,12 @@ def adaptive_grid(
         extra = [sf[k] + cell[k] * np.arange(1, min(int(need[k]), 64)) / min(int(need[k]), 64)
                  for k in coarse]
         sf = np.unique(np.concatenate([sf, *extra]))
-        h = steps(sf)
+        h = rule(sf)
+    return sf, h
+
+
+def _capped(sf: FloatArray, h: FloatArray, length: float, max_nodes: int) -> FloatArray:
+    """Steps grown in proportion to count at most ``max_nodes`` (at least `MIN_NODES`)."""
     h_max = np.maximum(h, CRUISE_STEP * length)
     for _ in range(4):
         count = float(np.sum(np.diff(sf) * 0.5 * (1.0 / h[1:] + 1.0 / h[:-1])))
@@ -432,9 +473,7 @@ def adaptive_grid(
                          np.full(sf.size, CRUISE_GRADING))
     if count < MIN_NODES - 1:
         h = h * (count / (MIN_NODES - 1))
-    grid = nodes_from_steps(sf, h, inner_anchors if inner_anchors.size else None)
-    grid_size("n", grid.size)
-    return grid
+    return h
 
 
 #: A breakpoint of the bound joins the first scan of `adaptive_grid` where the bound

@@ -61,46 +61,90 @@ def _rows(
     return r, c, v
 
 
-def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, FloatArray, list[Any]]:
-    """Return ``(A, b, q, cones)`` of the relaxation in Clarabel's ``Ax + s = b`` form."""
-    import scipy.sparse as sp
+class _Rows:
+    """Rows of ``A x + s = b`` gathered block by block, in cone order."""
 
+    def __init__(self) -> None:
+        self.r: list[IntArray] = []
+        self.c: list[IntArray] = []
+        self.v: list[FloatArray] = []
+        self.b: list[FloatArray] = []
+        self.count = 0
+
+    def add(self, n_rows: int, cols: list[Any], vals: list[Any], rhs: FloatArray) -> None:
+        """``n_rows`` rows, one entry per row from each column and value array."""
+        r, c, v = _rows(n_rows, cols, vals)
+        self.add_coo(np.asarray(r), np.asarray(c), np.asarray(v), rhs)
+
+    def add_coo(self, r: IntArray, c: IntArray, v: FloatArray, rhs: FloatArray) -> None:
+        """Rows given as coordinates ``r`` (from 0), ``c`` and values ``v``."""
+        self.r.append(r + self.count)
+        self.c.append(c)
+        self.v.append(v)
+        self.b.append(rhs)
+        self.count += rhs.size
+
+    def matrix(self, nvar: int) -> tuple[sp.csc_matrix, FloatArray]:
+        import scipy.sparse as sp
+
+        A = sp.csc_matrix((np.concatenate(self.v), (np.concatenate(self.r),
+                                                    np.concatenate(self.c))),
+                          shape=(self.count, nvar))
+        return A, np.concatenate(self.b)
+
+
+def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, FloatArray, list[Any]]:
+    """Return ``(A, b, q, cones)`` of the relaxation in Clarabel's ``Ax + s = b`` form.
+
+    Variables: ``w`` (n), the epigraph ``t`` and auxiliary ``z`` of each interior node
+    (``t_i >= τ_i / sqrt(w_i)`` through ``z_i² <= w_i`` and ``t_i z_i >= τ_i``), and with a
+    friction ellipse each cell's acceleration fraction ``u``.
+    """
     n = problem.n
     m = n - 2
     iw, it, iz, iu = 0, n, n + m, n + 2 * m
     nvar = n + 2 * m + (n - 1 if problem.has_grip else 0)
-    h, tau = problem.h, problem.tau
+    h = problem.h
     interior = np.arange(1, n - 1)
     seg = np.arange(n - 1)
-    blocks_r: list[IntArray] = []
-    blocks_c: list[IntArray] = []
-    blocks_v: list[FloatArray] = []
-    b_parts: list[FloatArray] = []
-    row0 = 0
-
-    def add(n_rows: int, cols: list[Any], vals: list[Any], rhs: FloatArray) -> None:
-        nonlocal row0
-        r, c, v = _rows(n_rows, cols, vals)
-        blocks_r.append(np.asarray(r) + row0)
-        blocks_c.append(np.asarray(c))
-        blocks_v.append(np.asarray(v))
-        b_parts.append(rhs)
-        row0 += n_rows
-
+    rows = _Rows()
     one = np.ones
     # Zero cone: the two boundary values.
-    add(2, [np.array([iw, iw + n - 1])], [one(2)], np.array([problem.w_start, problem.w_end]))
+    rows.add(2, [np.array([iw, iw + n - 1])], [one(2)], np.array([problem.w_start, problem.w_end]))
     # Nonnegative cone: acceleration, braking, upper bounds, jerk rows.
-    add(n - 1, [iw + seg + 1, iw + seg], [one(n - 1), -one(n - 1)], problem.accel * h)
-    add(n - 1, [iw + seg, iw + seg + 1], [one(n - 1), -one(n - 1)], problem.decel * h)
-    add(m, [iw + interior], [one(m)], problem.w_max[1:-1])
-    n_lower = 0
+    rows.add(n - 1, [iw + seg + 1, iw + seg], [one(n - 1), -one(n - 1)], problem.accel * h)
+    rows.add(n - 1, [iw + seg, iw + seg + 1], [one(n - 1), -one(n - 1)], problem.decel * h)
+    rows.add(m, [iw + interior], [one(m)], problem.w_max[1:-1])
     if problem.has_lower_bounds:
         assert problem.w_min is not None
         low = np.flatnonzero(problem.w_min[1:-1] > 0) + 1
-        n_lower = low.size
-        add(n_lower, [iw + low], [-one(n_lower)], -problem.w_min[low])
-    n_jerk = 0
+        rows.add(low.size, [iw + low], [-one(low.size)], -problem.w_min[low])
+    _add_stencil_rows(rows, problem, iw, it)
+    if problem.has_grip:  # (±(w_{i+1} - w_i) / (h A)) - u_i <= 0
+        ucol = iu + seg
+        for lo_col, hi_col, limit in ((iw + seg, iw + seg + 1, problem.accel),
+                                      (iw + seg + 1, iw + seg, problem.decel)):
+            rows.add(n - 1, [hi_col, lo_col, ucol],
+                     [1.0 / (h * limit), -1.0 / (h * limit), -one(n - 1)], np.zeros(n - 1))
+    n_nonneg = rows.count - 2
+    _add_node_cones(rows, problem.tau, iw, it, iz)
+    n_grip_cones = 0
+    if problem.grip is not None:
+        r, c, v, rhs = _grip_cones(problem.grip, iw, iu)
+        rows.add_coo(r, c, v, rhs)
+        n_grip_cones = rhs.size // 3
+    A, b = rows.matrix(nvar)
+    q = np.zeros(nvar)
+    q[it : it + m] = 1.0
+    cones = [clarabel.ZeroConeT(2), clarabel.NonnegativeConeT(n_nonneg)]
+    cones += [clarabel.SecondOrderConeT(3)] * (2 * m + n_grip_cones)
+    return A, b, q, cones
+
+
+def _add_stencil_rows(rows: _Rows, problem: DiscreteProblem, iw: int, it: int) -> None:
+    """The relaxed jerk and lateral-jerk rows ``±τ (c·w) / B - t <= 0`` (nonnegative cone)."""
+    tau = problem.tau
+    m = problem.n - 2
     wcols = (np.arange(m)[:, None] + np.arange(3)[None, :]) + iw
     for family in problem.stencil_families():  # jerk rows, then lateral-jerk rows
         finite = np.flatnonzero(np.isfinite(family.bound))
@@ -110,56 +154,26 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
         cols = wcols[finite]
         tcol = (it + finite)[:, None]
         k = finite.size
-        for sign in (1.0, -1.0):  # ±τ (c·w)/B - t <= 0
-            add(
+        for sign in (1.0, -1.0):
+            rows.add(
                 k,
                 [cols[:, 0], cols[:, 1], cols[:, 2], tcol[:, 0]],
-                [sign * coef[:, 0], sign * coef[:, 1], sign * coef[:, 2], -one(k)],
+                [sign * coef[:, 0], sign * coef[:, 1], sign * coef[:, 2], -np.ones(k)],
                 np.zeros(k),
             )
-        n_jerk += 2 * k
-    n_grip = 0
-    if problem.has_grip:  # (±(w_{i+1} - w_i) / (h A)) - u_i <= 0
-        ucol = iu + seg
-        for lo_col, hi_col, limit in ((iw + seg, iw + seg + 1, problem.accel),
-                                      (iw + seg + 1, iw + seg, problem.decel)):
-            add(n - 1, [hi_col, lo_col, ucol],
-                [1.0 / (h * limit), -1.0 / (h * limit), -one(n - 1)], np.zeros(n - 1))
-        n_grip = 2 * (n - 1)
-    n_nonneg = 2 * (n - 1) + m + n_lower + n_jerk + n_grip
-    # Second-order cones, interleaved per node: (w+1, 2z, w-1) and (t+z, t-z, 2 sqrt(τ)).
+
+
+def _add_node_cones(rows: _Rows, tau: FloatArray, iw: int, it: int, iz: int) -> None:
+    """Second-order cones, interleaved per node: (w+1, 2z, w-1) and (t+z, t-z, 2 sqrt(τ))."""
+    m = tau.size
     j = np.arange(m)
-    wc, tc, zc = iw + interior, it + j, iz + j
+    wc, tc, zc = iw + 1 + j, it + j, iz + j
     r = np.column_stack((6 * j, 6 * j + 1, 6 * j + 2, 6 * j + 3, 6 * j + 3, 6 * j + 4, 6 * j + 4))
     c = np.column_stack((wc, zc, wc, tc, zc, tc, zc))
     v = np.tile([-1.0, -2.0, -1.0, -1.0, -1.0, -1.0, 1.0], (m, 1))
-    blocks_r.append(r.ravel() + row0)
-    blocks_c.append(c.ravel())
-    blocks_v.append(v.ravel())
     rhs = np.zeros((m, 6))
     rhs[:, 0], rhs[:, 2], rhs[:, 5] = 1.0, -1.0, 2.0 * np.sqrt(tau)
-    b_parts.append(rhs.ravel())
-    row0 += 6 * m
-    n_grip_cones = 0
-    if problem.grip is not None:
-        r, c, v, rhs = _grip_cones(problem.grip, iw, iu)
-        blocks_r.append(r + row0)
-        blocks_c.append(c)
-        blocks_v.append(v)
-        b_parts.append(rhs)
-        row0 += rhs.size
-        n_grip_cones = rhs.size // 3
-
-    A = sp.csc_matrix(
-        (np.concatenate(blocks_v), (np.concatenate(blocks_r), np.concatenate(blocks_c))),
-        shape=(row0, nvar),
-    )
-    b = np.concatenate(b_parts)
-    q = np.zeros(nvar)
-    q[it : it + m] = 1.0
-    cones = [clarabel.ZeroConeT(2), clarabel.NonnegativeConeT(n_nonneg)]
-    cones += [clarabel.SecondOrderConeT(3)] * (2 * m + n_grip_cones)
-    return A, b, q, cones
+    rows.add_coo(r.ravel(), c.ravel(), v.ravel(), rhs.ravel())
 
 
 def _grip_cones(grip: FloatArray, iw: int, iu: int

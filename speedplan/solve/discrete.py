@@ -14,7 +14,7 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -160,8 +160,53 @@ def solve_problem(
     positive_feasible_w(problem)  # before scaling: its error names s in the problem's units
     if backend == "auto":  # only now: the pass above needs no solver (and no compilation)
         backend = _auto_backend(problem)
-    # Solve in units where the mean step and the largest bound are 1: well-scaled cones.
-    s_scale, w_scale = unit_scales(problem)
+    relaxed = _relaxed(problem, backend, fallback)
+    w = relaxed.w
+    status: Status = "optimal" if relaxed.exact else "relaxed"
+    refinement: RefinementInfo | None = None
+    refined = refine == "always" or (refine == "auto" and not relaxed.exact)
+    if refined:
+        w, status, refinement = _refined(problem, relaxed, w, status)
+    elif not relaxed.exact:
+        warnings.warn(
+            f"refine='never' and the relaxation is not exact: w violates jerk rows by up to "
+            f"{relaxed.info.jerk_violation:.3g} (status 'relaxed')",
+            SpeedplanWarning, stacklevel=3,
+        )
+
+    objective = problem.travel_time(w)
+    return DiscreteSolution(
+        w=w,
+        objective=objective,
+        lower_bound=relaxed.lower,
+        gap=(objective - relaxed.lower) / relaxed.lower,
+        exact=relaxed.exact,
+        exact_a_priori=problem.satisfies_a_priori_exactness(),
+        jerk_violation=problem.jerk_violation(w),
+        refined=refined,
+        status=status,
+        solve_time=time.perf_counter() - t_start,
+        backend=relaxed.info.backend,
+        relaxation=relaxed.info,
+        refinement=refinement,
+    )
+
+
+class _Relaxed(NamedTuple):
+    """The relaxation's answer, in the problem's units and in the solver's."""
+
+    unit: DiscreteProblem  # the problem in the solver's units (`unit_scales`)
+    w_unit: FloatArray  # the relaxation's w in those units
+    w_scale: float
+    w: FloatArray  # clipped into the bounds, in the problem's units, ends fixed
+    lower: float  # certified lower bound on the travel time [s]
+    exact: bool
+    info: RelaxationInfo
+
+
+def _relaxed(problem: DiscreteProblem, backend: str, fallback: bool) -> _Relaxed:
+    """Solve the relaxation in units where the mean step and the largest bound are 1."""
+    s_scale, w_scale = unit_scales(problem)  # well-scaled cones
     time_scale = s_scale / np.sqrt(w_scale)
     unit = problem.scaled(s_scale, w_scale)
     relax, backend, fallback_reason = _relax_with_fallback(unit, backend, fallback)
@@ -173,72 +218,52 @@ def solve_problem(
     # ellipse met to GRIP_TOL is exact (the convex rows are not relaxed).
     exact = relaxed_violation <= problem.jerk_tol and problem.grip_violation(
         w_relaxed) <= GRIP_TOL
-    relaxation = RelaxationInfo(
+    info = RelaxationInfo(
         backend=backend, status=relax.status, iterations=relax.iterations,
         time=relax.solve_time + relax.setup_time, w=w_relaxed,
         jerk_violation=relaxed_violation, fallback=fallback_reason,
     )
-    w = w_relaxed
-    status: Status = "optimal" if exact else "relaxed"
-    refined = False
-    refinement: RefinementInfo | None = None
+    return _Relaxed(unit, relax.w, w_scale, w_relaxed, lower, exact, info)
 
-    if refine == "always" or (refine == "auto" and not exact):
-        refined = True
 
-        def feasible(w_unit: FloatArray) -> bool:
-            w_ref = np.clip(w_unit * w_scale, 0.0, problem.w_max)
-            return bool(problem.linear_violation(w_ref) <= _linear_tol(problem)
-                        and problem.jerk_violation(w_ref) <= problem.jerk_tol
-                        and problem.grip_violation(w_ref) <= GRIP_TOL)
+def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status: Status
+             ) -> tuple[FloatArray, Status, RefinementInfo]:
+    """The nonconvex refinement from the relaxation's point: ``w`` and status it leaves.
 
-        ref = refine_nlp(unit, relax.w, accept=feasible)
-        w_ref = np.clip(ref.w * w_scale, 0.0, problem.w_max)
-        ref_ok = ref.success and feasible(ref.w)
-        refinement = RefinementInfo(
-            status=ref.status, accepted=ref_ok, iterations=ref.iterations, time=ref.solve_time,
-            objective=problem.travel_time(w_ref) if ref_ok else None,
-        )
-        if not exact:
-            if ref_ok:
-                w, status = w_ref, "refined"
-            else:
-                scaled = _scale_into_jerk_bounds(problem, w_relaxed)
-                if scaled is None:
-                    raise SolverError(
-                        f"the relaxation is not exact (jerk violation {relaxed_violation:.3g}) "
-                        f"and the refinement did not return a feasible point ({ref.status})",
-                        backend="ipopt", status=ref.status,
-                    )
-                warnings.warn(
-                    f"the refinement failed ({ref.status}); returning the relaxed "
-                    "solution scaled into the jerk bounds (status 'scaled')",
-                    SpeedplanWarning, stacklevel=3,
-                )
-                w, status = scaled, "scaled"
-    elif not exact:
-        warnings.warn(
-            f"refine='never' and the relaxation is not exact: w violates jerk rows by up to "
-            f"{relaxed_violation:.3g} (status 'relaxed')",
-            SpeedplanWarning, stacklevel=3,
-        )
+    An exact relaxation keeps its own ``w`` (the refinement is only recorded); otherwise the
+    refined point if it is feasible, else the relaxed one scaled into the jerk bounds.
+    """
 
-    objective = problem.travel_time(w)
-    return DiscreteSolution(
-        w=w,
-        objective=objective,
-        lower_bound=lower,
-        gap=(objective - lower) / lower,
-        exact=exact,
-        exact_a_priori=problem.satisfies_a_priori_exactness(),
-        jerk_violation=problem.jerk_violation(w),
-        refined=refined,
-        status=status,
-        solve_time=time.perf_counter() - t_start,
-        backend=backend,
-        relaxation=relaxation,
-        refinement=refinement,
+    def feasible(w_unit: FloatArray) -> bool:
+        w_ref = np.clip(w_unit * relaxed.w_scale, 0.0, problem.w_max)
+        return bool(problem.linear_violation(w_ref) <= _linear_tol(problem)
+                    and problem.jerk_violation(w_ref) <= problem.jerk_tol
+                    and problem.grip_violation(w_ref) <= GRIP_TOL)
+
+    ref = refine_nlp(relaxed.unit, relaxed.w_unit, accept=feasible)
+    w_ref = np.clip(ref.w * relaxed.w_scale, 0.0, problem.w_max)
+    ref_ok = ref.success and feasible(ref.w)
+    refinement = RefinementInfo(
+        status=ref.status, accepted=ref_ok, iterations=ref.iterations, time=ref.solve_time,
+        objective=problem.travel_time(w_ref) if ref_ok else None,
     )
+    if relaxed.exact:
+        return w, status, refinement
+    if ref_ok:
+        return w_ref, "refined", refinement
+    scaled = _scale_into_jerk_bounds(problem, relaxed.w)
+    if scaled is None:
+        raise SolverError(
+            f"the relaxation is not exact (jerk violation {relaxed.info.jerk_violation:.3g}) "
+            f"and the refinement did not return a feasible point ({ref.status})",
+            backend="ipopt", status=ref.status,
+        )
+    warnings.warn(
+        f"the refinement failed ({ref.status}); returning the relaxed "
+        "solution scaled into the jerk bounds (status 'scaled')",
+        SpeedplanWarning, stacklevel=4,
+    )
+    return scaled, "scaled", refinement
 
 
 def _accel_pair(A: Any, n: int) -> tuple[FloatArray, FloatArray]:
