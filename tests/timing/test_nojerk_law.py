@@ -28,7 +28,7 @@ from speedplan.model import PlanRequest, build_model
 from speedplan.timing import SpeedProfile, TimeLaw
 from speedplan.timing.verify import bound_breakpoints
 
-PATHS = FsPath(__file__).resolve().parents[1] / "paths"
+PATHS = FsPath(__file__).resolve().parents[2] / "paths"
 NO_JERK = replace(LGV, j_max=math.inf)
 ROAD = sp.Limits(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=math.inf)
 

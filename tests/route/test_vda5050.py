@@ -21,7 +21,7 @@ from scipy.interpolate import BSpline
 from speedplan import InvalidInputError
 from speedplan.route import Route
 
-ORDERS = FsPath(__file__).resolve().parents[1] / "paths" / "orders"
+ORDERS = FsPath(__file__).resolve().parents[2] / "paths" / "orders"
 
 
 def node(i, x, y, actions=(), **pos):

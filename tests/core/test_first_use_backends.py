@@ -22,7 +22,7 @@ from speedplan.core import jit
 from speedplan.geometry import Line
 from speedplan.io import read_path
 
-ROOT = Path(__file__).parents[1]
+ROOT = Path(__file__).parents[2]
 LGV = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 
 

@@ -25,7 +25,7 @@ from speedplan.io import (
     write_waypoints,
 )
 
-ROOT = FsPath(__file__).resolve().parents[1]
+ROOT = FsPath(__file__).resolve().parents[2]
 SAMPLES = sorted(p for p in (ROOT / "paths").iterdir() if p.suffix in (".csv", ".json"))
 
 TRAJ = {"degree": 2, "knotVector": [0, 0, 0, 1, 1, 1],
@@ -87,7 +87,7 @@ def test_json_segments_waypoints_and_zones(tmp_path):
     assert w.length == pytest.approx(5.0, rel=1e-14)
 
 
-# A whole order (`edges`) is a route: read_path refuses it (tests/test_route_io.py).
+# A whole order (`edges`) is a route: read_path refuses it (tests/route/test_order_files.py).
 @pytest.mark.parametrize("wrap", [lambda t: t, lambda t: {"trajectory": t}])
 def test_vda5050_trajectory_bare_or_nested(tmp_path, wrap):
     p = read_path(write(tmp_path, "edge.json", wrap(TRAJ)))

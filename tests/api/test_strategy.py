@@ -195,7 +195,7 @@ def test_states_read_off_a_plan_replan_without_a_warning():
     # whose state needs 2.6e-5 more jerk than j_max (the law's rounding), warned per cycle.
     from speedplan.io import read_path
 
-    u_turn = read_path(os.path.join(os.path.dirname(__file__), "..", "paths", "u_turn.json"))
+    u_turn = read_path(os.path.join(os.path.dirname(__file__), "..", "..", "paths", "u_turn.json"))
     first = sp.plan(u_turn, LGV)
     rounded = 0
     for t in (*np.linspace(0.25, first.duration - 0.5, 13), 3.0):

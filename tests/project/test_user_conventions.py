@@ -16,7 +16,7 @@ from shared import LGV, LGV_ARGS
 import speedplan as sp
 from speedplan import cli
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

@@ -286,7 +286,7 @@ def test_refinement_is_feasible_certified_and_never_worse_than_ipopt(family, see
 #: ``benchmarks/data/refine_corpus.npz`` entries (``plan()`` problems of an earlier model,
 #: braking starts, relaxed ``w`` stored) where IPOPT's tight run ends below the refinement by
 #: 2.5e-5 and 2.1e-6: bought by rows it leaves violated by 18 % and 0.4 % of ``jerk_tol``.
-CORPUS = Path(__file__).resolve().parents[1] / "benchmarks" / "data" / "refine_corpus.npz"
+CORPUS = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "refine_corpus.npz"
 
 
 @pytest.mark.parametrize("entry", [1, 37])

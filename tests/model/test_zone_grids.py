@@ -5,7 +5,7 @@ zone, both interior-point methods stalled (``NoProgress``, ``AlmostSolved`` at a
 stops inside the leg) on fine default grids, and ``plan()`` raised ``SolverError`` on feasible
 requests. The straight move below is the smallest reproduction found: a 1 m move through a
 0.11 m/s zone, whose 6 783-node default grid neither backend solved. (Since the banded
-method's progress test counts its residuals too, ``tests/test_ipm_progress.py``, it solves
+method's progress test counts its residuals too, ``tests/solve/test_ipm_progress.py``, it solves
 that grid; the coarser grids remain the next step where it gives up.)
 """
 

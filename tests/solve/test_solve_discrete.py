@@ -307,7 +307,7 @@ def test_fine_uniform_grid_gets_the_same_answer_from_auto_and_clarabel():
     import speedplan as sp
     from speedplan.io import read_path
 
-    path = read_path(str(Path(__file__).parents[1] / "paths" / "u_turn.json"))
+    path = read_path(str(Path(__file__).parents[2] / "paths" / "u_turn.json"))
     limits = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
     auto = sp.plan(path, limits, n=5000, refine="never")
     ref = sp.plan(path, limits, n=5000, refine="never", backend="clarabel")
@@ -330,7 +330,7 @@ def test_very_fine_grid_gets_a_certified_answer(name):
     import speedplan as sp
     from speedplan.io import read_path
 
-    path = read_path(str(Path(__file__).parents[1] / "paths" / name))
+    path = read_path(str(Path(__file__).parents[2] / "paths" / name))
     limits = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
     prof = sp.plan(path, limits, n=20000, refine="never")
     sol = prof.solution

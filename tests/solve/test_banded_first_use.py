@@ -15,7 +15,7 @@ from speedplan.solve import banded, discrete
 from speedplan.solve.paper import paper_instance
 from speedplan.solve.problem import DiscreteProblem
 
-ROOT = Path(__file__).parents[1]
+ROOT = Path(__file__).parents[2]
 
 
 def _problem(n: int) -> DiscreteProblem:

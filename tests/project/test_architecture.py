@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from shared import imported_modules
 
-PACKAGE = Path(__file__).resolve().parent.parent / "speedplan"
+PACKAGE = Path(__file__).resolve().parents[2] / "speedplan"
 LAYERS = ("core", "geometry", "solve", "model", "timing", "route")
 TOP = len(LAYERS)
 

@@ -11,7 +11,7 @@ from speedplan import InvalidInputError
 from speedplan.io import read_path, read_route
 from speedplan.route import Route
 
-ROOT = FsPath(__file__).resolve().parents[1]
+ROOT = FsPath(__file__).resolve().parents[2]
 ORDERS = sorted((ROOT / "paths" / "orders").glob("*.json"))
 
 

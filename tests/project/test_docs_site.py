@@ -26,7 +26,7 @@ import pytest
 
 import speedplan
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.skipif(
     shutil.which("mkdocs") is None and importlib.util.find_spec("mkdocs") is None,
     reason="the docs extra is not installed",

@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SCANNED = ("README.md", "CHANGELOG.md", "pyproject.toml", "mkdocs.yml", "conftest.py",
            "docs", "tests", "benchmarks", "speedplan", "paths", ".ci")
 SUFFIXES = {".md", ".py", ".toml", ".yml", ".yaml", ".json", ".csv", ".txt", ".cfg", ""}

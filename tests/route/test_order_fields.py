@@ -22,7 +22,7 @@ from shared import LGV
 from speedplan import Route, plan_route
 from speedplan.route.vda5050 import OrderWarning
 
-ORDERS = FsPath(__file__).resolve().parent.parent / "paths" / "orders"
+ORDERS = FsPath(__file__).resolve().parents[2] / "paths" / "orders"
 
 
 def _node(i, x, y, version="2.1.0", deviation=None, **pos):
