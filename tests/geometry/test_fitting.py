@@ -65,6 +65,7 @@ def test_g1_hermite_special_cases():
 
 # ---- clothoid chain -------------------------------------------------------------------------
 AISLE = np.array([[0, 0], [12, 0], [13.5, 1.5], [13.5, 10], [15, 11.5], [27, 11.5]], float)
+SERPENTINE = [[0, 0], [20, 0], [20, 6], [0, 6], [0, 12]]
 
 
 @pytest.mark.parametrize("pts", [AISLE, AISLE * 1e-3 + 5.0, AISLE[::-1],
@@ -99,6 +100,16 @@ def test_clothoid_chain_uses_given_headings():
     p = Path.from_waypoints(pts, kind="clothoid", headings=heads)
     np.testing.assert_allclose(wrapped(p.heading(p.offsets) - heads), 0, atol=1e-12)
     np.testing.assert_allclose(p.point(p.offsets), pts, atol=1e-9)
+
+
+def test_clothoid_chain_headings_follow_the_leg_bisectors():
+    # Legs of the serpentine point 0, π/2, π, π/2: bisectors π/4, 3π/4, 3π/4; leg directions at
+    # the ends (headings estimated from a spline, -1.19 rad at the start, swing the chain
+    # 7 m out).
+    p = Path.from_waypoints(SERPENTINE, kind="clothoid")
+    expected = np.array([0, 1, 3, 3, 2]) * np.pi / 4
+    np.testing.assert_allclose(p.heading(p.offsets), expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(p.point(p.offsets), SERPENTINE, rtol=0, atol=1e-9)
 
 
 def test_closed_waypoints_give_a_closed_smooth_loop():

@@ -1,26 +1,88 @@
-"""A dip of the speed bound narrower than the default grid's first scan, or than a zone scan.
+"""The default grid: graded ends that neither cruise fast nor arrive early, end transients
+sized from the speed cap, and dips of the speed bound narrower than its first scan or a zone
+scan.
 
-Found by ``benchmarks/fuzz_zones.py`` (seed 3, case 51): a 4.5 km path with a 9 cm hairpin
-(0.29 m/s for 0.3 m) between two points of the scan ``adaptive_grid`` reads the bound on
-(0.97 m apart). The grid had 45 m steps there, the law crossed the hairpin too fast, and
-three refinements of a quarter each left it at 1.76x ``j_max``: ``limits_exceeded``. The
-joins of the path's pieces, where a clothoid chain's curvature peaks, and the zones' edges
-(``bound_breakpoints``) now join the scan where the bound dips between its points.
+Straight moves are judged by ruckig's exact optimum of the same move and finite differences of
+the sampled trajectory (``oracles.measure``).
+
+A dip drawn by ``benchmarks/fuzz_zones.py`` (seed 3, case 51): a 4.5 km path with a 9 cm
+hairpin (0.29 m/s for 0.3 m) between two points of the scan ``adaptive_grid`` reads the bound
+on (0.97 m apart). A grid of 45 m steps there crosses the hairpin too fast, and three
+refinements of a quarter each leave it at 1.76x ``j_max``: ``limits_exceeded``. The joins of
+the path's pieces, where a clothoid chain's curvature peaks, and the zones' edges
+(``bound_breakpoints``) join the scan where the bound dips between its points.
 
 A zone crossed between two points of the membership scan of ``zone_intervals`` (2 cm on a
-4 km path) was not seen at all: a 1 cm zone at 0.29 m/s was crossed at 5.29 m/s and the
-plan said ``optimal`` (its checks read the zone's edges from that scan). Steps next to a
-zone are now scanned again, 64 times finer.
+4 km path) is not seen at all: a 1 cm zone at 0.29 m/s crossed at 5.29 m/s, with a plan
+saying ``optimal`` (its checks read the zone's edges from that scan). Steps next to a zone are
+scanned again, 64 times finer.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from oracles import measure, no_jerk_lower_bound, ruckig_move, within_promise
+from oracles import (
+    PROMISED,
+    measure,
+    no_jerk_lower_bound,
+    ruckig_duration,
+    ruckig_move,
+    within_promise,
+)
 
-from speedplan import Limits, Path, SpeedZone, plan
+from speedplan import Limits, Path, SpanLimit, SpeedZone, plan
 from speedplan.geometry import Arc, Line, SpeedBound, bound_breakpoints, zone_intervals
+
+
+def _line(length: float) -> Path:
+    return Path.from_segments([Line(length)])
+
+
+def _physical(profile, length, lim, **states):
+    """Within the promised tolerances, and never faster than ruckig beyond 1e-4."""
+    m = measure(profile, samples=12_000)
+    assert within_promise(m), m
+    assert profile.duration >= ruckig_duration(length, lim, **states) * (1 - 1e-4)
+    assert profile.status in ("optimal", "refined")
+
+
+@pytest.mark.parametrize(("length", "lim"), [
+    (400.0, Limits(v_max=0.2, a_max=3.0, a_lat_max=1.0, j_max=10.0)),  # was 1822.8 s < 2000 s
+    (100.0, Limits(v_max=0.2, a_max=0.5, a_lat_max=1.0, j_max=5.0)),  # was -0.23 %, silent
+    (10_000.0, Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)),  # was -0.35 %
+])
+def test_graded_default_grids_neither_cruise_fast_nor_arrive_early(length, lim):
+    profile = plan(_line(length), lim)
+    _physical(profile, length, lim)
+    assert profile.duration >= length / lim.v_max  # L / v_max alone bounds it from below
+
+
+@pytest.mark.parametrize(("length", "cap", "lim"), [
+    # Capped far below v_max by a span, a zone or v_limit (an edge's maxSpeed in a route):
+    # the default grid sized its end transients from v_max and came out 1.2e-3 slower than
+    # ruckig at the cap (benchmarks/fuzz_caps.py draws such moves) ...
+    (172.9, 0.06039, Limits(v_max=4.93, a_max=0.4172, a_lat_max=1.0, j_max=0.03581)),
+    (32.54, 0.06776, Limits(v_max=3.383, a_max=3.707, a_lat_max=1.0, j_max=0.08693)),
+    # ... or 2.2e-4 *faster*, with the jerk 4.3 % over j_max.
+    (1.848, 0.1455, Limits(v_max=7.125, a_max=0.2465, a_lat_max=1.0, j_max=0.02665)),
+])
+@pytest.mark.parametrize("how", ["span", "v_limit"])
+@pytest.mark.parametrize("n", [None, 300])
+def test_a_cap_far_below_v_max_is_planned_to_its_own_optimum(length, cap, lim, how, n):
+    # A user grid's graded ends had the same cause: 7.6e-3 above at n = 300 (the first move).
+    path = _line(length)
+    kw = ({"spans": [SpanLimit(0.0, length, v_max=cap)]} if how == "span"
+          else {"v_limit": ([0.0, length], [cap, cap])})
+    profile = plan(path, lim, n=n, **kw)
+    capped = Limits(v_max=cap, a_max=lim.a_max, a_lat_max=1.0, j_max=lim.j_max)
+    exact = ruckig_duration(length, capped)
+    assert profile.status == "optimal"
+    below = 2e-5 if n is None else 1e-4  # the jerk tolerance on a coarse grid
+    assert exact * (1 - below) <= profile.duration <= exact * (1 + 1e-4)
+    m = measure(profile, samples=12_000)
+    assert m.speed <= 1 + PROMISED["speed"] and m.jerk <= 1 + 0.02, m
+
 
 LIM = Limits(v_max=5.29, a_max=1.79, a_lat_max=0.948, j_max=0.273)
 

@@ -405,8 +405,8 @@ def test_infeasible_rows_are_reported_not_returned_as_success():
     assert isinstance(res, RefineResult)
 
 
-def _issue_problem(n: int) -> DiscreteProblem:
-    """The problem on the exactly uniform grid of ``n`` nodes (as plan() built it then)."""
+def _braking_start_problem(n: int) -> DiscreteProblem:
+    """A braking start's problem on the exactly uniform grid of ``n`` nodes (not graded)."""
     lim = sp.Limits(v_max=1.5103489923280469, a_max=0.8675731399347792, a_lat_max=1,
                     j_max=0.1324661827707745)
     path = sp.Path.from_segments([Line(8.149176458679765)])
@@ -417,13 +417,12 @@ def _issue_problem(n: int) -> DiscreteProblem:
     return leg_on_grid(req, leg.bound, uniform, 0.0, v0, a0, 0.0, 0.0).problem
 
 
-def test_issue_17_braking_start_on_a_uniform_grid_is_refined():
-    # Before: IPOPT (adaptive barrier, rows divided by their bound) reported
-    # Infeasible_Problem_Detected here and solve_problem raised SolverError. (On the default
-    # grid the relaxation of this request is now exact: the start envelopes of the model; on
-    # plan()'s user grids too, now graded at the braking start: the uniform grid keeps the
-    # refinement exercised.)
-    p = _issue_problem(2000)
+def test_a_braking_start_on_a_uniform_grid_is_refined():
+    # IPOPT with an adaptive barrier and rows divided by their bound reports
+    # Infeasible_Problem_Detected here. (On the default grid the relaxation of this request
+    # is exact: the start envelopes of the model; on plan()'s user grids too, graded at the
+    # braking start: the uniform grid keeps the refinement exercised.)
+    p = _braking_start_problem(2000)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no fallback warning either
         try:
