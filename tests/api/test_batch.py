@@ -1,4 +1,5 @@
-"""plan_many: argument checks, warnings captured per job, loud executor failures, spawn."""
+"""plan_many: argument checks, results and warnings per job, loud executor failures, spawn,
+process pools and a dask cluster."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import warnings
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import replace
 
+import numpy as np
 import pytest
 from shared import LGV
 
@@ -145,3 +147,37 @@ def test_spawn_start_method_needs_the_main_guard(tmp_path, guarded):
     else:  # loud, with the fix in the message, instead of a list of failures and exit 0
         assert res.returncode != 0
         assert "__name__" in res.stderr and "spawn" in res.stderr
+
+
+def _jobs():
+    lim = sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
+    good = [(sp.Path.from_segments([Line(L)]), lim) for L in (4.0, 9.0)]
+    bad = {"path": sp.Path.from_segments([Line(5.0)]), "limits": lim, "v0": 5.0}
+    return [good[0], bad, good[1]]
+
+
+def test_plan_many_matches_one_by_one_and_reports_errors_per_job():
+    jobs = _jobs()
+    seen = []
+    with ThreadPoolExecutor(2) as ex:
+        results = sp.plan_many(jobs, ex, progress=lambda d, t: seen.append((d, t)))
+    assert [r.ok for r in results] == [True, False, True]
+    assert isinstance(results[1].error, sp.InvalidInputError)
+    single = sp.plan(*jobs[2])
+    assert results[2].profile.duration == single.duration
+    assert seen[-1] == (3, 3)
+
+
+def test_plan_many_on_a_process_pool_and_a_dask_cluster():
+    distributed = pytest.importorskip("distributed")
+    jobs = _jobs()
+    local = sp.plan_many(jobs)  # default: local process pool
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = sp.plan_many(jobs, client.get_executor())
+    assert [r.ok for r in local] == [r.ok for r in remote] == [True, False, True]
+    for a, b in zip(local, remote, strict=True):
+        if a.ok:
+            assert a.profile.duration == b.profile.duration
+            assert np.array_equal(a.profile.w, b.profile.w)

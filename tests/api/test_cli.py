@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import io
 import json
 import subprocess
@@ -248,3 +249,53 @@ def test_grip_ellipse_from_the_command_line(root, tmp_path):
     bad = run("plan", str(root / "paths" / "u_turn.json"), *LGV_ARGS, "--grip", "circle",
               cwd=tmp_path)
     assert bad.returncode == 2 and "ellipse" in bad.stderr
+
+
+@pytest.mark.parametrize("name", ["aisle_corners.csv", "nurbs_edge.json", "slow_zone.json"])
+def test_cli_plan_writes_trajectory_and_plot(tmp_path, name, request):
+    root = request.config.rootpath
+    out, fig = tmp_path / "traj.csv", tmp_path / "fig.png"
+    res = run("plan", str(root / "paths" / name), *LGV_ARGS, "-o", str(out), "--plot", str(fig))
+    assert res.returncode == 0, res.stderr
+    assert "duration" in res.stdout and "status    optimal" in res.stdout
+    rows = [r for r in csv.reader(out.open()) if not r[0].startswith("#")]
+    assert rows[0][:3] == ["t [s]", "s [m]", "x [m]"] and len(rows) > 100
+    data = np.array(rows[1:], dtype=float)
+    assert np.all(np.diff(data[:, 0]) > 0) and data[:, 6].max() <= 2.0 * 1.005
+    assert fig.stat().st_size > 20_000
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_cli_demo_runs_in_a_fresh_directory(tmp_path):
+    res = run("demo", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "speedplan-demo.csv").stat().st_size > 0
+    assert (tmp_path / "speedplan-demo.png").stat().st_size > 20_000
+
+
+def test_cli_json_output(tmp_path, request):
+    out = tmp_path / "t.json"
+    res = run("plan", str(request.config.rootpath / "paths" / "u_turn.json"), *LGV_ARGS,
+              "-o", str(out))
+    assert res.returncode == 0, res.stderr
+    doc = json.loads(out.read_text())
+    assert doc["units"]["v"] == "m/s" and len(doc["columns"]["t"]) > 100
+
+
+@pytest.mark.parametrize(
+    ("args", "code", "text"),
+    [
+        (["plan", "no_such_file.csv", *LGV_ARGS], 2, "does not exist"),
+        (["plan", "paths/u_turn.json", "--v-max", "-1", "--a-max", "1", "--a-lat-max", "1",
+          "--j-max", "1"], 2, "`--v-max`"),
+        (["plan", "paths/slow_zone.json", *LGV_ARGS, "--v0", "2", "--a-decel", "0.01"], 3,
+         "too short"),
+        (["plan", "paths/u_turn.json", *LGV_ARGS, "--standstill", "bogus"], 2, "invalid choice"),
+        (["frobnicate"], 2, "invalid choice"),
+    ],
+)
+def test_cli_errors_are_one_line_with_documented_exit_codes(args, code, text, request):
+    res = run(*args, cwd=request.config.rootpath)
+    assert res.returncode == code
+    assert text in res.stderr
+    assert "Traceback" not in res.stderr

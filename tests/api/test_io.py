@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 import shapely
 
+import speedplan as sp
 from speedplan import InvalidInputError, Limits, Path, SpeedplanWarning, SpeedZone, plan
 from speedplan.core.checks import as_array, as_scalar, broadcast_positive, choice
 from speedplan.geometry import Arc, Clothoid, Line, speed_bounds, zone_intervals
@@ -353,3 +354,33 @@ def test_messages_show_numpy_scalars_as_plain_numbers(call, shown):
         call()
     assert shown in str(info.value)
     assert "np.float64" not in str(info.value)
+
+
+def test_bad_files_raise_invalid_input(tmp_path):
+    bad_json = tmp_path / "bad.json"
+    bad_json.write_text("{not json")
+    with pytest.raises(sp.InvalidInputError, match=r"bad\.json"):
+        read_path(bad_json)
+    no_xy = tmp_path / "w.csv"
+    no_xy.write_text("a,b\n1,2\n3,4\n")
+    with pytest.raises(sp.InvalidInputError, match="'x' and 'y'"):
+        read_path(no_xy)
+    seg = tmp_path / "s.json"
+    seg.write_text(json.dumps({"segments": [{"type": "arc", "radius": 1.0}]}))
+    with pytest.raises(sp.InvalidInputError, match="angle"):
+        read_path(seg)
+    zone = tmp_path / "z.json"
+    zone.write_text(json.dumps({"segments": [{"type": "line", "length": 3}],
+                                "zones": [{"polygon": [[0, 0], [1, 0]], "v_max": 1}]}))
+    with pytest.raises(sp.InvalidInputError, match="polygon"):
+        read_zones(zone)
+
+
+def test_sample_files_load_with_sane_lengths(request):
+    lengths = {}
+    for f in sorted((request.config.rootpath / "paths").glob("*.*")):
+        if f.suffix in (".csv", ".json"):
+            lengths[f.name] = read_path(f).length
+    assert len(lengths) >= 6
+    assert all(5.0 < L < 1000.0 for L in lengths.values())
+    assert read_zones(request.config.rootpath / "paths" / "slow_zone.json")[0].v_max == 0.5

@@ -11,6 +11,7 @@ import pytest
 from shared import LGV
 
 import speedplan as sp
+from speedplan.geometry import Line
 from speedplan.io import read_path
 from speedplan.plot import PANELS, plot_jerk, plot_path, plot_profile
 
@@ -153,3 +154,13 @@ def test_zones_are_drawn_on_the_path(request):
     ax = fig.axes[PANELS.index("path")]
     assert len(ax.patches) == 1
     assert any("0.5 m/s" in t.get_text() for t in ax.texts)
+
+
+def test_plot_axes_are_sane(tmp_path):
+    prof = sp.plan(sp.Path.from_segments([Line(10.0)]),
+                   sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    fig = plot_profile(prof, str(tmp_path / "p.png"))
+    axes = dict(zip(PANELS, fig.axes, strict=False))
+    assert axes["speed"].get_xlabel() == "s [m]" and axes["speed"].get_ylim()[1] >= 2.0
+    assert axes["jerk"].get_ylabel() == "jerk [m/s³]"
+    assert (tmp_path / "p.png").stat().st_size > 10_000
