@@ -8,14 +8,14 @@ Usage::
 
 ``--page`` measures the working tree (the files on disk, committed or not) and prints the
 figures block of ``docs/architecture.md`` (between its ``architecture-stats`` markers);
-``--write`` replaces the block in the page. ``tests/test_architecture_page.py`` fails when
-the page's block differs from what the tree gives, so the page cannot quote an old tree.
+``--write`` replaces the block in the page. ``tests/project/test_architecture_page.py`` fails
+when the page's block differs from what the tree gives, so the page cannot quote an old tree.
 
 Reads both trees straight from git (``git ls-tree``/``git show``, no checkout) and parses every
 ``speedplan/**.py`` with :mod:`ast`. The layers and the rule that assigns a module to one are
-those of ``tests/test_architecture.py`` in the working tree (read with ``ast``, not imported):
-``speedplan.<layer>...`` is in that layer, ``speedplan._version`` in the lowest, everything
-else at the top. Per tree it prints:
+those of ``tests/project/test_architecture.py`` in the working tree (read with ``ast``, not
+imported): ``speedplan.<layer>...`` is in that layer, ``speedplan._version`` in the lowest,
+everything else at the top. Per tree it prints:
 
 * the ``--top`` longest functions and methods, by source lines (``end_lineno - lineno + 1``,
   decorators and docstring included);
@@ -39,7 +39,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-CONTRACT = ROOT / "tests" / "test_architecture.py"
+CONTRACT = ROOT / "tests" / "project" / "test_architecture.py"
 sys.path.insert(0, str(ROOT / "tests"))
 
 from shared import imported_modules  # noqa: E402  (the contract test's own resolution)
@@ -238,7 +238,8 @@ def main() -> None:
             write_page(block)
         print(block)
         return
-    print("layers (tests/test_architecture.py), bottom to top:", ", ".join(layers), "+ top")
+    print("layers (tests/project/test_architecture.py), bottom to top:", ", ".join(layers),
+          "+ top")
     for ref in (args.before, args.after):
         report(measure(ref, layers), layers, args.top)
 

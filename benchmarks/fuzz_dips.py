@@ -8,7 +8,7 @@ Each case: a line, an arc (radius 1 mm - 1 m, 0.2 - 2.5 rad) and a line, 10 m - 
 the arc anywhere between 5 % and 95 % of the way; ``v_max`` 0.1-30 m/s, ``a_max`` 0.1-5 m/s²,
 ``a_lat_max`` 0.3-5 m/s², and 30 % of the cases without a jerk limit (else ``j_max``
 0.05-10 m/s³), on the default grid. The arc is a dip of the speed bound far narrower than
-the grids' first look at the path (``tests/test_default_grid_dips.py``). Each plan is judged
+the grids' first look at the path (``tests/model/test_default_grid.py``). Each plan is judged
 by the speed sampled on the arc (400 001 samples in time; at most ``√(a_lat_max r)``), by
 finite differences (``tests/oracles.py``: ``measure``, ``within_promise``), and against the
 exact no-jerk lower bound. Prints every error, ``limits_exceeded`` and silent violation.

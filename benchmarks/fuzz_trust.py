@@ -7,7 +7,7 @@ Usage::
 Prints the counts per outcome (planned, refused and why, flagged ``limits_exceeded``,
 ruckig's own numerical failures) and every failure (silent violation, duration below ruckig's
 optimum by more than 1e-4, false refusal or acceptance, solver error, crash) with its case.
-Exits 1 if there is any failure. The cases and the checks are those of ``tests/test_fuzz.py``
+Exits 1 if there is any failure. The cases and the checks are those of ``tests/api/test_fuzz.py``
 (``tests/trust_fuzz.py``).
 """
 

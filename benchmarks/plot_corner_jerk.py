@@ -7,7 +7,7 @@ Usage::
         --label "the other version"
     python benchmarks/plot_corner_jerk.py --draw before.npz after.npz --out corner-jerk.png
 
-``--save`` plans the corner case of ``tests/test_comfort.py`` (a slow shuttle's comfort
+``--save`` plans the corner case of ``tests/model/test_comfort.py`` (a slow shuttle's comfort
 limits on a three-corner G2 path) with whichever ``speedplan`` is imported and stores its
 trajectory at 100 Hz with a label; ``--draw`` plots the jerk and the acceleration of stored
 runs over the first corner, one row per run.
@@ -21,7 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+TESTS = Path(__file__).resolve().parent.parent / "tests"
+sys.path.insert(0, str(TESTS))  # oracles, imported by the test module below
+sys.path.insert(0, str(TESTS / "model"))  # test_comfort: the corner case
 
 
 def save(out: str, label: str) -> None:

@@ -1,6 +1,6 @@
 """The trust fuzz: straight moves over decades of scale, judged by ruckig and finite differences.
 
-Shared by the CI test (``tests/test_fuzz.py``, a few hundred cases) and the offline command
+Shared by the CI test (``tests/api/test_fuzz.py``, a few hundred cases) and the offline command
 (``python benchmarks/fuzz_trust.py --plans 20000``). A case draws a length from 1 mm to
 100 km, limits over decades (``v_max`` 0.05–30 m/s, ``a_max`` 0.05–5 m/s², ``j_max``
 0.02–50 m/s³) and boundary states on both sides of feasibility; :func:`run_case` plans it and

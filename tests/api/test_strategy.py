@@ -1,0 +1,267 @@
+"""The planning strategy: named attempts, their record on the profile, the time limit."""
+
+from __future__ import annotations
+
+import importlib
+import multiprocessing
+import os
+import pickle
+import signal
+import time
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+from shared import LGV
+
+import speedplan as sp
+from speedplan import strategy
+from speedplan.core.deadline import deadline
+from speedplan.geometry import Line
+from speedplan.model import PlanRequest
+from speedplan.route import Route, RouteEdge, RouteNode
+from speedplan.solve import DiscreteProblem
+from speedplan.solve.clarabel_ import solve_relaxation
+
+plan_request = importlib.import_module("speedplan.plan").plan_request
+
+STRAIGHT = sp.Path.from_segments([Line(30.0)])
+# A 4 m G2 path whose tiny a_max makes every jerk phase ~8 ms long: its default grid hits
+# the node cap and, without a limit, the plan takes minutes on a loaded machine.
+G2_4M = sp.Path.from_waypoints([
+    [0, 0], [0.12426521336474784, -0.11657631877453342],
+    [3.021780629947684, 0.018193808385309485], [3.207499798766692, -0.2747489556759499],
+    [3.9813199879850347, 0.1445236020023441]])
+G2_4M_LIMITS = sp.Limits(v_max=16.418898422873855, a_max=0.11059941918961164,
+                         a_lat_max=0.1453314309003239, j_max=13.58945597172854)
+
+
+def test_a_plan_records_which_attempt_answered():
+    profile = sp.plan(STRAIGHT, LGV)
+    assert [(a.name, a.leg, a.outcome) for a in profile.attempts] == [
+        ("model", None, "answered"), ("default_grid", 0, "answered")]
+    assert all(a.name in strategy.ATTEMPTS for a in profile.attempts)
+    assert all(a.seconds >= 0.0 for a in profile.attempts)
+
+
+@pytest.fixture
+def ungraded(monkeypatch):
+    """User grids exactly uniform: their first law breaks the jerk tolerance at the rests."""
+    build = importlib.import_module("speedplan.model.leg_grid")
+    monkeypatch.setattr(build, "graded_ends", lambda s, ell_start, ell_end: s)
+
+
+def test_a_refined_leg_records_the_law_it_replaced_and_why(ungraded):
+    # A uniform 300-node grid: its first law breaks the jerk tolerance at the rests.
+    profile = sp.plan(STRAIGHT, LGV, n=300)
+    outcomes = [(a.name, a.outcome) for a in profile.attempts]
+    assert outcomes[:2] == [("model", "answered"), ("given_grid", "replaced")]
+    assert "jerk" in profile.attempts[1].reason
+    assert outcomes[-1] == ("local_refinement", "answered")
+    assert profile.verification.ok
+
+
+def test_a_tiny_time_limit_raises_plan_timeout_naming_the_attempts():
+    with pytest.raises(sp.PlanTimeout) as info:
+        sp.plan(STRAIGHT, LGV, time_limit=1e-9)
+    err = info.value
+    assert isinstance(err, sp.SpeedplanError)
+    assert err.time_limit == 1e-9
+    assert [(a.name, a.outcome) for a in err.attempts] == [("model", "skipped")]
+    assert "time_limit=1e-09 s" in str(err) and "model skipped" in str(err)
+    again = pickle.loads(pickle.dumps(err))  # plan_many ships it back from a worker
+    assert isinstance(again, sp.PlanTimeout) and again.attempts == err.attempts
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf")])
+def test_time_limit_is_checked(bad):
+    with pytest.raises(sp.InvalidInputError, match="time_limit"):
+        sp.plan(STRAIGHT, LGV, time_limit=bad)
+
+
+class _RunsOutAfter(strategy.Budget):
+    """A budget that expires after ``calls`` checks (a slow machine, made deterministic)."""
+
+    def __init__(self, calls: int) -> None:
+        super().__init__(time_limit=1.0)
+        self.calls = calls
+
+    def remaining(self) -> float:
+        self.calls -= 1
+        return 1.0 if self.calls >= 0 else 0.0
+
+
+def test_a_budget_that_runs_out_before_the_law_passes_never_returns_it(ungraded):
+    # n=300: the first law exceeds the jerk tolerance; the budget lets the model and the
+    # first solve run, then not the refinement that would fix it.
+    request = PlanRequest.create(STRAIGHT, LGV, n=300)
+    with pytest.raises(sp.PlanTimeout) as info:
+        plan_request(request, budget=_RunsOutAfter(2))
+    names = [(a.name, a.outcome) for a in info.value.attempts]
+    assert names == [("model", "answered"), ("given_grid", "answered"),
+                     ("local_refinement", "skipped")]
+    # With the time to refine, the same request is planned and verified.
+    profile = plan_request(request, budget=_RunsOutAfter(100))
+    assert profile.verification.ok
+
+
+def test_a_verified_plan_found_within_the_limit_is_returned():
+    profile = sp.plan(STRAIGHT, LGV, time_limit=60.0)
+    assert profile.status == "optimal" and profile.verification.ok
+    assert profile.duration == pytest.approx(19.0, rel=1e-4)
+
+
+def test_the_slow_4m_g2_path_answers_within_its_time_limit():
+    # Without a limit this plan spends minutes in local refinements whose relaxations
+    # Clarabel needs 50 s for; with one, the strategy stops between attempts and Clarabel
+    # at the deadline (the banded kernel runs its ~1 s iterations to the end).
+    t0 = time.perf_counter()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            profile = sp.plan(G2_4M, G2_4M_LIMITS, time_limit=2.0)
+    except sp.PlanTimeout as exc:
+        assert exc.attempts and exc.attempts[0].name == "model"
+    else:
+        assert profile.verification.ok
+    assert time.perf_counter() - t0 < 15.0
+
+
+def test_the_deadline_stops_clarabel():
+    n = 4000
+    problem = DiscreteProblem(s=np.linspace(0.0, 100.0, n), w_max=np.full(n, 4.0),
+                              accel=np.full(n - 1, 2.0), decel=np.full(n - 1, 2.0),
+                              jerk=np.full(n - 2, 1.0))
+    with deadline(time.perf_counter()), pytest.raises(sp.SolverError, match="MaxTime"):
+        solve_relaxation(problem.scaled(100.0 / (n - 1), 4.0))
+
+
+def test_a_solver_error_does_not_advise_the_grid_already_in_use():
+    # A braking start whose speed dips to 9e-9 m/s: the default grid cannot resolve it.
+    path = sp.Path.from_segments([Line(1888.1898887677708)])
+    lim = sp.Limits(v_max=9.182910031427246, a_max=0.05542921908614846, a_lat_max=1.0,
+                    j_max=12.25568225509851)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            profile = sp.plan(path, lim, v0=1.491030987857941e-05, a0=-0.019111550739391747)
+    except sp.SolverError as exc:
+        assert "default grid" not in str(exc)
+    else:
+        assert profile.verification is not None
+
+
+def _one_edge_route(length: float) -> Route:
+    edge = RouteEdge("AB", 1, "A", "B", sp.Path.from_segments([Line(length)]), v_max=1.0)
+    return Route([RouteNode("A", 0, (0.0, 0.0)), RouteNode("B", 2, (length, 0.0))], [edge])
+
+
+def test_plan_route_passes_the_time_limit():
+    route = _one_edge_route(12.0)
+    assert sp.plan_route(route, LGV, time_limit=60.0).status == "optimal"
+    with pytest.raises(sp.PlanTimeout, match="on the leg"):
+        sp.plan_route(route, LGV, time_limit=1e-9)
+
+
+def test_plan_many_applies_the_time_limit_per_job():
+    jobs = [(STRAIGHT, LGV), (STRAIGHT, LGV, {"time_limit": 60.0})]
+    with ThreadPoolExecutor(2) as ex:
+        results = sp.plan_many(jobs, ex, time_limit=1e-9)
+    assert isinstance(results[0].error, sp.PlanTimeout)
+    assert results[1].ok
+    bad = sp.plan_many([(STRAIGHT, LGV, {"time_limit": -1})], ThreadPoolExecutor(1))
+    assert isinstance(bad[0].error, sp.InvalidInputError)
+
+
+def _kill_a_worker_once(done: int, total: int) -> None:
+    if done == 1:
+        workers = multiprocessing.active_children()
+        assert workers, "no worker process to kill"
+        os.kill(workers[0].pid, signal.SIGKILL)
+
+
+def test_plan_many_survives_a_worker_killed_mid_batch():
+    # SIGKILL one worker of the default process pool after the first result: every job it
+    # held or had queued would fail with BrokenProcessPool; they run again on a fresh pool.
+    jobs = [(sp.Path.from_segments([Line(5.0 + k)]), LGV) for k in range(24)]
+    results = sp.plan_many(jobs, progress=_kill_a_worker_once)
+    assert [r.index for r in results] == list(range(24))
+    assert all(r.ok for r in results), [repr(r.error) for r in results if not r.ok]
+
+
+def test_states_read_off_a_plan_replan_without_a_warning():
+    # A controller replanning at 10 Hz from its own plan's state: e.g. the U-turn at t = 3 s,
+    # whose state needs 2.6e-5 more jerk than j_max (the law's rounding), warned per cycle.
+    from speedplan.io import read_path
+
+    u_turn = read_path(os.path.join(os.path.dirname(__file__), "..", "..", "paths", "u_turn.json"))
+    first = sp.plan(u_turn, LGV)
+    rounded = 0
+    for t in (*np.linspace(0.25, first.duration - 0.5, 13), 3.0):
+        state = first.at(t)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            again = sp.plan(u_turn.sub(float(state.s[0])), LGV, v0=float(state.v[0]),
+                            a0=float(state.a[0]))
+        assert again.verification.ok, (t, again.verification.summary())
+        assert t + again.duration >= first.duration * (1 - 1e-4), t
+        rounded += any(a.name.endswith("state_rounding") for a in again.attempts
+                       if a.outcome == "answered")
+    assert rounded > 0  # the case is exercised
+
+
+def _final_stop_jerk(profile: sp.SpeedProfile, seconds: float) -> float:
+    """Largest finite-difference jerk over the last ``seconds`` of the profile [m/s³]."""
+    dt = 1e-3
+    t = np.arange(profile.duration - seconds, profile.duration, dt)
+    v = profile.at(t).v
+    return float(np.abs(np.diff(v, 2)).max() / dt**2)
+
+
+def test_an_outside_state_is_planned_with_the_jerk_slack_and_a_warning():
+    # Accelerating 0.4 % harder than the plan's own state at t = 3 s: the speed would
+    # overshoot v_max under j_max, not under 1.02 j_max. Planned with a warning, and the
+    # attempt that answered says so.
+    first = sp.plan(STRAIGHT, LGV)
+    state = first.at(3.0)
+    rest = sp.Path.from_segments([Line(30.0 - float(state.s[0]))])
+    with pytest.warns(sp.SpeedplanWarning, match="reachable only with 2% more jerk"):
+        again = sp.plan(rest, LGV, v0=float(state.v[0]), a0=float(state.a[0]) * 1.004)
+    assert next(a.name for a in again.attempts if a.outcome == "answered") == "jerk_slack"
+    assert again.verification.ok
+    # Within the promised jerk tolerance of the requested limit (finite differences).
+    assert _final_stop_jerk(again, 4.0) <= LGV.j_max * 1.05
+
+
+def test_a_backend_that_fails_on_a_grid_is_not_run_on_it_again(monkeypatch):
+    # The banded backend stalls on every grid: the strategy tries it on the default grid
+    # and on each coarser one once, then Clarabel on each in turn, never banded again.
+    discrete = importlib.import_module("speedplan.solve.discrete")
+    calls: list[int] = []
+
+    def stalls(unit):
+        calls.append(unit.n)
+        raise sp.SolverError("stalled (test)", backend="banded", status="NoProgress")
+
+    monkeypatch.setitem(discrete.RELAXATION_BACKENDS, "banded", stalls)
+    profile = sp.plan(STRAIGHT, LGV, backend="banded")
+    names = [(a.name, a.outcome) for a in profile.attempts]
+    assert names[:5] == [("model", "answered"), ("default_grid", "failed"),
+                         ("coarser_grid_1/2", "failed"), ("coarser_grid_1/4", "failed"),
+                         ("other_backend", "answered")]
+    assert len(calls) == len(set(calls)) == 3  # each grid (its own node count) once
+    assert profile.solution.backend == "clarabel" and profile.verification.ok
+
+
+def test_a_long_move_from_a_marginal_braking_state_answers_in_seconds():
+    # A trust-fuzz move (27.8 km, braking start that j_max misses by a hair): with the jerk
+    # slack held near the state only, the relaxation was inexact and the refinement ran for
+    # minutes; with the slack over the whole move it answers in about a second.
+    lim = sp.Limits(v_max=5.720500233946498, a_max=1.0997156178083936, a_lat_max=1,
+                    j_max=0.04562513470868499, a_decel=1.1432836388457868)
+    path = sp.Path.from_segments([Line(27781.810078116458)])
+    with pytest.warns(sp.SpeedplanWarning, match="2% more jerk"):
+        profile = sp.plan(path, lim, v0=2.7363134118689274, a0=-0.5026231549740972,
+                          time_limit=30.0)
+    assert profile.status == "optimal" and profile.verification.ok

@@ -1,0 +1,1 @@
+"""Tests of ``speedplan.core``: compiling the kernels, their cache and fallbacks."""

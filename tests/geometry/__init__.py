@@ -1,0 +1,1 @@
+"""Tests of ``speedplan.geometry``: primitives, paths, waypoint fitting, NURBS, speed bounds."""

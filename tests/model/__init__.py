@@ -1,0 +1,1 @@
+"""Tests of ``speedplan.model``: boundary states, grids, envelopes and rows of a request."""

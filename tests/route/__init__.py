@@ -1,0 +1,1 @@
+"""Tests of ``speedplan.route`` and ``plan_route``: routes, VDA 5050 orders, turns, updates."""

@@ -1,0 +1,1 @@
+"""Tests of ``speedplan.solve``: the discrete problem, its relaxation backends and refinement."""

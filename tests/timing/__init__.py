@@ -1,0 +1,1 @@
+"""Tests of ``speedplan.timing``: the time law, verification and trajectories."""
