@@ -4,7 +4,7 @@ The interior-point method's control flow (barrier update, filter line search, re
 stays in Python; what an iteration computes on arrays of ``n`` runs here, one call per step
 of the method, so the ~100 numpy passes of an iteration become a handful of fused loops.
 The formulas are those of the numpy path in `banded_nlp` (which runs
-until these kernels are compiled); ``tests/test_refine.py`` checks that both agree.
+until these kernels are compiled); ``tests/solve/test_refine.py`` checks that both agree.
 
 Layout (``m`` interior nodes, ``na = m + 1`` acceleration rows, ``R`` rows in all):
 
@@ -31,7 +31,7 @@ tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 # IPOPT's inertia-correction constants, the numpy path's (banded_nlp). Written here, not
 # imported: numba freezes globals into cached code and re-validates the cache against this
-# file only. tests/test_refine.py checks that the two sets agree.
+# file only. tests/solve/test_refine.py checks that the two sets agree.
 DELTA_W_FIRST, DELTA_W_MIN, DELTA_W_MAX = 1e-4, 1e-20, 1e40
 KAPPA_W_PLUS_FIRST, KAPPA_W_PLUS, KAPPA_W_MINUS = 100.0, 8.0, 1.0 / 3.0
 

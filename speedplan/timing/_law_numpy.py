@@ -5,7 +5,7 @@ The interface of `speedplan.core._law_kernel`, the compiled version.
 Used until numba's compiled code can run without compiling (`backend`): the first
 ``plan()`` of a fresh environment answers with Clarabel while a background process compiles
 the banded kernel, and compiling the time-law kernel in the foreground too would cost it
-seconds. The two agree to rounding (``tests/test_timing_law.py``
+seconds. The two agree to rounding (``tests/timing/test_time_law.py``
 compares them); durations and sampled states differ by a few units in the last place.
 """
 

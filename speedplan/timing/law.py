@@ -13,7 +13,7 @@ not (a cubic spline overshoots the jerk by ~40 %).
 **Why the law does not pass exactly through the nodes.** The discrete optimum switches its
 jerk between a cell and the next (e.g. a cruise node followed by a saturated braking node);
 its values then admit no C¹ interpolant with the jerk within the limit: on a 400 m road move
-the data need twice the limit's curvature over half a cell (``tests/test_timing_law.py``
+the data need twice the limit's curvature over half a cell (``tests/timing/test_time_law.py``
 shows it). The dual-cell law spreads the switch over the dual cell, which the jerk limit
 allows, at the price of a *local* node offset ``≈ h_{k-1} h_k D2_k / 8``: zero wherever the
 discrete ``w`` is locally linear (cruise, constant acceleration), O(h²) elsewhere, measured
