@@ -42,7 +42,7 @@ ROOT = Path(__file__).resolve().parents[1]
 CONTRACT = ROOT / "tests" / "project" / "test_architecture.py"
 sys.path.insert(0, str(ROOT / "tests"))
 
-from shared import imported_modules  # noqa: E402  (the contract test's own resolution)
+from shared import code_lines, imported_modules  # noqa: E402  (the contract test's own resolution)
 
 
 def contract_layers(file: Path = CONTRACT) -> tuple[str, ...]:
@@ -99,6 +99,7 @@ class Function:
     module: str
     name: str
     lines: int
+    code: int  # lines without the docstring (the contract test's longest-function rule)
 
 
 def functions(tree: ast.Module, module: str) -> list[Function]:
@@ -110,7 +111,8 @@ def functions(tree: ast.Module, module: str) -> list[Function]:
             if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
                 start = min([node.lineno, *(d.lineno for d in node.decorator_list)])
                 end = node.end_lineno if node.end_lineno is not None else node.lineno
-                out.append(Function(module, prefix + node.name, end - start + 1))
+                out.append(Function(module, prefix + node.name, end - start + 1,
+                                    code_lines(node)))
                 visit(node.body, f"{prefix}{node.name}.")
             elif isinstance(node, ast.ClassDef):
                 visit(node.body, f"{prefix}{node.name}.")
@@ -204,6 +206,10 @@ def page_block(stats: Stats, layers: tuple[str, ...], top: int = 5) -> str:
         "| longest functions (lines) | " + ", ".join(
             f"`{f.module.removeprefix('speedplan.')}.{f.name}` {f.lines}"
             for f in stats.functions[:top]) + " |",
+        "| over 80 lines of code (docstring excluded) | " + (", ".join(
+            f"`{f.module.removeprefix('speedplan.')}.{f.name}` {f.code}"
+            for f in sorted(stats.functions, key=lambda f: -f.code) if f.code > 80)
+            or "none") + " |",
         f"| upward imports (forbidden) | {len(stats.upward)} |",
         f"| imports skipping a layer downwards | {len(stats.wide)}: "
         + ", ".join(f"into {k} {n}" for k, n in sorted(pairs.items())) + " |",

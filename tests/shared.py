@@ -46,3 +46,19 @@ def imported_modules(tree: ast.AST, module: str, is_package: bool = False) -> li
         elif isinstance(node, ast.Import):
             out.extend(a.name for a in node.names if a.name.startswith("speedplan"))
     return out
+
+
+def code_lines(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    """Source lines of a function, decorators included and its docstring excluded.
+
+    Used by the import-contract test (the longest-function rule) and by
+    ``benchmarks/architecture_stats.py``.
+    """
+    start = min([node.lineno, *(d.lineno for d in node.decorator_list)])
+    end = node.end_lineno if node.end_lineno is not None else node.lineno
+    lines = end - start + 1
+    first = node.body[0]
+    if (isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant)
+            and isinstance(first.value.value, str)):
+        lines -= (first.end_lineno or first.lineno) - first.lineno + 1
+    return lines

@@ -11,7 +11,7 @@ import ast
 from pathlib import Path
 
 import pytest
-from shared import imported_modules
+from shared import code_lines, imported_modules
 
 PACKAGE = Path(__file__).resolve().parents[2] / "speedplan"
 LAYERS = ("core", "geometry", "solve", "model", "timing", "route")
@@ -131,3 +131,40 @@ def test_the_model_builds_data_and_calls_no_solver():
         solve = {m for m in _imports(file.read_text(encoding="utf-8"), module,
                                      file.name == "__init__.py") if m.startswith("speedplan.solve")}
         assert solve <= {"speedplan.solve.problem"}, f"{module} imports {sorted(solve)}"
+
+
+#: Functions allowed over `MAX_CODE_LINES`, each with its reason (named in docs/architecture.md).
+LONG_FUNCTIONS = {
+    # A numba kernel: one loop over the pieces with the inversion inlined, so that it
+    # compiles to a single function without calls in its inner loop.
+    "speedplan.core._law_kernel._invert_into",
+}
+#: Longest function, in lines of code (decorators included, docstring excluded).
+MAX_CODE_LINES = 80
+
+
+def _long_functions(source: str, module: str) -> dict[str, int]:
+    out = {}
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            lines = code_lines(node)
+            if lines > MAX_CODE_LINES:
+                out[f"{module}.{node.name}"] = lines
+    return out
+
+
+def test_no_function_is_longer_than_the_rule_allows_except_the_named_kernels():
+    long = {}
+    for file in FILES:
+        long.update(_long_functions(file.read_text(encoding="utf-8"), _module_name(file)))
+    assert set(long) <= LONG_FUNCTIONS, {k: v for k, v in long.items() if k not in LONG_FUNCTIONS}
+    page = (PACKAGE.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    for name in LONG_FUNCTIONS:
+        assert name.removeprefix("speedplan.") in page, f"docs/architecture.md: explain {name}"
+
+
+def test_the_length_rule_counts_code_not_the_docstring():
+    body = "".join(f"    x{i} = {i}\n" for i in range(MAX_CODE_LINES))
+    doc = '    """' + "\n" * 30 + '    """\n'
+    assert _long_functions("def f():\n" + doc + body, "m") == {"m.f": MAX_CODE_LINES + 1}
+    assert _long_functions("def f():\n" + doc + body[body.index("\n") + 1:], "m") == {}
