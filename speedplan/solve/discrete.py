@@ -14,12 +14,13 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
 from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
+from ..core.options import BACKENDS, REFINE_MODES, Backend, Refine
 from .banded import check_grid_resolvable, kernel_for_auto, solve_unit_relaxation, unit_scales
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .nojerk import check_reachable, max_feasible_w, positive_feasible_w
@@ -29,8 +30,9 @@ from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
 __all__ = ["BACKENDS", "REFINE_MODES", "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
 
-#: Relaxation backends by name; each maps a problem in the units of
-#: `unit_scales`, boundary values checked, to a RelaxationResult.
+#: Relaxation backends by name (the names of `speedplan.core.options.RelaxationBackend`);
+#: each maps a problem in the units of `unit_scales`, boundary values checked, to a
+#: RelaxationResult.
 RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = {
     "clarabel": solve_relaxation,
     "banded": solve_unit_relaxation,
@@ -44,8 +46,6 @@ AUTO_BANDED_FROM = 100
 #: many nodes while a background process compiles it; from this size on Clarabel would take
 #: about as long as the compilation (16 s at 10^5 nodes), so ``"auto"`` waits for it.
 AUTO_WAIT_FROM = 100_000
-BACKENDS = ("auto", *RELAXATION_BACKENDS)
-REFINE_MODES = ("auto", "always", "never")
 
 
 def _linear_tol(problem: DiscreteProblem) -> float:
@@ -241,7 +241,8 @@ def solve_problem(
     )
 
 
-def _accel_pair(A: Any, n: int) -> tuple[FloatArray, FloatArray]:
+def _accel_pair(A: ArrayLike | tuple[ArrayLike, ArrayLike], n: int
+                ) -> tuple[FloatArray, FloatArray]:
     if isinstance(A, tuple):
         if len(A) != 2:
             raise InvalidInputError(
@@ -254,15 +255,15 @@ def _accel_pair(A: Any, n: int) -> tuple[FloatArray, FloatArray]:
 
 
 def solve_discrete(
-    w_max: Any,
-    A: Any,
-    J: Any,
+    w_max: ArrayLike,
+    A: ArrayLike | tuple[ArrayLike, ArrayLike],
+    J: ArrayLike,
     h: float = 1.0,
     *,
     w_start: float = 0.0,
     w_end: float = 0.0,
-    refine: str = "auto",
-    backend: str = "auto",
+    refine: Refine = "auto",
+    backend: Backend = "auto",
 ) -> DiscreteSolution:
     """Solve the paper's discrete speed-planning problem with a certificate of optimality.
 
