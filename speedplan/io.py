@@ -56,7 +56,7 @@ from numpy.typing import ArrayLike
 from .core.checks import as_array, choice
 from .core.errors import InvalidInputError, SpeedplanWarning
 from .core.log import logger
-from .core.options import JsonValue
+from .core.options import FILE_FORMATS, FileFormat, JsonValue, PathKind
 from .geometry import Path, SpeedZone
 from .geometry.bounds import check_zones
 from .geometry.fitting import DEFAULT_KIND, KINDS
@@ -86,7 +86,7 @@ FileName = str | PathLike[str]
 Source = str | PathLike[str] | IO[str]
 
 #: Path file formats, by the name ``format=`` takes.
-FORMATS = ("csv", "json")
+FORMATS = FILE_FORMATS
 
 #: Accepted names of the heading column of CSV waypoints [rad] (at most one per file).
 HEADING_COLUMNS = ("heading", "yaw", "theta")
@@ -329,7 +329,8 @@ def _zone_polygon(z: dict[str, Any]) -> Any:
                            [_ring(f"holes[{k}]", h) for k, h in enumerate(holes)])
 
 
-def read_path(file: Source, *, kind: str | None = None, format: str | None = None) -> Path:
+def read_path(file: Source, *, kind: PathKind | None = None,
+              format: FileFormat | None = None) -> Path:
     r"""Read a path file: CSV waypoints, JSON segments/waypoints or a VDA 5050 trajectory.
 
     Parameters
@@ -414,7 +415,7 @@ def read_route(file: Source) -> Route:
         raise InvalidInputError(f"{name}: {exc}") from exc
 
 
-def read_zones(file: Source, *, format: str | None = None) -> list[SpeedZone]:
+def read_zones(file: Source, *, format: FileFormat | None = None) -> list[SpeedZone]:
     """Speed zones stored in a JSON path file (none for CSV files).
 
     ``file`` and ``format`` as in [`read_path`][speedplan.io.read_path].
@@ -655,7 +656,7 @@ def _trajectory_from_columns(name: str, cols: dict[str, Any], metadata: dict[str
     return Trajectory(**arrays, metadata=metadata)
 
 
-def read_trajectory(file: Source, *, format: str | None = None) -> Trajectory:
+def read_trajectory(file: Source, *, format: FileFormat | None = None) -> Trajectory:
     """Read a trajectory written by `Trajectory.to_csv` or `Trajectory.to_json`.
 
     The values come back bit for bit, except the heading: the files hold it wrapped to

@@ -17,6 +17,7 @@ import speedplan.io
 from speedplan.batch import PlanJob
 from speedplan.core import options
 from speedplan.geometry import Line
+from speedplan.geometry.fitting import KINDS
 from speedplan.model import rest_points
 from speedplan.model.request import PlanRequest
 from speedplan.route_plan import RouteOptions, plan_route_update, route_jobs
@@ -75,6 +76,18 @@ def test_plan_route_names_the_leg_and_lists_the_valid_values():
         sp.plan_route(route, LGV, backend="fast")  # type: ignore[typeddict-item]
 
 
+@pytest.mark.parametrize(("name", "values"), [
+    ("kind", options.PATH_KINDS),
+    ("format", options.FILE_FORMATS),
+])
+def test_read_path_refuses_an_unknown_option_listing_the_valid_ones(tmp_path, name, values):
+    file = tmp_path / "p.csv"
+    file.write_text("x,y\n0,0\n3,4\n")
+    with pytest.raises(sp.InvalidInputError, match=rf"`{name}` must be one of "
+                                                   rf"{_listing(values)}; got 'xml'"):
+        speedplan.io.read_path(file, **{name: "xml"})
+
+
 def test_the_reach_modes_are_a_closed_set():
     assert options.check_option("reach", "distance", options.REACH_MODES) == "distance"
     with pytest.raises(sp.InvalidInputError, match=r"`reach` must be one of 'max_jerk', "
@@ -88,12 +101,16 @@ def test_the_value_tuples_are_the_literals_values():
                           (options.Standstill, options.STANDSTILL_MODES),
                           (options.Reach, options.REACH_MODES),
                           (options.Grip, options.GRIP_MODELS),
+                          (options.PathKind, options.PATH_KINDS),
+                          (options.FileFormat, options.FILE_FORMATS),
                           (options.RestReason, options.REST_REASONS)]:
         assert values == get_args(alias) and len(set(values)) == len(values)
     # The re-exports of the older homes are the same objects.
     assert sp.solve.BACKENDS is options.BACKENDS and sp.solve.REFINE_MODES is options.REFINE_MODES
     assert sp.model.STANDSTILL_MODES is options.STANDSTILL_MODES
     assert sp.core.limits.GRIP_MODELS is options.GRIP_MODELS
+    assert speedplan.io.FORMATS is options.FILE_FORMATS
+    assert options.PATH_KINDS == KINDS  # the kinds Path.from_waypoints takes
 
 
 def test_every_relaxation_backend_has_a_name_and_auto_comes_first():
@@ -125,6 +142,7 @@ PUBLIC_FUNCTIONS = [
     sp.plan, sp.plan_many, sp.plan_route, sp.plan_route_update, sp.solve_discrete,
     route_jobs, plan_route_update, sp.Limits, PlanRequest.create, PlanJob,
     speedplan.io.path_from_dict, speedplan.io.zones_from_dict, speedplan.io.path_to_dict,
+    speedplan.io.read_path, speedplan.io.read_zones, speedplan.io.read_trajectory,
     speedplan.io.write_waypoints, speedplan.io.write_nurbs, speedplan.io.write_trajectory,
 ]
 

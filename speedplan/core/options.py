@@ -28,9 +28,10 @@ from numpy.typing import ArrayLike
 from .checks import choice
 
 __all__ = [
-    "BACKENDS", "GRIP_MODELS", "REACH_MODES", "REFINE_MODES", "RELAXATION_BACKEND_NAMES",
-    "REST_REASONS", "STANDSTILL_MODES", "Backend", "Grip", "JsonObject", "JsonValue", "Reach",
-    "Refine", "RelaxationBackend", "RestReason", "Standstill", "VLimit", "check_option",
+    "BACKENDS", "FILE_FORMATS", "GRIP_MODELS", "PATH_KINDS", "REACH_MODES", "REFINE_MODES",
+    "RELAXATION_BACKEND_NAMES", "REST_REASONS", "STANDSTILL_MODES", "Backend", "FileFormat",
+    "Grip", "JsonObject", "JsonValue", "PathKind", "Reach", "Refine", "RelaxationBackend",
+    "RestReason", "Standstill", "VLimit", "check_option",
 ]
 
 Refine: TypeAlias = Literal["auto", "always", "never"]
@@ -55,6 +56,11 @@ boundary states."""
 Grip: TypeAlias = Literal["independent", "ellipse"]
 """How the tangential and the lateral acceleration share the grip: each within its own
 limit (``"independent"``), or within one friction ellipse (``"ellipse"``)."""
+PathKind: TypeAlias = Literal["g2", "clothoid", "spline", "polyline"]
+"""How `speedplan.Path.from_waypoints` joins waypoints: straight legs with G2 corners, a G1
+clothoid chain, a cubic spline, or a polyline."""
+FileFormat: TypeAlias = Literal["csv", "json"]
+"""The text format of a path, zones or trajectory file."""
 RestReason: TypeAlias = Literal["cusp", "stop", "curvature jump"]
 """Why a model stops the vehicle inside a path: a cusp (it reverses), a stop asked for
 (``stops=``), or a curvature jump under a lateral-jerk limit."""
@@ -65,6 +71,8 @@ BACKENDS: tuple[Backend, ...] = get_args(Backend)
 STANDSTILL_MODES: tuple[Standstill, ...] = get_args(Standstill)
 REACH_MODES: tuple[Reach, ...] = get_args(Reach)
 GRIP_MODELS: tuple[Grip, ...] = get_args(Grip)
+PATH_KINDS: tuple[PathKind, ...] = get_args(PathKind)
+FILE_FORMATS: tuple[FileFormat, ...] = get_args(FileFormat)
 REST_REASONS: tuple[RestReason, ...] = get_args(RestReason)
 
 JsonValue: TypeAlias = "str | int | float | bool | list[JsonValue] | dict[str, JsonValue] | None"
