@@ -193,7 +193,8 @@ def _normalise(job: object, index: int) -> dict[str, Any] | PlanJob:
     else:
         raise InvalidInputError(
             f"`jobs[{index}]` must be a dict with 'path' and 'limits' (plus plan() keywords), a "
-            f"tuple (path, limits[, kwargs]) or a PlanRequest; got {type(job).__name__}"
+            f"tuple (path, limits[, kwargs]), a PlanRequest or a PlanJob; got "
+            f"{type(job).__name__}"
         )
     if "path" not in kwargs or "limits" not in kwargs:
         raise InvalidInputError(f"`jobs[{index}]` needs both 'path' and 'limits'")
