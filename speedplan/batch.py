@@ -11,7 +11,7 @@ from concurrent.futures import BrokenExecutor, Executor, Future, ProcessPoolExec
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple, TypeAlias
 
 from .core.checks import as_scalar, shown
 from .core.errors import InvalidInputError, SpeedplanError
@@ -20,7 +20,55 @@ from .model import PlanRequest
 from .plan import plan_request
 from .timing import SpeedProfile
 
-__all__ = ["BatchResult", "JobWarning", "plan_many"]
+if TYPE_CHECKING:
+    from .core.limits import Limits
+    from .geometry import Path
+
+__all__ = ["BatchResult", "Job", "JobWarning", "PlanJob", "plan_many"]
+
+
+@dataclass(frozen=True)
+class PlanJob:
+    """One job of [`plan_many`][speedplan.plan_many], validated: what to plan, and for how long.
+
+    Attributes
+    ----------
+    request : PlanRequest
+        The validated arguments of [`speedplan.plan`][speedplan.plan].
+    time_limit : float or None
+        Seconds the job may take once it runs; ``None``: the batch's ``time_limit``.
+
+    Examples
+    --------
+    >>> from concurrent.futures import ThreadPoolExecutor
+    >>> from speedplan import Limits, Path, plan_many
+    >>> from speedplan.batch import PlanJob
+    >>> from speedplan.model import PlanRequest
+    >>> req = PlanRequest.create(Path.from_waypoints([[0, 0], [5, 0]], kind="polyline"),
+    ...                          Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    >>> with ThreadPoolExecutor(1) as ex:
+    ...     results = plan_many([PlanJob(req, time_limit=30.0)], ex)
+    >>> [r.ok for r in results]
+    [True]
+    """
+
+    request: PlanRequest
+    time_limit: float | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.request, PlanRequest):
+            raise InvalidInputError(
+                f"`request` must be a PlanRequest (PlanRequest.create); got "
+                f"{type(self.request).__name__}")
+        if self.time_limit is not None:
+            object.__setattr__(self, "time_limit",
+                               as_scalar("time_limit", self.time_limit, positive=True))
+
+
+#: A job as [`plan_many`][speedplan.plan_many] takes it: a dict ``{"path": ..., "limits": ...,
+#: **plan_kwargs}``, a tuple ``(path, limits[, plan_kwargs])``, a `PlanRequest` or a `PlanJob`.
+Job: TypeAlias = ("Mapping[str, object] | tuple[Path, Limits] "
+                  "| tuple[Path, Limits, Mapping[str, object]] | PlanRequest | PlanJob")
 
 
 @dataclass(frozen=True)
@@ -121,26 +169,32 @@ def _captured_warnings() -> Iterator[list[JobWarning]]:
                 _context = _show_before = None
 
 
-def _run_job(request: PlanRequest, time_limit: float | None = None) -> _Outcome:
-    """The worker: ``plan_request(request)`` with the warnings it issues."""
+def _run_job(job: PlanJob) -> _Outcome:
+    """The worker: ``plan_request(job.request)`` with the warnings it issues."""
     with _captured_warnings() as caught:
         try:
-            profile = plan_request(request, time_limit=time_limit)
+            profile = plan_request(job.request, time_limit=job.time_limit)
         except SpeedplanError as exc:
             return _Outcome(None, exc, tuple(caught))
     return _Outcome(profile, None, tuple(caught))
 
 
 # ---- the batch ------------------------------------------------------------------------------
-def _normalise(job: Any, index: int) -> dict[str, Any]:
+def _normalise(job: object, index: int) -> dict[str, Any] | PlanJob:
+    """A user's job as the keywords of `PlanRequest.create` (or the typed job it already is)."""
+    if isinstance(job, PlanJob):
+        return job
+    if isinstance(job, PlanRequest):
+        return PlanJob(job)
     if isinstance(job, Mapping):
         kwargs = dict(job)
     elif isinstance(job, tuple) and len(job) in (2, 3):
         kwargs = {"path": job[0], "limits": job[1], **(job[2] if len(job) == 3 else {})}
     else:
         raise InvalidInputError(
-            f"`jobs[{index}]` must be a dict with 'path' and 'limits' (plus plan() keywords) or a "
-            f"tuple (path, limits[, kwargs]); got {type(job).__name__}"
+            f"`jobs[{index}]` must be a dict with 'path' and 'limits' (plus plan() keywords), a "
+            f"tuple (path, limits[, kwargs]), a PlanRequest or a PlanJob; got "
+            f"{type(job).__name__}"
         )
     if "path" not in kwargs or "limits" not in kwargs:
         raise InvalidInputError(f"`jobs[{index}]` needs both 'path' and 'limits'")
@@ -165,14 +219,13 @@ def _job_list(jobs: Any) -> list[Any]:
         ) from exc
 
 
-def _request(kwargs: dict[str, Any], time_limit: float | None
-             ) -> tuple[PlanRequest, float | None]:
-    """The job's request and its time limit (its own ``time_limit``, else the batch's)."""
-    kw = dict(kwargs)
+def _typed_job(job: dict[str, Any] | PlanJob, time_limit: float | None) -> PlanJob:
+    """The validated job; its time limit is its own ``time_limit``, else the batch's."""
+    if isinstance(job, PlanJob):
+        return job if job.time_limit is not None else PlanJob(job.request, time_limit)
+    kw = dict(job)
     limit = kw.pop("time_limit", time_limit)
-    if limit is not None:
-        limit = as_scalar("time_limit", limit, positive=True)
-    return PlanRequest.create(kw.pop("path"), kw.pop("limits"), **kw), limit
+    return PlanJob(PlanRequest.create(kw.pop("path"), kw.pop("limits"), **kw), limit)
 
 
 def _print_progress(done: int, total: int) -> None:
@@ -195,7 +248,7 @@ def _common_failure(results: list[BatchResult], shipped: Iterable[int]) -> BaseE
 
 
 def plan_many(
-    jobs: Iterable[Any],
+    jobs: Iterable[Job],
     executor: Executor | None = None,
     *,
     progress: bool | Callable[[int, int], None] = False,
@@ -206,8 +259,9 @@ def plan_many(
     Parameters
     ----------
     jobs : iterable
-        Each a dict ``{"path": ..., "limits": ..., **plan_kwargs}`` or a tuple
-        ``(path, limits[, plan_kwargs])``.
+        Each a dict ``{"path": ..., "limits": ..., **plan_kwargs}``, a tuple
+        ``(path, limits[, plan_kwargs])``, a validated `PlanRequest`, or a `PlanJob`
+        (a request and its own time limit; `speedplan.route_plan.route_jobs` makes them).
     executor : concurrent.futures.Executor, optional
         Where to run: default a local ``ProcessPoolExecutor`` (one worker per core). A
         dask.distributed ``Client.get_executor()`` or a Ray executor work unchanged.
@@ -272,10 +326,10 @@ def plan_many(
     report = _print_progress if progress is True else (progress or None)
     results: list[BatchResult | None] = [None] * total
     # Check every job here, before shipping any: a bad argument costs no worker round trip.
-    requests: dict[int, tuple[PlanRequest, float | None]] = {}
-    for i, kwargs in enumerate(normalised):
+    requests: dict[int, PlanJob] = {}
+    for i, job in enumerate(normalised):
         try:
-            requests[i] = _request(kwargs, time_limit)
+            requests[i] = _typed_job(job, time_limit)
         except (InvalidInputError, TypeError) as exc:
             logger.debug("plan_many: job %d refused before sending: %s", i, exc)
             results[i] = BatchResult(i, None, exc)
@@ -324,7 +378,7 @@ def plan_many(
     return out
 
 
-def _run_batch(ex: Executor, requests: dict[int, tuple[PlanRequest, float | None]],
+def _run_batch(ex: Executor, requests: dict[int, PlanJob],
                results: list[BatchResult | None], tick: Callable[[], None], *, final: bool
                ) -> list[int]:
     """Run ``requests`` on ``ex`` into ``results``; the jobs lost to a broken executor.
@@ -333,7 +387,7 @@ def _run_batch(ex: Executor, requests: dict[int, tuple[PlanRequest, float | None
     result is the ``BrokenExecutor`` error.
     """
     futures: dict[Future[_Outcome], int] = {
-        ex.submit(_run_job, req, limit): i for i, (req, limit) in requests.items()}
+        ex.submit(_run_job, job): i for i, job in requests.items()}
     lost = []
     for fut in as_completed(futures):
         i = futures[fut]

@@ -30,11 +30,13 @@ from .core.errors import (
     SolverError,
     SpeedplanError,
 )
-from .core.limits import GRIP_MODELS, Limits
+from .core.limits import Limits
 from .core.log import logger
-from .solve import BACKENDS, REFINE_MODES
+from .core.options import BACKENDS, GRIP_MODELS, REFINE_MODES, STANDSTILL_MODES, Standstill
 
 if TYPE_CHECKING:
+    from .geometry import Path, SpeedZone
+    from .route import Route
     from .timing import SpeedProfile, Trajectory, Verification
 
 __all__ = ["EXIT_CODES", "exit_status", "main"]
@@ -43,7 +45,7 @@ EXIT_CODES = {"ok": 0, "usage": 2, "infeasible": 3, "solver": 4, "limits": 5}
 DEMO_PATH = "warehouse_loop.json"
 DEMO_LIMITS = {"v_max": 2.0, "a_max": 1.0, "a_lat_max": 1.0, "j_max": 0.5}
 TRAJECTORY_FORMATS = ("csv", "json")
-STANDSTILL_HELP = {
+STANDSTILL_HELP: dict[Standstill, str] = {
     "smooth": "acceleration 0 at a standstill, jerk-limited from the first instant",
     "free": "the paper's model: the acceleration may jump at a standstill",
 }
@@ -156,7 +158,7 @@ def _add_common(p: argparse.ArgumentParser, out: str | None = None,
     g.add_argument("--start-s", type=float, default=0.0, metavar="S",
                    help="VDA 5050 order only: where the vehicle is along the route [m] (an "
                    "order update while driving; --v0/--a0 its state there)")
-    g.add_argument("--standstill", choices=tuple(STANDSTILL_HELP), default="smooth",
+    g.add_argument("--standstill", choices=STANDSTILL_MODES, default="smooth",
                    help="model at a standstill: "
                    + "; ".join(f"{k}: {v}" for k, v in STANDSTILL_HELP.items()))
     g = p.add_argument_group("solver")
@@ -336,7 +338,7 @@ def _stdin_text(args: argparse.Namespace) -> str:
     return text
 
 
-def _read_order(args: argparse.Namespace, pathfile: str | FsPath) -> Any:
+def _read_order(args: argparse.Namespace, pathfile: str | FsPath) -> Route | None:
     """The [`Route`][speedplan.Route] when the input is a VDA 5050 order, else ``None``."""
     import json
 
@@ -364,7 +366,8 @@ def _read_order(args: argparse.Namespace, pathfile: str | FsPath) -> Any:
     return read_route(buf)
 
 
-def _read_input(args: argparse.Namespace, pathfile: str | FsPath) -> tuple[Any, Any, str]:
+def _read_input(args: argparse.Namespace, pathfile: str | FsPath
+                ) -> tuple[Path, list[SpeedZone], str]:
     from .io import read_path, read_zones
 
     if str(pathfile) == "-":
@@ -414,7 +417,7 @@ def _conclude(args: argparse.Namespace, status: str, check: Verification,
     return code
 
 
-def _run_route(args: argparse.Namespace, route: Any, name: str, info: IO[str]) -> int:
+def _run_route(args: argparse.Namespace, route: Route, name: str, info: IO[str]) -> int:
     """``speedplan plan order.json``: plan the order's released base, print the node times."""
     from .route_plan import plan_route
 

@@ -51,10 +51,12 @@ from typing import IO, Any
 
 import numpy as np
 import shapely
+from numpy.typing import ArrayLike
 
 from .core.checks import as_array, choice
 from .core.errors import InvalidInputError, SpeedplanWarning
 from .core.log import logger
+from .core.options import FILE_FORMATS, FileFormat, JsonValue, PathKind
 from .geometry import Path, SpeedZone
 from .geometry.bounds import check_zones
 from .geometry.fitting import DEFAULT_KIND, KINDS
@@ -84,7 +86,7 @@ FileName = str | PathLike[str]
 Source = str | PathLike[str] | IO[str]
 
 #: Path file formats, by the name ``format=`` takes.
-FORMATS = ("csv", "json")
+FORMATS = FILE_FORMATS
 
 #: Accepted names of the heading column of CSV waypoints [rad] (at most one per file).
 HEADING_COLUMNS = ("heading", "yaw", "theta")
@@ -243,7 +245,7 @@ def _nurbs_from_trajectory(traj: Any) -> Path:
     return trajectory_path(traj, "trajectory")
 
 
-def path_from_dict(doc: Any, name: str = "document") -> Path:
+def path_from_dict(doc: JsonValue, name: str = "document") -> Path:
     """Build a `Path` from a parsed JSON document (segments, waypoints or VDA 5050).
 
     Parameters
@@ -265,11 +267,13 @@ def path_from_dict(doc: Any, name: str = "document") -> Path:
             return _nurbs_from_trajectory(traj)
         if not isinstance(doc, dict):
             raise InvalidInputError(f"expected a JSON object; got {type(doc).__name__}")
-        if "segments" in doc:
-            return Path.from_segments(doc["segments"], start=doc.get("start", (0.0, 0.0)),
-                                      heading=doc.get("heading", 0.0))
-        if "waypoints" in doc:
-            return Path.from_waypoints(doc["waypoints"], kind=doc.get("kind", DEFAULT_KIND))
+        fields: dict[str, Any] = doc  # each field is checked by the constructor it goes to
+        if "segments" in fields:
+            return Path.from_segments(fields["segments"], start=fields.get("start", (0.0, 0.0)),
+                                      heading=fields.get("heading", 0.0))
+        if "waypoints" in fields:
+            return Path.from_waypoints(fields["waypoints"],
+                                       kind=fields.get("kind", DEFAULT_KIND))
     except InvalidInputError as exc:
         raise InvalidInputError(f"{name}: {exc}") from exc
     except (KeyError, TypeError, ValueError, AttributeError) as exc:  # safety net: odd JSON
@@ -279,7 +283,7 @@ def path_from_dict(doc: Any, name: str = "document") -> Path:
     )
 
 
-def zones_from_dict(doc: Any, name: str = "document") -> list[SpeedZone]:
+def zones_from_dict(doc: JsonValue, name: str = "document") -> list[SpeedZone]:
     """Speed zones listed under ``"zones"`` (an empty list when there are none).
 
     Examples
@@ -300,7 +304,7 @@ def zones_from_dict(doc: Any, name: str = "document") -> list[SpeedZone]:
             raise InvalidInputError(f"{name}: zones[{i}] must be an object with 'polygon' and "
                                     "'v_max'")
         try:
-            out.append(SpeedZone(_zone_polygon(z), z["v_max"]))
+            out.append(SpeedZone(_zone_polygon(z), z["v_max"]))  # type: ignore[arg-type]  # checked there
         except InvalidInputError as exc:
             raise InvalidInputError(f"{name}: zones[{i}]: {exc}") from exc
     return out
@@ -325,7 +329,8 @@ def _zone_polygon(z: dict[str, Any]) -> Any:
                            [_ring(f"holes[{k}]", h) for k, h in enumerate(holes)])
 
 
-def read_path(file: Source, *, kind: str | None = None, format: str | None = None) -> Path:
+def read_path(file: Source, *, kind: PathKind | None = None,
+              format: FileFormat | None = None) -> Path:
     r"""Read a path file: CSV waypoints, JSON segments/waypoints or a VDA 5050 trajectory.
 
     Parameters
@@ -410,7 +415,7 @@ def read_route(file: Source) -> Route:
         raise InvalidInputError(f"{name}: {exc}") from exc
 
 
-def read_zones(file: Source, *, format: str | None = None) -> list[SpeedZone]:
+def read_zones(file: Source, *, format: FileFormat | None = None) -> list[SpeedZone]:
     """Speed zones stored in a JSON path file (none for CSV files).
 
     ``file`` and ``format`` as in [`read_path`][speedplan.io.read_path].
@@ -444,7 +449,8 @@ def _zone_dicts(zones: Any) -> list[dict[str, Any]]:
     return out
 
 
-def path_to_dict(path: Path, zones: Sequence[SpeedZone] | None = None) -> dict[str, Any]:
+def path_to_dict(path: Path, zones: Sequence[SpeedZone] | None = None
+                 ) -> dict[str, JsonValue]:
     """The JSON-segments document of a path made of lines, arcs and clothoids.
 
     Exact for paths from `Path.from_segments`, G2 corner paths, polylines and clothoid
@@ -498,7 +504,7 @@ def _write_text(file: FileName, text: str, what: str) -> None:
         fh.write(text)
 
 
-def write_waypoints(file: FileName, xy: Any, headings: Any = None) -> None:
+def write_waypoints(file: FileName, xy: ArrayLike, headings: ArrayLike | None = None) -> None:
     """Write waypoints [m] (and headings [rad]) as CSV with an ``x,y[,heading]`` header.
 
     Examples
@@ -569,9 +575,9 @@ def write_path(
 def write_nurbs(
     file: FileName,
     degree: int,
-    knots: Any,
-    control_points: Any,
-    weights: Any = None,
+    knots: ArrayLike,
+    control_points: ArrayLike,
+    weights: ArrayLike | None = None,
 ) -> None:
     """Write a NURBS path as a VDA 5050 edge ``trajectory`` JSON object (validated first).
 
@@ -607,8 +613,8 @@ def write_nurbs(
     _write_text(file, json.dumps(doc, indent=1) + "\n", "VDA 5050 NURBS JSON")
 
 
-def write_trajectory(file: FileName, degree: int, knots: Any, control_points: Any,
-                     weights: Any = None) -> None:
+def write_trajectory(file: FileName, degree: int, knots: ArrayLike, control_points: ArrayLike,
+                     weights: ArrayLike | None = None) -> None:
     """Deprecated name of `write_nurbs` (it writes a path, not a trajectory in time).
 
     Warns
@@ -650,7 +656,7 @@ def _trajectory_from_columns(name: str, cols: dict[str, Any], metadata: dict[str
     return Trajectory(**arrays, metadata=metadata)
 
 
-def read_trajectory(file: Source, *, format: str | None = None) -> Trajectory:
+def read_trajectory(file: Source, *, format: FileFormat | None = None) -> Trajectory:
     """Read a trajectory written by `Trajectory.to_csv` or `Trajectory.to_json`.
 
     The values come back bit for bit, except the heading: the files hold it wrapped to

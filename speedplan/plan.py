@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from typing import Any
 
 from .core.errors import SpeedplanWarning
 from .core.limits import Limits
+from .core.options import Backend, Refine, Standstill, VLimit
 from .geometry import Path, SpanLimit, SpeedBound, SpeedZone
 from .model import Model, PlanRequest
 from .model.request import STANDSTILL_MODES
@@ -45,10 +45,10 @@ def plan(
     vf: float = 0.0,
     af: float = 0.0,
     zones: Sequence[SpeedZone] | None = None,
-    v_limit: Any = None,
-    refine: str = "auto",
-    standstill: str = "smooth",
-    backend: str = "auto",
+    v_limit: VLimit | None = None,
+    refine: Refine = "auto",
+    standstill: Standstill = "smooth",
+    backend: Backend = "auto",
     stops: Sequence[float] | None = None,
     spans: Sequence[SpanLimit] | None = None,
     time_limit: float | None = None,
@@ -81,7 +81,8 @@ def plan(
     zones : sequence of SpeedZone, optional
         Polygons with their own speed limit.
     v_limit : tuple (s, v), optional
-        Per-position speed limit along the path (see `speedplan.speed_bounds`).
+        Per-position speed limit along the path: knots ``s`` [m] (strictly increasing) and
+        speeds ``v`` [m/s] (>= 0), linear in between (see `speedplan.speed_bounds`).
     refine : {"auto", "always", "never"}
         IPOPT refinement when the relaxation is not exact (see `solve_discrete`).
     standstill : {"smooth", "free"}

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+from collections.abc import Sequence
 from concurrent.futures import Executor
-from typing import Any
+from typing import TypedDict, Unpack
 
 import numpy as np
 
-from .batch import plan_many
+from .batch import PlanJob, plan_many
 from .core.checks import as_scalar
 from .core.errors import (
     InfeasibleError,
@@ -20,28 +21,53 @@ from .core.errors import (
 )
 from .core.limits import Limits
 from .core.numerics import wrap_angle
-from .geometry import SpanLimit
-from .plan import plan
+from .core.options import Backend, Refine, Standstill
+from .geometry import SpanLimit, SpeedZone
+from .model import PlanRequest
+from .plan import plan_request
 from .route import THETA_TOLERANCE, Route, RouteProfile
 from .route.profile import RouteTurn
 from .strategy import Budget
 from .timing import SpeedProfile
 from .timing.rotation import Turn
 
-__all__ = ["plan_route", "plan_route_update", "route_jobs", "route_turns"]
+__all__ = ["RouteOptions", "plan_route", "plan_route_update", "route_jobs", "route_turns"]
 
 #: plan() options that plan_route() sets itself from the route.
 _FROM_ROUTE = ("v0", "a0", "vf", "af", "stops", "spans", "v_limit")
 
 
+class _LegOptions(TypedDict, total=False):
+    n: int | None
+    ds: float | None
+    zones: Sequence[SpeedZone] | None
+    refine: Refine
+    standstill: Standstill
+    backend: Backend
+
+
+class RouteOptions(_LegOptions, total=False):
+    """The [`speedplan.plan`][speedplan.plan] keywords of a route's legs, all optional.
+
+    ``n``, ``ds``, ``zones``, ``refine``, ``standstill``, ``backend`` and ``time_limit``, as
+    for `speedplan.plan`; stops, spans and boundary states come from the route itself.
+    """
+
+    time_limit: float | None
+
+
 def route_jobs(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
-               a0: float = 0.0, **plan_options: Any) -> tuple[list[dict[str, Any]], list[float]]:
-    """The `speedplan.plan` jobs of a route's stop-to-stop legs, and where each starts.
+               a0: float = 0.0, **plan_options: Unpack[RouteOptions]
+               ) -> tuple[list[PlanJob], list[float]]:
+    """The `speedplan.plan_many` jobs of a route's stop-to-stop legs, and where each starts.
 
     Leg ``j`` runs from ``max(stop_s[j], start_s)`` to ``stop_s[j + 1]`` along
     `Route.path` (legs wholly behind ``start_s`` are dropped); the first starts at
     ``(v0, a0)``, every other from rest; each ends at rest. The edges' ``v_max`` and
     ``yaw_rate_max`` become [`SpanLimit`][speedplan.SpanLimit] over their part of the leg.
+    Each job is a validated [`PlanJob`][speedplan.batch.PlanJob] (``time_limit``, if given,
+    is each leg's own); a leg's invalid argument raises
+    [`InvalidInputError`][speedplan.InvalidInputError] naming the leg.
 
     Examples
     --------
@@ -54,8 +80,8 @@ def route_jobs(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     >>> edges = [RouteEdge("AB", 1, "A", "B", Path.from_segments([Line(4.0)]), v_max=1.0),
     ...          RouteEdge("BC", 3, "B", "C", Path.from_segments([Line(5.0)], start=(4, 0)))]
     >>> jobs, starts = route_jobs(Route(nodes, edges), Limits(2, 1, 1, 0.5))
-    >>> starts, [job["path"].length for job in jobs], jobs[0]["spans"]
-    ([0.0, 4.0], [4.0, 5.0], [SpanLimit(start=0.0, end=4.0, v_max=1.0, yaw_rate_max=None)])
+    >>> starts, [job.request.path.length for job in jobs], jobs[0].request.spans
+    ([0.0, 4.0], [4.0, 5.0], (SpanLimit(start=0.0, end=4.0, v_max=1.0, yaw_rate_max=None),))
     """
     if not isinstance(route, Route):
         raise InvalidInputError(
@@ -74,20 +100,24 @@ def route_jobs(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
         raise InvalidInputError(
             f"`start_s`={start!r} m must lie before the end of the route ({length:.9g} m)"
         )
+    time_limit = plan_options.pop("time_limit", None)
+    leg_options: _LegOptions = plan_options
     stops = route.stop_s
     path = route.path
-    jobs: list[dict[str, Any]] = []
+    jobs: list[PlanJob] = []
     starts: list[float] = []
     for j in range(stops.size - 1):
         lo, hi = max(float(stops[j]), start), float(stops[j + 1])
         if hi - lo <= 1e-9 * length:
             continue
         first = not jobs
-        jobs.append({
-            "path": path.sub(lo, hi), "limits": limits,
-            "v0": v0 if first else 0.0, "a0": a0 if first else 0.0,
-            "spans": _edge_spans(route, lo, hi), **plan_options,
-        })
+        try:
+            request = PlanRequest.create(
+                path.sub(lo, hi), limits, v0=v0 if first else 0.0, a0=a0 if first else 0.0,
+                spans=_edge_spans(route, lo, hi), **leg_options)
+            jobs.append(PlanJob(request, time_limit))
+        except SpeedplanError as exc:
+            raise _on_leg(exc, lo, hi) from exc
         starts.append(lo)
     return jobs, starts
 
@@ -172,7 +202,8 @@ def _turns(heads: tuple[float, ...], node: int, s: float, rate: float,
 
 def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float = 0.0,
                a0: float = 0.0, heading0: float | None = None,
-               executor: Executor | None = None, **plan_options: Any) -> RouteProfile:
+               executor: Executor | None = None,
+               **plan_options: Unpack[RouteOptions]) -> RouteProfile:
     """Plan the minimum-time motion along a route's released base.
 
     The vehicle stops (v = 0, a = 0) at every `Route.stop_s` — the nodes with a
@@ -255,25 +286,18 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
     if executor is None:
         legs: list[SpeedProfile] = []
         for job, lo in zip(jobs, starts, strict=True):
-            options = {k: v for k, v in job.items() if k not in ("path", "limits")}
             try:
-                if budget.time_limit is not None:  # the legs share the route's limit
-                    if budget.expired():
-                        raise PlanTimeout(
-                            f"time_limit={budget.time_limit:.6g} s ran out after {len(legs)} "
-                            f"of the route's {len(jobs)} legs; pass a larger time_limit",
-                            time_limit=budget.time_limit)
-                    options["time_limit"] = budget.remaining()
-                legs.append(plan(job["path"], job["limits"], **options))
+                legs.append(plan_request(job.request, time_limit=_leg_time(budget, legs, jobs)))
             except SpeedplanError as exc:
-                raise _on_leg(exc, lo, job) from exc
+                raise _on_leg(exc, lo, lo + job.request.path.length) from exc
     else:
         results = plan_many(jobs, executor, time_limit=budget.time_limit)
         legs = []
         for result, lo, job in zip(results, starts, jobs, strict=True):
             if result.error is not None:
                 if isinstance(result.error, SpeedplanError):
-                    raise _on_leg(result.error, lo, job) from result.error
+                    raise _on_leg(result.error, lo, lo + job.request.path.length) \
+                        from result.error
                 raise result.error
             assert result.profile is not None
             legs.append(result.profile)
@@ -283,7 +307,7 @@ def plan_route(route: Route, limits: Limits, *, start_s: float = 0.0, v0: float 
 
 def plan_route_update(profile: RouteProfile, route: Route, t: float, limits: Limits | None = None,
                       *, executor: Executor | None = None,
-                      **plan_options: Any) -> RouteProfile:
+                      **plan_options: Unpack[RouteOptions]) -> RouteProfile:
     """Plan an order update from where the vehicle is at time ``t`` of the current plan.
 
     ``route`` is the update (VDA 5050: the same ``orderId``, a larger ``orderUpdateId``), whose
@@ -416,9 +440,20 @@ def _same_place(old: Route, new: Route, s: float) -> bool:
     return bool(np.max(np.hypot(gap[:, 0], gap[:, 1])) <= 1e-6)
 
 
-def _on_leg(exc: SpeedplanError, lo: float, job: dict[str, Any]) -> SpeedplanError:
+def _leg_time(budget: Budget, legs: Sequence[SpeedProfile], jobs: Sequence[PlanJob]
+              ) -> float | None:
+    """The time the next leg may take: what the legs before it left of the route's limit."""
+    if budget.time_limit is None:
+        return None
+    if budget.expired():
+        raise PlanTimeout(
+            f"time_limit={budget.time_limit:.6g} s ran out after {len(legs)} of the route's "
+            f"{len(jobs)} legs; pass a larger time_limit", time_limit=budget.time_limit)
+    return budget.remaining()
+
+
+def _on_leg(exc: SpeedplanError, lo: float, hi: float) -> SpeedplanError:
     """The leg's error, saying which leg, with ``s`` along the route."""
-    hi = lo + float(job["path"].length)
     msg = f"on the leg from s={lo:.6g} m to s={hi:.6g} m of the route: {exc}"
     if isinstance(exc, InfeasibleError):
         return InfeasibleError(msg, constraint=exc.constraint,

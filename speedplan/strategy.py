@@ -50,6 +50,7 @@ from .core.errors import (
     SolverError,
     SpeedplanWarning,
 )
+from .core.options import RelaxationBackend
 from .model import ForcedLeg, Leg, Model, PlanRequest, build_model
 from .model.boundary import STATE_JERK_ROUNDING, STATE_JERK_SLACK, state_jerk
 from .model.build import leg_on_grid
@@ -366,7 +367,7 @@ def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg, i: int, record: Re
     raise failure
 
 
-def _other_backend(failed: str) -> str:
+def _other_backend(failed: str) -> RelaxationBackend:
     """The relaxation backend that is not ``failed`` (``"banded"`` or ``"clarabel"``)."""
     return "clarabel" if failed == "banded" else "banded"
 

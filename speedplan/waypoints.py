@@ -55,6 +55,6 @@ def profile_from_waypoints(
     path = Path.from_waypoints(xy, kind, headings=headings, corner_radius=corner_radius,
                                max_deviation=max_deviation, transition=transition)
     limits = Limits(v_max=v_max, a_max=a_max, a_lat_max=a_lat_max, j_max=j_max,
-                    a_decel=a_decel)  # type: ignore[arg-type]  # None: a_max
+                    a_decel=a_decel)
     profile = plan(path, limits, zones=zones, v0=v0, a0=a0, vf=vf, af=af, **plan_options)
     return profile.sample(dt)

@@ -1,4 +1,4 @@
-"""Base layer: errors and warnings, vehicle limits, input checks, shared numerics.
+"""Base layer: errors and warnings, vehicle limits, option types, input checks, shared numerics.
 
 Every other layer imports from here; this layer imports nothing else from speedplan.
 """

@@ -2,20 +2,15 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import as_scalar, choice
+from .checks import as_scalar
 from .errors import InvalidInputError
+from .options import GRIP_MODELS, Grip, check_option
 
 __all__ = ["DEFAULT_YAW_ACC", "GRIP_MODELS", "LIMIT_RANGE", "Limits"]
-
-#: How the tangential and the lateral acceleration share the tyres' (or wheels') grip:
-#: ``"independent"``, each within its own limit; ``"ellipse"``, the friction ellipse
-#: ``(a / a_max)² + (a_lat / a_lat_max)² <= 1`` (``a_decel`` in place of ``a_max`` when
-#: braking).
-GRIP_MODELS = ("independent", "ellipse")
 
 #: Finite limits lie within nine decades either side of 1 (SI units): from a stage moving
 #: nanometres per second to far beyond any vehicle. Outside it, the model's closed forms
@@ -29,7 +24,7 @@ LIMIT_RANGE = (1e-9, 1e9)
 DEFAULT_YAW_ACC = 1.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Limits:
     """Kinematic limits of a vehicle, SI units.
 
@@ -88,28 +83,32 @@ class Limits:
     a_max: float
     a_lat_max: float
     j_max: float
-    a_decel: float = field(default=None)  # type: ignore[assignment]
-    j_lat_max: float = field(default=None)  # type: ignore[assignment]
-    yaw_rate_max: float = field(default=None)  # type: ignore[assignment]
-    yaw_acc_max: float = DEFAULT_YAW_ACC
-    yaw_jerk_max: float = field(default=None)  # type: ignore[assignment]
-    grip: str = "independent"
+    a_decel: float
+    j_lat_max: float
+    yaw_rate_max: float
+    yaw_acc_max: float
+    yaw_jerk_max: float
+    grip: Grip
 
-    def __post_init__(self) -> None:
+    def __init__(self, v_max: float, a_max: float, a_lat_max: float, j_max: float,
+                 a_decel: float | None = None, j_lat_max: float | None = None,
+                 yaw_rate_max: float | None = None, yaw_acc_max: float = DEFAULT_YAW_ACC,
+                 yaw_jerk_max: float | None = None, grip: Grip = "independent") -> None:
+        # Written out so that the optional limits take None while the attributes are floats.
         set_ = object.__setattr__
-        set_(self, "v_max", as_scalar("v_max", self.v_max, positive=True))
-        set_(self, "a_max", as_scalar("a_max", self.a_max, positive=True))
-        set_(self, "a_lat_max", as_scalar("a_lat_max", self.a_lat_max, positive=True,
+        set_(self, "v_max", as_scalar("v_max", v_max, positive=True))
+        set_(self, "a_max", as_scalar("a_max", a_max, positive=True))
+        set_(self, "a_lat_max", as_scalar("a_lat_max", a_lat_max, positive=True,
                                           allow_inf=True))
-        set_(self, "j_max", as_scalar("j_max", self.j_max, positive=True, allow_inf=True))
-        decel = self.a_max if self.a_decel is None else self.a_decel
+        set_(self, "j_max", as_scalar("j_max", j_max, positive=True, allow_inf=True))
+        decel = self.a_max if a_decel is None else a_decel
         set_(self, "a_decel", as_scalar("a_decel", decel, positive=True))
-        for name in ("j_lat_max", "yaw_rate_max", "yaw_jerk_max"):  # None: no limit, inf
-            value = getattr(self, name)
+        for name, value in (("j_lat_max", j_lat_max), ("yaw_rate_max", yaw_rate_max),
+                            ("yaw_jerk_max", yaw_jerk_max)):  # None: no limit, inf
             set_(self, name, np.inf if value is None else as_scalar(name, value, positive=True,
                                                                      allow_inf=True))
-        set_(self, "yaw_acc_max", as_scalar("yaw_acc_max", self.yaw_acc_max, positive=True))
-        choice("grip", self.grip, GRIP_MODELS)
+        set_(self, "yaw_acc_max", as_scalar("yaw_acc_max", yaw_acc_max, positive=True))
+        set_(self, "grip", check_option("grip", grip, GRIP_MODELS))
         if self.grip == "ellipse" and not np.isfinite(self.a_lat_max):
             raise InvalidInputError(
                 "`grip`='ellipse' shares the grip between `a_max` and `a_lat_max`: give a "

@@ -18,12 +18,13 @@ import numpy as np
 
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
+from ..core.options import RestReason
 from ..geometry import SpeedBound
 from ..solve.problem import MAX_RAMP_STEPS, DiscreteProblem, ramp_steps
 from .boundary import STATE_JERK_ROUNDING, check_reachable_states, turnaround_speed
 from .grid import MIN_NODES
 from .leg_grid import default_grid, grid_anchors, leg_grid
-from .legs import ForcedLeg, Leg, Model, Rest, RestReason, TimeLawSpec
+from .legs import ForcedLeg, Leg, Model, Rest, TimeLawSpec
 from .request import STATE_ROUNDING, PlanRequest, within_limit
 from .rows import (
     Envelopes,

@@ -8,23 +8,18 @@ in speeds and metres along the path.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
 from ..core.limits import Limits
+from ..core.options import Backend, Refine, RestReason
 from ..geometry import SpeedBound
 from ..solve.problem import DiscreteProblem
 from .request import PlanRequest
 
-__all__ = ["ForcedLeg", "Leg", "Model", "Rest", "RestReason", "TimeLawSpec",
-           "explain_infeasible"]
-
-#: Why the vehicle must be at rest at a point inside the path (`Rest.reason`).
-RestReason = Literal["cusp", "stop", "curvature jump"]
-
+__all__ = ["ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "explain_infeasible"]
 
 @dataclass(frozen=True)
 class TimeLawSpec:
@@ -96,7 +91,7 @@ class Leg(_Ends):
         Grid (from 0 to ``length``), node bounds with the boundary envelopes, rows.
     time_law : TimeLawSpec
         How to build the continuous law from its solution.
-    refine : str
+    refine : Refine
         Refinement mode; ``backend``: relaxation backend (from the request).
     anchors : ndarray
         Positions on the leg [m] its grids keep as nodes (joins of path pieces where the
@@ -107,8 +102,8 @@ class Leg(_Ends):
     problem: DiscreteProblem
     time_law: TimeLawSpec
     limits: Limits
-    refine: str = "auto"
-    backend: str = "auto"
+    refine: Refine = "auto"
+    backend: Backend = "auto"
     anchors: FloatArray = field(default_factory=lambda: np.zeros(0))
 
 

@@ -4,31 +4,30 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from ..core.checks import as_array, as_scalar, choice
+from ..core.checks import as_array, as_scalar
 from ..core.errors import InvalidInputError
 from ..core.limits import Limits
+from ..core.options import (
+    BACKENDS,
+    REACH_MODES,
+    REFINE_MODES,
+    STANDSTILL_MODES,
+    Backend,
+    Reach,
+    Refine,
+    Standstill,
+    VLimit,
+    check_option,
+)
 from ..geometry import Path, SpeedZone
 from ..geometry.bounds import SpanLimit, check_spans, check_zones
-from ..solve.discrete import BACKENDS, REFINE_MODES
 
 __all__ = ["MIN_RELATIVE_LENGTH", "REACH_MODES", "STANDSTILL_MODES", "STATE_ROUNDING",
            "PlanRequest", "within_limit"]
-
-#: ``"smooth"``: acceleration is 0 at a standstill and jerk-limited from the first instant.
-#: ``"free"``: the paper's model, where acceleration may jump at a standstill.
-STANDSTILL_MODES = ("smooth", "free")
-#: The upper envelope that caps ``w`` next to a moving boundary state (``PlanRequest.reach``):
-#: ``"max_jerk"``, the fastest motion in time (``+j_max`` at once), tight and keeping the
-#: relaxation exact, but below the speed of some feasible motions where the speed first dips;
-#: ``"distance"``, the exact largest ``w`` at each distance
-#: (`fastest_w`), whose kinks can leave the relaxation
-#: inexact. `speedplan.plan` uses the first and falls back to the second when the first
-#: refuses the boundary states.
-REACH_MODES = ("max_jerk", "distance")
 #: Shortest path planned, relative to ``v_max² / a_max`` (4e-9 m for v_max = 2 m/s, a_max = 1
 #: m/s²; relative, so that millimetres and metres agree). Far below any vehicle's resolution;
 #: much shorter paths (nearly coincident waypoints) made the solvers fail with misleading
@@ -96,25 +95,31 @@ class PlanRequest:
     vf: float = 0.0
     af: float = 0.0
     zones: tuple[SpeedZone, ...] | None = None
-    v_limit: Any = None
-    refine: str = "auto"
-    standstill: str = "smooth"
-    backend: str = "auto"
+    v_limit: VLimit | None = None
+    refine: Refine = "auto"
+    standstill: Standstill = "smooth"
+    backend: Backend = "auto"
     stops: tuple[float, ...] = ()
     spans: tuple[SpanLimit, ...] = ()
-    reach: str = "max_jerk"  # one of REACH_MODES; set by plan(), not by callers
+    reach: Reach = "max_jerk"  # one of REACH_MODES; set by plan(), not by callers
     #: Jerk [m/s³] the jerk rows allow when a moving boundary state needs a hair more than
     #: ``limits.j_max`` (``None``: ``limits.j_max``): set by plan() for states just outside
     #: what ``j_max`` reaches, not by callers.
     state_jerk: float | None = None
 
     @classmethod
-    def create(cls, path: Any, limits: Any, *, n: Any = None, ds: Any = None, v0: Any = 0.0,
-               a0: Any = 0.0, vf: Any = 0.0, af: Any = 0.0,
-               zones: Sequence[SpeedZone] | None = None, v_limit: Any = None,
-               refine: str = "auto", standstill: str = "smooth", backend: str = "auto",
-               stops: Any = None, spans: Any = None) -> PlanRequest:
-        """Check every argument; raise `InvalidInputError` naming a bad one."""
+    def create(cls, path: Path, limits: Limits, *, n: int | None = None,
+               ds: float | None = None, v0: float = 0.0, a0: float = 0.0, vf: float = 0.0,
+               af: float = 0.0, zones: Sequence[SpeedZone] | None = None,
+               v_limit: VLimit | None = None, refine: Refine = "auto",
+               standstill: Standstill = "smooth", backend: Backend = "auto",
+               stops: ArrayLike | None = None,
+               spans: Sequence[SpanLimit] | None = None) -> PlanRequest:
+        """Check every argument; raise `InvalidInputError` naming a bad one.
+
+        Each argument is checked at run time whatever its annotation says (an option string
+        against its closed set, listing the valid values).
+        """
         if not isinstance(path, Path):
             raise InvalidInputError(
                 f"`path` must be a speedplan.Path; got {type(path).__name__} (build one with "
@@ -125,9 +130,9 @@ class PlanRequest:
                 f"`limits` must be a speedplan.Limits; got {type(limits).__name__}"
             )
         limits.check_range()
-        choice("refine", refine, REFINE_MODES)
-        choice("standstill", standstill, STANDSTILL_MODES)
-        choice("backend", backend, BACKENDS)
+        refine = check_option("refine", refine, REFINE_MODES)
+        standstill = check_option("standstill", standstill, STANDSTILL_MODES)
+        backend = check_option("backend", backend, BACKENDS)
         if n is not None and ds is not None:
             raise InvalidInputError("pass at most one of `n` and `ds`")
         if n is not None and (isinstance(n, bool) or not isinstance(n, int | np.integer)
@@ -190,7 +195,7 @@ class PlanRequest:
             )
 
 
-def _check_stops(stops: Any, length: float) -> tuple[float, ...]:
+def _check_stops(stops: ArrayLike | None, length: float) -> tuple[float, ...]:
     """``stops`` as sorted positions strictly inside ``(0, length)`` [m]."""
     if stops is None:
         return ()

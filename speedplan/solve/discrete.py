@@ -14,12 +14,14 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, choice, grid_size
+from ..core.checks import FloatArray, as_array, as_scalar, broadcast_positive, grid_size
 from ..core.errors import InvalidInputError, SolverError, SpeedplanWarning
+from ..core.options import BACKENDS, REFINE_MODES, Backend, Refine, RelaxationBackend, check_option
 from .banded import check_grid_resolvable, kernel_for_auto, solve_unit_relaxation, unit_scales
 from .clarabel_ import RelaxationResult, solve_relaxation
 from .nojerk import check_reachable, max_feasible_w, positive_feasible_w
@@ -29,8 +31,9 @@ from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
 __all__ = ["BACKENDS", "REFINE_MODES", "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
 
-#: Relaxation backends by name; each maps a problem in the units of
-#: `unit_scales`, boundary values checked, to a RelaxationResult.
+#: Relaxation backends by name (the names of `speedplan.core.options.RelaxationBackend`);
+#: each maps a problem in the units of `unit_scales`, boundary values checked, to a
+#: RelaxationResult.
 RELAXATION_BACKENDS: dict[str, Callable[[DiscreteProblem], RelaxationResult]] = {
     "clarabel": solve_relaxation,
     "banded": solve_unit_relaxation,
@@ -44,8 +47,6 @@ AUTO_BANDED_FROM = 100
 #: many nodes while a background process compiles it; from this size on Clarabel would take
 #: about as long as the compilation (16 s at 10^5 nodes), so ``"auto"`` waits for it.
 AUTO_WAIT_FROM = 100_000
-BACKENDS = ("auto", *RELAXATION_BACKENDS)
-REFINE_MODES = ("auto", "always", "never")
 
 
 def _linear_tol(problem: DiscreteProblem) -> float:
@@ -68,7 +69,7 @@ def _scale_into_jerk_bounds(problem: DiscreteProblem, w: FloatArray) -> FloatArr
     return w * (c * (1.0 - 1e-12))
 
 
-def _auto_backend(problem: DiscreteProblem) -> str:
+def _auto_backend(problem: DiscreteProblem) -> RelaxationBackend:
     """``backend="auto"``: banded from `AUTO_BANDED_FROM` nodes on, once it is compiled.
 
     Friction-ellipse rows are Clarabel's alone (the banded kernel holds no cone of them).
@@ -121,7 +122,7 @@ def _relax_with_fallback(
 
 
 def solve_problem(
-    problem: DiscreteProblem, *, refine: str = "auto", backend: str = "clarabel",
+    problem: DiscreteProblem, *, refine: Refine = "auto", backend: Backend = "clarabel",
     fallback: bool = True,
 ) -> DiscreteSolution:
     """Solve a validated `DiscreteProblem` (any grid) and certify the result.
@@ -140,8 +141,8 @@ def solve_problem(
         If a backend fails and no feasible point can be produced.
     """
     t_start = time.perf_counter()
-    refine = choice("refine", refine, REFINE_MODES)
-    backend = choice("backend", backend, BACKENDS)
+    refine = check_option("refine", refine, REFINE_MODES)
+    backend = check_option("backend", backend, BACKENDS)
     check_reachable(problem)
     if problem.has_grip and backend == "banded":
         raise InvalidInputError(
@@ -266,7 +267,8 @@ def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status:
     return scaled, "scaled", refinement
 
 
-def _accel_pair(A: Any, n: int) -> tuple[FloatArray, FloatArray]:
+def _accel_pair(A: ArrayLike | tuple[ArrayLike, ArrayLike], n: int
+                ) -> tuple[FloatArray, FloatArray]:
     if isinstance(A, tuple):
         if len(A) != 2:
             raise InvalidInputError(
@@ -279,15 +281,15 @@ def _accel_pair(A: Any, n: int) -> tuple[FloatArray, FloatArray]:
 
 
 def solve_discrete(
-    w_max: Any,
-    A: Any,
-    J: Any,
+    w_max: ArrayLike,
+    A: ArrayLike | tuple[ArrayLike, ArrayLike],
+    J: ArrayLike,
     h: float = 1.0,
     *,
     w_start: float = 0.0,
     w_end: float = 0.0,
-    refine: str = "auto",
-    backend: str = "auto",
+    refine: Refine = "auto",
+    backend: Backend = "auto",
 ) -> DiscreteSolution:
     """Solve the paper's discrete speed-planning problem with a certificate of optimality.
 

@@ -181,3 +181,44 @@ def test_plan_many_on_a_process_pool_and_a_dask_cluster():
         if a.ok:
             assert a.profile.duration == b.profile.duration
             assert np.array_equal(a.profile.w, b.profile.w)
+
+
+def test_a_validated_request_or_job_plans_as_its_dict_does():
+    from speedplan.batch import PlanJob
+    from speedplan.model import PlanRequest
+
+    path = sp.Path.from_waypoints([[0, 0], [6, 0], [9, 4]])
+    options = {"v0": 0.5, "refine": "never", "n": 120}
+    request = PlanRequest.create(path, LGV, **options)
+    jobs = [{"path": path, "limits": LGV, **options}, (path, LGV, options), request,
+            PlanJob(request), PlanJob(request, time_limit=60.0)]
+    with ThreadPoolExecutor(2) as ex:
+        results = sp.plan_many(jobs, ex)
+    assert all(r.ok for r in results)
+    reference = sp.plan(path, LGV, **options)
+    assert {r.profile.duration for r in results} == {reference.duration}
+    np.testing.assert_array_equal(results[2].profile.w, reference.w)
+
+
+def test_a_jobs_own_time_limit_takes_precedence_over_the_batchs():
+    from speedplan.batch import PlanJob
+    from speedplan.model import PlanRequest
+
+    request = PlanRequest.create(sp.Path.from_segments([Line(3.0)]), LGV)
+    with ThreadPoolExecutor(2) as ex:
+        tight, own = sp.plan_many([PlanJob(request), PlanJob(request, time_limit=60.0)], ex,
+                                  time_limit=1e-9)
+    assert isinstance(tight.error, sp.PlanTimeout) and own.ok
+
+
+@pytest.mark.parametrize(("kwargs", "match"), [
+    ({"request": "path"}, "`request` must be a PlanRequest"),
+    ({"time_limit": 0.0}, "`time_limit` must be > 0"),
+])
+def test_a_plan_job_checks_its_fields(kwargs, match):
+    from speedplan.batch import PlanJob
+    from speedplan.model import PlanRequest
+
+    fields = {"request": PlanRequest.create(sp.Path.from_segments([Line(3.0)]), LGV), **kwargs}
+    with pytest.raises(sp.InvalidInputError, match=match):
+        PlanJob(**fields)

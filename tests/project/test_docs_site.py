@@ -55,6 +55,13 @@ EXTRA_PUBLIC = (
     "speedplan.timing.rotation.Turn",
     "speedplan.route.vda5050.OrderWarning",
     "speedplan.route_plan.route_turns",
+    "speedplan.route_plan.RouteOptions",
+    "speedplan.batch.PlanJob",
+    "speedplan.core.options.Refine",
+    "speedplan.core.options.Backend",
+    "speedplan.core.options.Standstill",
+    "speedplan.core.options.Grip",
+    "speedplan.core.options.VLimit",
 )
 #: Members of public classes that are implementation details (the paper's scaled constants,
 #: the solver's internals) and stay off the reference.

@@ -214,3 +214,39 @@ def test_bad_arguments_name_themselves():
         plan_route(route, LGV, vf=1.0)
     with pytest.raises(InvalidInputError, match=r"`route` must be a speedplan\.route\.Route"):
         plan_route("order.json", LGV)
+
+
+def test_route_jobs_are_validated_plan_jobs_whose_plans_are_the_routes_legs():
+    from speedplan import plan, plan_many
+    from speedplan.batch import PlanJob
+    from speedplan.model import PlanRequest
+    from speedplan.route_plan import route_jobs
+
+    route = Route.from_vda5050(three_edge_order())
+    jobs, starts = route_jobs(route, LGV, refine="auto", time_limit=60.0)
+    assert all(isinstance(j, PlanJob) and isinstance(j.request, PlanRequest) for j in jobs)
+    assert [j.time_limit for j in jobs] == [60.0] * len(jobs)
+    assert starts == [0.0, pytest.approx(10.0)]
+    assert sum(j.request.path.length for j in jobs) == pytest.approx(route.length, rel=1e-12)
+    assert jobs[1].request.spans[0].v_max == ARC_LIMIT  # the arc edge's limit, leg-local
+    profile = plan_route(route, LGV)
+    with ThreadPoolExecutor(2) as ex:
+        batch = plan_many(jobs, ex)
+        parallel = plan_route(route, LGV, executor=ex)
+    by_hand = [plan(j.request.path, LGV, spans=j.request.spans) for j in jobs]
+    for leg, result, other, own in zip(profile.legs, batch, parallel.legs, by_hand, strict=True):
+        assert result.profile is not None
+        assert leg.duration == result.profile.duration == other.duration == own.duration
+
+
+def test_route_jobs_refuse_an_invalid_option_naming_the_leg():
+    from speedplan.route_plan import route_jobs
+
+    route = Route.from_vda5050(three_edge_order())
+    with pytest.raises(InvalidInputError, match=r"on the leg from s=0 m to s=10 m of the route: "
+                                                r"`refine` must be one of 'auto', 'always'"):
+        route_jobs(route, LGV, refine="sometimes")  # type: ignore[typeddict-item]
+    with pytest.raises(InvalidInputError, match=r"on the leg from s=0 m .*`time_limit`"):
+        route_jobs(route, LGV, time_limit=-1.0)
+    with pytest.raises(InvalidInputError, match="plan_route sets 'v_limit' from the route"):
+        route_jobs(route, LGV, v_limit=([0.0], [1.0]))  # type: ignore[call-arg]
