@@ -55,6 +55,14 @@ EXTRA_PUBLIC = (
     "speedplan.timing.rotation.Turn",
     "speedplan.route.vda5050.OrderWarning",
     "speedplan.route_plan.route_turns",
+    "speedplan.timing.LimitCheck",
+    "speedplan.core.kinematics.speed",
+    "speedplan.core.kinematics.acceleration",
+    "speedplan.core.kinematics.lateral_acceleration",
+    "speedplan.core.kinematics.yaw_rate",
+    "speedplan.core.kinematics.lateral_acceleration_rate",
+    "speedplan.core.kinematics.lateral_jerk",
+    "speedplan.core.kinematics.friction_ellipse",
 )
 #: Members of public classes that are implementation details (the paper's scaled constants,
 #: the solver's internals) and stay off the reference.
