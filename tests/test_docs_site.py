@@ -62,6 +62,8 @@ EXTRA_PUBLIC = (
     "speedplan.core.kinematics.yaw_rate",
     "speedplan.core.kinematics.lateral_acceleration_rate",
     "speedplan.core.kinematics.lateral_jerk",
+    "speedplan.core.kinematics.lateral_jerk_from_slope",
+    "speedplan.core.kinematics.lateral_rate_weights",
     "speedplan.core.kinematics.friction_ellipse",
 )
 #: Members of public classes that are implementation details (the paper's scaled constants,

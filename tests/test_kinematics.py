@@ -74,6 +74,22 @@ def test_lateral_acceleration_rate_times_speed_is_the_lateral_jerk():
         kinematics.lateral_jerk(kappa, rate, w, a), rtol=1e-12, atol=1e-14)
 
 
+def test_the_row_weights_reproduce_the_lateral_rate_of_a_quadratic_law():
+    # Three nodes of a quadratic w(s): the three-point difference is exact for it, and so the
+    # weights give κ' w + κ w' at the middle node; the chord's at the cell midpoints.
+    s = np.array([0.0, 0.3, 0.8])
+    w = 1.0 + 2.0 * s - 1.5 * s * s
+    h0, h1 = np.diff(s)
+    first = np.array([-h1 / (h0 * (h0 + h1)), (h1 - h0) / (h0 * h1), h0 / (h1 * (h0 + h1))])
+    kappa, rate = 0.4, -0.2
+    weights = kinematics.lateral_rate_weights(np.array([kappa]), np.array([rate]),
+                                              [0.0, 1.0, 0.0], first)
+    exact = rate * w[1] + kappa * (2.0 - 3.0 * s[1])
+    assert float((weights @ w)[0]) == pytest.approx(exact, rel=1e-13)
+    assert float(kinematics.lateral_jerk_from_slope(kappa, rate, w[1], 2.0 - 3.0 * s[1])) == \
+        pytest.approx(np.sqrt(w[1]) * exact, rel=1e-13)
+
+
 def test_speed_acceleration_and_friction_ellipse():
     assert kinematics.speed(np.array([9.0, -1e-20])).tolist() == [3.0, 0.0]
     assert kinematics.acceleration(np.array([3.0])).tolist() == [1.5]

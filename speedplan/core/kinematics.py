@@ -21,7 +21,8 @@ import numpy as np
 from .checks import FloatArray
 
 __all__ = ["acceleration", "friction_ellipse", "lateral_acceleration",
-           "lateral_acceleration_rate", "lateral_jerk", "speed", "yaw_rate"]
+           "lateral_acceleration_rate", "lateral_jerk", "lateral_jerk_from_slope",
+           "lateral_rate_weights", "speed", "yaw_rate"]
 
 
 def speed(w: Any) -> FloatArray:
@@ -117,6 +118,59 @@ def lateral_acceleration_rate(kappa: Any, kappa_rate: Any, w: Any, w_slope: Any)
     """
     out: FloatArray = np.asarray(kappa_rate, dtype=np.float64) * w + np.multiply(kappa,
                                                                                  w_slope)
+    return out
+
+
+def lateral_rate_weights(kappa: Any, kappa_rate: Any, value_weights: Any,
+                         slope_weights: Any) -> FloatArray:
+    """Weights on the nodes' ``w`` of ``κ' w + κ w'`` at points where both are linear in them.
+
+    A discretisation gives ``w`` and ``w'`` at a point as weighted sums of node values
+    (``value_weights``, ``slope_weights``, the last axis over the nodes); the lateral
+    acceleration's rate (`lateral_acceleration_rate`) is then ``weights @ w_nodes``, what
+    a lateral-jerk row bounds times ``sqrt(w)``.
+
+    Parameters
+    ----------
+    kappa, kappa_rate : array_like, shape (k,)
+        Curvature [1/m] and its rate [1/m²] at the ``k`` points.
+    value_weights, slope_weights : array_like, shape (k, p) or (p,)
+        Weights of ``p`` nodes giving ``w`` (dimensionless) and ``w'`` [1/m] at each point.
+
+    Examples
+    --------
+    At a cell's midpoint, ``w = (w_0 + w_1) / 2`` and ``w' = (w_1 - w_0) / h``, ``h = 0.5``:
+
+    >>> import numpy as np
+    >>> lateral_rate_weights(np.array([0.25]), np.array([0.5]), [0.5, 0.5], [-2.0, 2.0]).tolist()
+    [[-0.25, 0.75]]
+    """
+    out: FloatArray = (np.asarray(kappa_rate, dtype=np.float64)[..., None] * value_weights
+                       + np.asarray(kappa, dtype=np.float64)[..., None] * slope_weights)
+    return out
+
+
+def lateral_jerk_from_slope(kappa: Any, kappa_rate: Any, w: Any, w_slope: Any) -> FloatArray:
+    """Lateral jerk ``sqrt(w) (κ' w + κ w')`` [m/s³] from ``w`` and its slope ``w' = dw/ds``.
+
+    `lateral_jerk` with ``a = w'/2``: the form of the discrete problem, where ``w'`` is a
+    difference of node values.
+
+    Parameters
+    ----------
+    kappa, kappa_rate : array_like
+        Curvature [1/m] and its rate ``dκ/ds`` [1/m²].
+    w, w_slope : array_like
+        Squared speed [m²/s²] and its slope ``dw/ds`` [m/s²].
+
+    Examples
+    --------
+    A clothoid ``κ = 0.1 s`` at a constant 2 m/s: ``c v³ = 0.8`` m/s³.
+
+    >>> lateral_jerk_from_slope(0.3, 0.1, 4.0, 0.0).tolist()
+    0.8
+    """
+    out: FloatArray = speed(w) * lateral_acceleration_rate(kappa, kappa_rate, w, w_slope)
     return out
 
 
