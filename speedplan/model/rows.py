@@ -16,6 +16,7 @@ import numpy as np
 
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
+from ..core.kinematics import lateral_rate_weights
 from ..core.limits import Limits
 from ..geometry import Path
 from ..solve.problem import StencilRows
@@ -181,8 +182,7 @@ def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float, *,
     for rate, rows in ((after, bound), (before, np.where(before != after, bound, np.inf))):
         if not np.isfinite(rows).any():
             continue
-        coef = kappa[:, None] * first
-        coef[:, 1] += rate
+        coef = lateral_rate_weights(kappa, rate, [0.0, 1.0, 0.0], first)  # w at the node
         families.append(StencilRows(coef=coef, bound=rows))
     families.extend(_midpoint_rows(path, lo, s, bound))
     return tuple(families)
@@ -253,8 +253,8 @@ def _midpoint_rows(path: Path, lo: float, s: FloatArray, bound: FloatArray
     mid = lo + 0.5 * (s[:-1] + s[1:])
     kappa = path.curvature(mid)
     rate = path.curvature_rate(mid)
-    left = 0.5 * rate - kappa / h  # weights of w_i and w_{i+1} in κ' w_mid + κ w'_mid
-    right = 0.5 * rate + kappa / h
+    # w' = (w_{i+1} - w_i) / h with the 1/h taken into the curvature (κ/h, not κ (1/h)).
+    left, right = lateral_rate_weights(kappa / h, rate, [0.5, 0.5], [-1.0, 1.0]).T
     zero = np.zeros(s.size - 2)
     ahead = StencilRows(coef=np.column_stack((zero, left[1:], right[1:])), bound=bound)
     behind = StencilRows(coef=np.column_stack((left[:-1], right[:-1], zero)), bound=bound)

@@ -15,7 +15,7 @@ from ..timing import SpeedProfile, Trajectory, Verification
 from ..timing.profile import sample_times
 from ..timing.rotation import Turn
 from ..timing.trajectory import COLUMNS
-from ..timing.verify import LIMIT_NAMES
+from ..timing.verify import LIMIT_NAMES, LimitCheck
 from .route import Route
 
 __all__ = ["RouteProfile", "RouteTrajectory", "RouteTurn"]
@@ -265,22 +265,26 @@ class RouteProfile:
             t = t[t <= turn.duration]
             _, rate, acc = turn.turn.at(t)
             peak_rate, peak_acc = float(np.max(np.abs(rate))), float(np.max(np.abs(acc)))
-            maxima = dict.fromkeys(LIMIT_NAMES, 0.0)
-            ratios = dict.fromkeys(LIMIT_NAMES, 0.0)
-            maxima.update(yaw_rate=peak_rate, yaw_acc=peak_acc)
-            if np.isfinite(turn.rate_limit):
-                ratios["yaw_rate"] = peak_rate / turn.rate_limit
-            ratios["yaw_acc"] = peak_acc / limits.yaw_acc_max
+            # The vehicle stands: every other quantity is 0 during the turn.
+            checks = {k: LimitCheck(k, ratio=0.0, maximum=0.0, where_s=turn.s)
+                      for k in LIMIT_NAMES}
+            checks["yaw_rate"] = LimitCheck(
+                "yaw_rate", ratio=(peak_rate / turn.rate_limit if np.isfinite(turn.rate_limit)
+                                   else 0.0),
+                maximum=peak_rate, limit=turn.rate_limit, where_s=turn.s)
+            checks["yaw_acc"] = LimitCheck("yaw_acc", ratio=peak_acc / limits.yaw_acc_max,
+                                           maximum=peak_acc, limit=limits.yaw_acc_max,
+                                           where_s=turn.s)
             if np.isfinite(limits.yaw_jerk_max):  # without a limit the acceleration steps
                 step = np.diff(t)
                 wide = step > 1e-9
                 jerk = float(np.max(np.abs(np.diff(acc)[wide] / step[wide]), initial=0.0))
-                maxima["yaw_jerk"] = jerk
-                ratios["yaw_jerk"] = jerk / limits.yaw_jerk_max
+                checks["yaw_jerk"] = LimitCheck("yaw_jerk", ratio=jerk / limits.yaw_jerk_max,
+                                                maximum=jerk, limit=limits.yaw_jerk_max,
+                                                where_s=turn.s)
             else:
-                del maxima["yaw_jerk"], ratios["yaw_jerk"]
-            out.append(Verification(maxima=maxima, ratios=ratios,
-                                    where=dict.fromkeys(ratios, turn.s)))
+                del checks["yaw_jerk"]
+            out.append(Verification(checks))
         return out
 
     # ---- sampling in time -------------------------------------------------------------------

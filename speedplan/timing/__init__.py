@@ -1,9 +1,10 @@
 """Time mapping: from the discrete speed law ``w(s)`` to a trajectory in time, and its checks."""
 
-from .law import LawChain, TimeLaw
+from .law import Extreme, LawChain, PieceExtremes, TimeLaw
 from .profile import PROFILE_STATUSES, LegResult, SpeedProfile, law_for
 from .trajectory import COLUMNS, Trajectory
-from .verify import TOLERANCES, Verification
+from .verify import TOLERANCES, LimitCheck, Verification
 
-__all__ = ["COLUMNS", "PROFILE_STATUSES", "TOLERANCES", "LawChain", "LegResult", "SpeedProfile",
-           "TimeLaw", "Trajectory", "Verification", "law_for"]
+__all__ = ["COLUMNS", "PROFILE_STATUSES", "TOLERANCES", "Extreme", "LawChain", "LegResult",
+           "LimitCheck", "PieceExtremes", "SpeedProfile", "TimeLaw", "Trajectory", "Verification",
+           "law_for"]

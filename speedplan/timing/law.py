@@ -58,6 +58,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -65,7 +66,7 @@ from ..core.checks import FloatArray, IntArray
 from ..core.errors import InvalidInputError
 from ._law_numpy import backend
 
-__all__ = ["STANDSTILL_EXPONENT", "LawChain", "TimeLaw"]
+__all__ = ["STANDSTILL_EXPONENT", "Extreme", "LawChain", "PieceExtremes", "TimeLaw"]
 
 #: Exponent ``p`` of ``u = w^p`` on standstill regions: ``w ∝ s^{4/3}`` makes ``u`` linear.
 STANDSTILL_EXPONENT = 0.75
@@ -86,6 +87,47 @@ class _Pieces:
     is_u: np.ndarray  # bool per piece: variable u = w^{3/4}
     y_right: FloatArray  # value at each piece's right knot in the piece's own variable
     g_right: FloatArray  # slope at each piece's right knot in the piece's own variable
+
+
+class Extreme(NamedTuple):
+    """Exact extremes of one quantity over every piece of a law (arrays of one per piece)."""
+
+    at: FloatArray
+    """Arc length of each piece's maximum [m]."""
+    maximum: FloatArray
+    """Each piece's maximum (SI units)."""
+    minimum: FloatArray
+    """Each piece's minimum (SI units)."""
+
+
+class PieceExtremes(NamedTuple):
+    """`TimeLaw.extremes`: those of ``w`` [m²/s²], ``a`` [m/s²] and the jerk [m/s³]."""
+
+    w: Extreme
+    """Squared speed."""
+    a: Extreme
+    """Tangential acceleration."""
+    jerk: Extreme
+    """Jerk."""
+
+
+@dataclass(frozen=True, eq=False)
+class _Work:
+    """The arrays of `_Pieces` under construction, filled region by region in place.
+
+    Grid steps ``h``, node values ``w`` and ``u = w^{3/4}``; knots ``x``, their values ``y``
+    and slopes ``g``, the pieces' curvatures ``c``, right-end values ``y_r`` and slopes ``g_r``.
+    """
+
+    x: FloatArray
+    h: FloatArray
+    w: FloatArray
+    u: FloatArray
+    y: FloatArray
+    g: FloatArray
+    c: FloatArray
+    y_r: FloatArray
+    g_r: FloatArray
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,18 +250,15 @@ class TimeLaw:
         node_u[:lead] = True
         node_u[n - trail:] = trail > 0
         is_u = node_u[(np.arange(m) + 1) // 2]  # the node whose dual cell holds each piece
-        u = w**STANDSTILL_EXPONENT
-        y, g, c = np.zeros(m + 1), np.zeros(m + 1), np.zeros(m)
-        y_r, g_r = np.zeros(m), np.zeros(m)  # right ends, in each piece's own variable
+        wk = _Work(x=x, h=h, w=w, u=w**STANDSTILL_EXPONENT, y=np.zeros(m + 1),
+                   g=np.zeros(m + 1), c=np.zeros(m), y_r=np.zeros(m), g_r=np.zeros(m))
+        y, g, c, u = wk.y, wk.g, wk.c, wk.u
+        y_r, g_r = wk.y_r, wk.g_r  # right ends, in each piece's own variable
         mid_k0, mid_k1 = lead, max(n - trail, lead)
         mid_p0 = 0 if lead == 0 else 2 * lead - 1
         mid_p1 = m if trail == 0 else max(2 * (n - trail) - 1, mid_p0)
         if lead == n:  # a forced start to a moving end: u all along, bent to meet the end
-            y[0], g[0] = u[0], (u[1] - u[0]) / h[0]
-            end = _convert(w[-1], self._end_slope(w, h, False, start=False), from_u=False)
-            _fill_region(x, h, u, 0, n, n, 0, m, y, g, c, end[1])
-            _bend_to(x, c, g, y, 0, m, end[0] - y[m], end[1] - g[m], free_start=True)
-            y[m] = u[-1]
+            self._forced_start(wk)
             return _Pieces(x=x, y=y, g=g, c=c, is_u=is_u, y_right=y[1:].copy(),
                            g_right=g[1:].copy())
         free_start = w[0] == 0.0  # at rest: the slope of u there is free
@@ -231,36 +270,9 @@ class TimeLaw:
             g_junction = _convert(y[mid_p0], g[mid_p0], from_u=True)[1]
         else:
             g_junction = self._end_slope(w, h, False, start=True)
-        if mid_k1 > mid_k0:  # the w-region, from value 0, then anchored
-            y_u_end, g_u_end = y[mid_p0], g[mid_p0]
-            y[mid_p0], g[mid_p0] = 0.0, g_junction
-            _fill_region(x, h, w, mid_k0, mid_k1, n, mid_p0, mid_p1, y, g, c,
-                         None if trail else self._end_slope(w, h, False, start=False))
-            nodes = np.arange(max(mid_k0, 1) + (1 if lead else 0), min(mid_k1, n - 1))
-            if nodes.size:
-                local = c[2 * nodes] * h[nodes] ** 2 / 8.0
-                const = float(np.median(y[2 * nodes] - w[nodes] - local))
-            else:
-                const = float(y[2 * mid_k0] - w[mid_k0]) if mid_k0 < n else 0.0
-            if lead and free_start:
-                y[mid_p0:mid_p1 + 1] -= const
-                target = _convert(y[mid_p0], g[mid_p0], from_u=False)
-                _bend_to(x, c, g, y, 0, mid_p0, target[0] - y_u_end, target[1] - g_u_end,
-                         free_start=True)
-                y[mid_p0], g[mid_p0] = target  # the junction knot, in u for the left side
-                y_r[:mid_p0], g_r[:mid_p0] = y[1:mid_p0 + 1], g[1:mid_p0 + 1]
-                y[mid_p0], g[mid_p0] = _convert(target[0], target[1], from_u=True)
-            else:  # exact start values: the shift through a window at the region's start
-                start_value = _convert(y_u_end, g_u_end, from_u=True)[0] if lead else w[0]
-                y[mid_p0:mid_p1 + 1] += start_value
-                _shift_after(x, c, g, y, mid_p0, mid_p1, -(const + start_value), start=True)
-                if lead:
-                    y_r[:mid_p0], g_r[:mid_p0] = y[1:mid_p0 + 1], g[1:mid_p0 + 1]
-                    y[mid_p0] = start_value
-                    y_r[:mid_p0][-1:] = y_u_end
-                    g_r[:mid_p0][-1:] = g_u_end
-            y_r[mid_p0:mid_p1], g_r[mid_p0:mid_p1] = y[mid_p0 + 1:mid_p1 + 1], g[mid_p0 + 1:
-                                                                                   mid_p1 + 1]
+        if mid_k1 > mid_k0:  # 2. the w-region, from value 0, then anchored
+            self._anchored_middle(wk, (mid_k0, mid_k1, mid_p0, mid_p1), g_junction,
+                                  lead=lead, trail=trail, free_start=free_start)
         if trail == n:  # a forced stop: u from the moving start (slope from its acceleration)
             y[0], g[0] = _convert(w[0], g_junction, from_u=False)
             mid_p1 = 0
@@ -277,6 +289,56 @@ class TimeLaw:
             y[m] = w[-1]
             y_r[mid_p0:], g_r[mid_p0:] = y[mid_p0 + 1:], g[mid_p0 + 1:]
         return _Pieces(x=x, y=y, g=g, c=c, is_u=is_u, y_right=y_r, g_right=g_r)
+
+    def _forced_start(self, wk: _Work) -> None:
+        """A forced start to a moving end: ``u`` all along, bent to meet the end (in place)."""
+        x, h, w, u, y, g, c = wk.x, wk.h, wk.w, wk.u, wk.y, wk.g, wk.c
+        n, m = w.size, x.size - 1
+        y[0], g[0] = u[0], (u[1] - u[0]) / h[0]
+        end = _convert(w[-1], self._end_slope(w, h, False, start=False), from_u=False)
+        _fill_region(x, h, u, 0, n, n, 0, m, y, g, c, end[1])
+        _bend_to(x, c, g, y, 0, m, end[0] - y[m], end[1] - g[m], free_start=True)
+        y[m] = u[-1]
+
+    def _anchored_middle(self, wk: _Work, span: tuple[int, int, int, int], g_junction: float,
+                         *, lead: int, trail: int, free_start: bool) -> None:
+        """Step 2 of `_pieces`: the ``w``-region's pieces, anchored (in place).
+
+        ``span``: its first and last-plus-one node, first and last knot; ``g_junction`` its
+        start slope in ``w``; ``lead``, ``trail`` the ``u``-regions' node counts.
+        """
+        x, h, w, y, g, c, y_r, g_r = wk.x, wk.h, wk.w, wk.y, wk.g, wk.c, wk.y_r, wk.g_r
+        mid_k0, mid_k1, mid_p0, mid_p1 = span
+        n = w.size
+        y_u_end, g_u_end = y[mid_p0], g[mid_p0]
+        y[mid_p0], g[mid_p0] = 0.0, g_junction
+        _fill_region(x, h, w, mid_k0, mid_k1, n, mid_p0, mid_p1, y, g, c,
+                     None if trail else self._end_slope(w, h, False, start=False))
+        nodes = np.arange(max(mid_k0, 1) + (1 if lead else 0), min(mid_k1, n - 1))
+        if nodes.size:
+            local = c[2 * nodes] * h[nodes] ** 2 / 8.0
+            const = float(np.median(y[2 * nodes] - w[nodes] - local))
+        else:
+            const = float(y[2 * mid_k0] - w[mid_k0]) if mid_k0 < n else 0.0
+        if lead and free_start:
+            y[mid_p0:mid_p1 + 1] -= const
+            target = _convert(y[mid_p0], g[mid_p0], from_u=False)
+            _bend_to(x, c, g, y, 0, mid_p0, target[0] - y_u_end, target[1] - g_u_end,
+                     free_start=True)
+            y[mid_p0], g[mid_p0] = target  # the junction knot, in u for the left side
+            y_r[:mid_p0], g_r[:mid_p0] = y[1:mid_p0 + 1], g[1:mid_p0 + 1]
+            y[mid_p0], g[mid_p0] = _convert(target[0], target[1], from_u=True)
+        else:  # exact start values: the shift through a window at the region's start
+            start_value = _convert(y_u_end, g_u_end, from_u=True)[0] if lead else w[0]
+            y[mid_p0:mid_p1 + 1] += start_value
+            _shift_after(x, c, g, y, mid_p0, mid_p1, -(const + start_value), start=True)
+            if lead:
+                y_r[:mid_p0], g_r[:mid_p0] = y[1:mid_p0 + 1], g[1:mid_p0 + 1]
+                y[mid_p0] = start_value
+                y_r[:mid_p0][-1:] = y_u_end
+                g_r[:mid_p0][-1:] = g_u_end
+        y_r[mid_p0:mid_p1], g_r[mid_p0:mid_p1] = y[mid_p0 + 1:mid_p1 + 1], g[mid_p0 + 1:
+                                                                               mid_p1 + 1]
 
     def _linear_pieces(self) -> _Pieces:
         """``w`` linear on each cell: the chord, split at the cell's midpoint knot."""
@@ -341,13 +403,23 @@ class TimeLaw:
         return self.kinematics(self.s)[0] - np.maximum(self.w, 0.0)
 
     # ---- extremes ---------------------------------------------------------------------------
-    def extremes(self) -> dict[str, tuple[FloatArray, FloatArray, FloatArray]]:
-        """Exact extremes of each piece: ``{name: (s_of_max, max, min)}``.
+    def extremes(self) -> PieceExtremes:
+        """Exact extremes of each piece: ``(at, maximum, minimum)`` of ``w``, ``a`` and jerk.
 
-        For ``"w"``, ``"a"`` and ``"jerk"`` over every piece (arrays of one entry per piece),
-        from the closed forms: ``w`` and ``a`` are quadratic / linear in ``w``-pieces, and in
-        ``u``-pieces ``a`` and the jerk are extremal at the ends or where their derivative,
-        a polynomial in the piece's offset, vanishes.
+        Over every piece (arrays of one entry per piece), from the closed forms: ``w`` and
+        ``a`` are quadratic / linear in ``w``-pieces, and in ``u``-pieces ``a`` and the jerk
+        are extremal at the ends or where their derivative, a polynomial in the piece's
+        offset, vanishes.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from speedplan.timing import TimeLaw
+        >>> law = TimeLaw(np.linspace(0.0, 1.0, 5), np.array([1.0, 1.5, 2.0, 2.5, 3.0]),
+        ...               linear=True)
+        >>> ex = law.extremes()
+        >>> ex.a.maximum.tolist(), float(ex.w.maximum.max()), float(ex.w.at[-1])
+        ([1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0], 3.0, 1.0)
         """
         p = self._pieces
         if self.linear:  # extremes at the knots; constant acceleration, no jerk
@@ -355,7 +427,8 @@ class TimeLaw:
             w_max, w_min = np.maximum(p.y[:-1], p.y_right), np.minimum(p.y[:-1], p.y_right)
             at = np.where(p.y_right > p.y[:-1], p.x[1:], p.x[:-1])
             zero = np.zeros_like(a)
-            return {"w": (at, w_max, w_min), "a": (p.x[:-1], a, a), "jerk": (p.x[:-1], zero, zero)}
+            return PieceExtremes(w=Extreme(at, w_max, w_min), a=Extreme(p.x[:-1], a, a),
+                                 jerk=Extreme(p.x[:-1], zero, zero))
         width = np.diff(p.x)
         cands = [np.zeros_like(width), width]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -371,12 +444,13 @@ class TimeLaw:
         dx = np.stack(cands)  # (candidates, pieces)
         # One piece per column: the piece data broadcast over the candidates.
         w, _, a, jerk = self._kinematics(np.arange(width.size), dx, width - dx)
-        out = {}
-        for name, val in (("w", w), ("a", a), ("jerk", jerk)):
+        cols = np.arange(width.size)
+
+        def extreme(val: FloatArray) -> Extreme:
             i_max = np.argmax(val, axis=0)
-            cols = np.arange(width.size)
-            out[name] = (p.x[:-1] + dx[i_max, cols], val[i_max, cols], val.min(axis=0))
-        return out
+            return Extreme(p.x[:-1] + dx[i_max, cols], val[i_max, cols], val.min(axis=0))
+
+        return PieceExtremes(w=extreme(w), a=extreme(a), jerk=extreme(jerk))
 
     @property
     def knots(self) -> FloatArray:

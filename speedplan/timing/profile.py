@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from .._version import __version__
+from ..core import kinematics
 from ..core.attempts import Attempt
 from ..core.checks import FloatArray, as_array, as_scalar
 from ..core.errors import InvalidInputError
@@ -229,11 +230,11 @@ class SpeedProfile:
         xy = np.asarray(xy).reshape(-1, 2)
         direction = (np.asarray(self.path.direction(q), dtype=np.float64)
                      if hasattr(self.path, "direction") else np.ones(q.size))
-        lat_jerk = v * (curvature_rate(self.path, q) * w + 2.0 * kappa * a)
+        lat_jerk = kinematics.lateral_jerk(kappa, curvature_rate(self.path, q), w, a, v)
         return Trajectory(
             t=tt, s=q, x=xy[:, 0], y=xy[:, 1], heading=np.asarray(heading, dtype=np.float64),
-            curvature=kappa, v=v, a=a, j=jerk, a_lat=kappa * v * v, yaw_rate=kappa * v,
-            j_lat=lat_jerk, direction=direction,
+            curvature=kappa, v=v, a=a, j=jerk, a_lat=kinematics.lateral_acceleration(kappa, w),
+            yaw_rate=kinematics.yaw_rate(kappa, v), j_lat=lat_jerk, direction=direction,
         )
 
     def sample(self, dt: float = 0.01) -> Trajectory:

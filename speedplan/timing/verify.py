@@ -9,24 +9,27 @@ zones, ``v_limit``), lateral acceleration ``κ v²``, yaw rate ``κ v`` and late
 at the piece's speed maximum, and at every breakpoint of the speed bound inside the leg
 (`bound_breakpoints`: knots of ``v_limit``, ends of spans, zone entries and exits, joins
 of path pieces), where a narrow dip or a step of the bound can fall between two samples.
+The quantities come from `speedplan.core.kinematics`, with ``κ'`` the path's exact rate
+(`curvature_rate`). Each limit's outcome is a `LimitCheck`; a `Verification` holds them.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.checks import FloatArray
+from ..core import kinematics
+from ..core.checks import FloatArray, IntArray
 from ..core.forward import Forwarded
 from ..core.limits import Limits
 from ..geometry import Path, SpeedBound
 from ..geometry.bounds import bound_breakpoints
-from .law import TimeLaw
+from .law import PieceExtremes, TimeLaw
 
-__all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "Verification",
-           "bound_breakpoints", "check_law", "curvature_rate"]
+__all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "LimitCheck",
+           "Verification", "bound_breakpoints", "check_law", "curvature_rate"]
 
 #: Points per law piece where path-dependent quantities are evaluated (ends included).
 SAMPLES_PER_PIECE = 5
@@ -48,13 +51,83 @@ TOLERANCES: dict[str, float] = {
 LIMIT_NAMES = tuple(TOLERANCES)
 
 
-
 @dataclass(frozen=True)
-class Verification:
-    """Realised maxima of a law and their ratios to the limits.
+class LimitCheck:
+    """How one limit fared: the realised maximum, its ratio to the limit and where.
 
     Attributes
     ----------
+    name : str
+        The quantity, one of `LIMIT_NAMES` (``"speed"``, ``"accel"``, ``"lateral_jerk"``, ...).
+    ratio : float
+        The largest ratio of the quantity to its limit (0 for a limit not set; ``"speed"``
+        against the local bound ``sqrt(mu+(s))``, ``"grip"`` the ellipse's radius).
+    maximum : float or None
+        Largest realised value, SI units (see [`Verification`][speedplan.Verification]);
+        ``None`` when not measured.
+    limit : float or None
+        The limit checked against, SI units (``inf``: not set; for ``"speed"`` the global
+        ``v_max``, the ratio being against the local bound); ``None`` when not recorded.
+    where_s : float or None
+        Arc length [m] at which the ratio is largest; ``None`` when not recorded.
+    unset : bool
+        Whether the limit is not set (``inf`` or ``None``): the ratio is 0 and means nothing.
+
+    Examples
+    --------
+    >>> from speedplan.timing import LimitCheck
+    >>> check = LimitCheck("jerk", ratio=1.02, maximum=0.51, limit=0.5, where_s=3.0)
+    >>> check.tolerance, check.exceeded
+    (0.05, False)
+    """
+
+    name: str
+    ratio: float
+    maximum: float | None = None
+    limit: float | None = None
+    where_s: float | None = None
+    unset: bool = False
+
+    @property
+    def tolerance(self) -> float:
+        """The documented tolerance of this limit, a fraction of it (`TOLERANCES`)."""
+        return TOLERANCES[self.name]
+
+    @property
+    def exceeded(self) -> bool:
+        """Whether the ratio exceeds ``1 + tolerance`` (a NaN ratio does)."""
+        return not self.ratio <= 1.0 + self.tolerance
+
+    def line(self) -> str:
+        """The check's line of [`Verification.summary`][speedplan.Verification.summary]."""
+        if self.unset:
+            return f"{self.name:12s}  not set"
+        flag = "  VIOLATED" if self.exceeded else ""
+        at = f" at s={self.where_s:.4g} m" if self.where_s is not None and self.ratio > 0 else ""
+        return (f"{self.name:12s} {self.ratio:8.4f} of limit (tolerance "
+                f"{1 + self.tolerance:.3f}){at}{flag}")
+
+
+def _records(maxima: Mapping[str, float], ratios: Mapping[str, float],
+             where: Mapping[str, float], unset: Iterable[str]) -> dict[str, LimitCheck]:
+    """One `LimitCheck` per entry of ``ratios`` (in its order), from per-quantity maps."""
+    off = frozenset(unset)
+    return {k: LimitCheck(k, ratio=r, maximum=maxima.get(k), where_s=where.get(k),
+                          unset=k in off) for k, r in ratios.items()}
+
+
+@dataclass(frozen=True, init=False)
+class Verification:
+    """Realised maxima of a law and their ratios to the limits: one record per limit.
+
+    Built from the records (``checks``), or, as the maps below, from ``maxima``, ``ratios``,
+    ``where`` and ``unset`` (keyword arguments; one record per entry of ``ratios``).
+
+    Attributes
+    ----------
+    checks : Mapping of str to LimitCheck
+        The record of each checked quantity ([`LimitCheck`][speedplan.timing.LimitCheck]),
+        in report order (`LIMIT_NAMES`).
     maxima : dict
         Largest realised value of each quantity, SI units (``"speed"`` [m/s], ``"accel"``
         and ``"decel"`` [m/s²], ``"lateral"`` [m/s²], ``"jerk"`` and ``"lateral_jerk"``
@@ -76,20 +149,32 @@ class Verification:
         Largest speed [m/s], acceleration, braking deceleration [m/s²], absolute jerk [m/s³]
         and absolute lateral acceleration [m/s²]: the entries of ``maxima``.
 
+    ``maxima``, ``ratios``, ``where`` and ``unset`` are read-only views of ``checks``.
+
     Examples
     --------
     >>> from speedplan import Limits, Path, plan
     >>> prof = plan(Path.from_waypoints([[0, 0], [10, 0]], kind="polyline"),
     ...             Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
     >>> check = prof.verify()
-    >>> check.ok, check.ratios["jerk"] <= 1.05
-    (True, True)
+    >>> check.ok, check.ratios["jerk"] <= 1.05, check.checks["jerk"].limit
+    (True, True, 0.5)
     """
 
-    maxima: dict[str, float]
-    ratios: dict[str, float]
-    where: dict[str, float] = field(default_factory=dict)
-    unset: frozenset[str] = frozenset()
+    checks: Mapping[str, LimitCheck]
+
+    def __init__(self, checks: Mapping[str, LimitCheck] | Iterable[LimitCheck] | None = None,
+                 *, maxima: Mapping[str, float] | None = None,
+                 ratios: Mapping[str, float] | None = None,
+                 where: Mapping[str, float] | None = None,
+                 unset: Iterable[str] = frozenset()) -> None:
+        if checks is None:
+            records = _records(maxima or {}, ratios or {}, where or {}, unset)
+        elif isinstance(checks, Mapping):
+            records = dict(checks)
+        else:
+            records = {c.name: c for c in checks}
+        object.__setattr__(self, "checks", records)
 
     # Shorthands for entries of ``maxima``, documented in the class docstring.
     max_speed = Forwarded[float]("maxima", key="speed")
@@ -99,14 +184,34 @@ class Verification:
     max_lateral = Forwarded[float]("maxima", key="lateral")
 
     @property
+    def maxima(self) -> dict[str, float]:
+        """Largest realised value of each quantity (see the class docstring)."""
+        return {k: c.maximum for k, c in self.checks.items() if c.maximum is not None}
+
+    @property
+    def ratios(self) -> dict[str, float]:
+        """Each quantity's largest ratio to its limit (see the class docstring)."""
+        return {k: c.ratio for k, c in self.checks.items()}
+
+    @property
+    def where(self) -> dict[str, float]:
+        """Arc length [m] at which each ratio is largest."""
+        return {k: c.where_s for k, c in self.checks.items() if c.where_s is not None}
+
+    @property
+    def unset(self) -> frozenset[str]:
+        """The quantities whose limit is not set."""
+        return frozenset(k for k, c in self.checks.items() if c.unset)
+
+    @property
     def violations(self) -> dict[str, float]:
         """The ratios exceeding their tolerance."""
-        return {k: r for k, r in self.ratios.items() if not r <= 1.0 + TOLERANCES[k]}
+        return {k: c.ratio for k, c in self.checks.items() if c.exceeded}
 
     @property
     def ok(self) -> bool:
         """Whether every ratio is within its tolerance."""
-        return not self.violations
+        return not any(c.exceeded for c in self.checks.values())
 
     def summary(self) -> str:
         """One line per limit: realised ratio, tolerance and where.
@@ -121,34 +226,26 @@ class Verification:
         >>> prof.verify().summary().splitlines()[-2:]
         ['lateral_jerk  not set', 'grip          not set']
         """
-        lines = []
-        for k, r in self.ratios.items():
-            if k in self.unset:
-                lines.append(f"{k:12s}  not set")
-                continue
-            flag = "  VIOLATED" if not r <= 1 + TOLERANCES[k] else ""
-            at = f" at s={self.where[k]:.4g} m" if k in self.where and r > 0 else ""
-            lines.append(f"{k:12s} {r:8.4f} of limit (tolerance {1 + TOLERANCES[k]:.3f}){at}"
-                         f"{flag}")
-        return "\n".join(lines)
+        return "\n".join(c.line() for c in self.checks.values())
 
     @staticmethod
     def merged(parts: list[Verification]) -> Verification:
         """The worst of several verifications (legs of one profile).
 
-        A quantity only some parts check (``"yaw_acc"`` of turns) is merged over those.
+        A quantity only some parts check (``"yaw_acc"`` of turns) is merged over those; it
+        counts as not set when every part has it and none sets it.
         """
-        keys = [k for k in LIMIT_NAMES if any(k in p.ratios for p in parts)]
-        maxima = {k: max(p.maxima[k] for p in parts if k in p.maxima) for k in keys}
-        ratios, where = {}, {}
-        for k in keys:
-            worst = max((p for p in parts if k in p.ratios),
-                        key=lambda p: (p.ratios[k] if np.isfinite(p.ratios[k]) else np.inf))
-            ratios[k] = worst.ratios[k]
-            if k in worst.where:
-                where[k] = worst.where[k]
-        unset = frozenset.intersection(*(p.unset for p in parts)) if parts else frozenset()
-        return Verification(maxima=maxima, ratios=ratios, where=where, unset=unset)
+        out = []
+        for k in LIMIT_NAMES:
+            have = [p.checks[k] for p in parts if k in p.checks]
+            if not have:
+                continue
+            worst = max(have, key=lambda c: c.ratio if np.isfinite(c.ratio) else np.inf)
+            peaks = [c.maximum for c in have if c.maximum is not None]
+            out.append(LimitCheck(k, ratio=worst.ratio, maximum=max(peaks) if peaks else None,
+                                  limit=worst.limit, where_s=worst.where_s,
+                                  unset=len(have) == len(parts) and all(c.unset for c in have)))
+        return Verification(out)
 
 
 @dataclass(frozen=True)
@@ -161,18 +258,163 @@ class LegCheck:
 
 
 def curvature_rate(path: Path, s: FloatArray) -> FloatArray:
-    """``dκ/ds`` [1/m²] by a central difference (one-sided at the path's ends).
+    """``dκ/ds`` [1/m²]: the path's exact rate (`speedplan.Path.curvature_rate`).
 
-    Where the curvature jumps (a G1 path) the result is of order ``jump / (2 δ)``: lateral
-    jerk is then unbounded, which is what it is physically.
+    Within ``δ = 1e-7`` of the path's length of a curvature jump (a G1 path,
+    `speedplan.Path.curvature_jumps`) the rate is a Dirac: there it is the jump over the
+    ``2 δ`` that straddle it (one-sided at the path's ends), so lateral jerk is unbounded
+    there, which is what it is physically, unless the vehicle stands.
     """
+    s = np.asarray(s, dtype=np.float64)
+    rate = np.array(path.curvature_rate(s), dtype=np.float64)
+    joins = path.curvature_jumps()[0]
+    if not joins.size:
+        return rate
     length = path.length
     delta = max(1e-7 * length, 1e-9)
-    lo = np.clip(s - delta, 0.0, length)
-    hi = np.clip(s + delta, 0.0, length)
-    both = np.asarray(path.curvature(np.concatenate((hi.ravel(), lo.ravel()))))  # one pass
-    out: FloatArray = (both[:hi.size].reshape(hi.shape) - both[hi.size:].reshape(lo.shape)) / (
-        hi - lo)
+    k = np.searchsorted(joins, s)  # the joins either side of each position
+    near = np.minimum(np.abs(s - joins[np.maximum(k - 1, 0)]),
+                      np.abs(s - joins[np.minimum(k, joins.size - 1)])) <= delta
+    if near.any():
+        q = s[near]
+        lo, hi = np.clip(q - delta, 0.0, length), np.clip(q + delta, 0.0, length)
+        both = np.asarray(path.curvature(np.concatenate((hi, lo))), dtype=np.float64)
+        rate[near] = (both[:hi.size] - both[hi.size:]) / (hi - lo)
+    return rate
+
+
+@dataclass(frozen=True, eq=False)
+class _Samples:
+    """The law of one leg at its sample points, and the distinct positions they lie at.
+
+    Samples: ``SAMPLES_PER_PIECE`` per piece plus its speed maximum (``shape``, row-major),
+    then the bound's breakpoints inside the leg (``n_breaks``).
+    """
+
+    w: FloatArray
+    v: FloatArray
+    a: FloatArray
+    spots: FloatArray  # distinct positions, leg arc length [m]
+    sample_spot: IntArray  # index into ``spots`` of each sample
+    shape: tuple[int, int]  # the pieces' samples
+    n_breaks: int
+    break_pieces: IntArray  # the piece(s) each breakpoint counts for
+
+
+def _law_samples(law: TimeLaw, top: FloatArray, local: FloatArray) -> _Samples:
+    """The law at its samples, and where they lie (see `_Samples`).
+
+    Each piece's `SAMPLES_PER_PIECE` points, its speed maximum ``top``, and the
+    breakpoints ``local`` [m, leg arc length].
+    """
+    knots = law.knots
+    width = np.diff(knots)
+    m = width.size
+    frac = np.linspace(0.0, 1.0, SAMPLES_PER_PIECE)
+    # Each breakpoint counts for the piece(s) it lies in (both, on a knot).
+    at = np.searchsorted(knots, local, side="right") - 1
+    left = np.searchsorted(knots, local, side="left") - 1
+    extra_piece = np.clip(np.concatenate((at, left)), 0, m - 1)
+    # The law on each piece at its own offsets (both sides of a knot: the acceleration may
+    # jump there); the path once per distinct position: neighbouring pieces share a knot,
+    # and a maximum at a knot is that knot.
+    dx = np.concatenate((width[:, None] * frac[None, :], (top - knots[:-1])[:, None]), axis=1)
+    piece = np.arange(m)[:, None]
+    w_p, v_p, a_p, _ = law._kinematics(piece, dx, width[:, None] - dx)
+    w_b, v_b, a_b, _ = law.kinematics(local)
+    inner = knots[:-1, None] + width[:, None] * frac[None, 1:-1]
+    own = (top != knots[:-1]) & (top != knots[1:])
+    n_inner = inner.size
+    where_at = np.empty((m, SAMPLES_PER_PIECE + 1), dtype=np.intp)  # index into `spots`
+    where_at[:, 0] = np.arange(m)
+    where_at[:, SAMPLES_PER_PIECE - 1] = np.arange(1, m + 1)
+    where_at[:, 1:-2] = m + 1 + np.arange(n_inner).reshape(inner.shape)
+    at_top = np.where(top == knots[1:], np.arange(1, m + 1), np.arange(m))
+    where_at[:, -1] = np.where(own, m + 1 + n_inner + np.cumsum(own) - 1, at_top)
+    spots = np.concatenate((knots, inner.ravel(), top[own], local))
+    sample_spot = np.concatenate((where_at.ravel(), spots.size - local.size
+                                  + np.arange(local.size)))
+    return _Samples(w=np.concatenate((w_p.ravel(), w_b)), v=np.concatenate((v_p.ravel(), v_b)),
+                    a=np.concatenate((a_p.ravel(), a_b)), spots=spots, sample_spot=sample_spot,
+                    shape=(m, SAMPLES_PER_PIECE + 1), n_breaks=int(local.size),
+                    break_pieces=extra_piece)
+
+
+def _sampled_loads(smp: _Samples, spot_glob: FloatArray, path: Path,
+                   bound: Callable[[FloatArray], FloatArray], limits: Limits
+                   ) -> dict[str, tuple[FloatArray, FloatArray, float]]:
+    """``name: (load, value, limit)`` of the path-dependent quantities at the samples.
+
+    ``load / limit`` is the ratio (``"speed"``'s load is already one), ``value`` the
+    realised quantity; a quantity without a limit is one 0.
+    """
+    if isinstance(bound, SpeedBound) and bound.path is path and bound.offset == 0.0:
+        # The curvature is the bound's own (remembered from the grid where it has a memo).
+        kappa_spot, wb_spot = bound.curvature_and_bound(spot_glob)
+    else:
+        kappa_spot = np.asarray(path.curvature(spot_glob), dtype=np.float64)
+        wb_spot = np.asarray(bound(spot_glob), dtype=np.float64)
+    kappa = kappa_spot[smp.sample_spot]
+    wb = wb_spot[smp.sample_spot]
+    w, v, a = smp.w, smp.v, smp.a
+    with np.errstate(divide="ignore", invalid="ignore"):
+        speed = np.where(wb > 0, v / np.sqrt(wb), np.where(v > 0, np.inf, 0.0))
+    lateral = kinematics.lateral_acceleration(np.abs(kappa), w)
+    yaw = kinematics.yaw_rate(np.abs(kappa), v)
+    if np.isfinite(limits.j_lat_max):
+        rate = curvature_rate(path, spot_glob)[smp.sample_spot]
+        lat_jerk = np.abs(kinematics.lateral_jerk(kappa, rate, w, a, v))
+    else:
+        lat_jerk = np.zeros(1)  # no limit: nothing to evaluate, reported as 0
+    if limits.ellipse:  # the friction ellipse's radius, 1 on the ellipse
+        grip = kinematics.friction_ellipse(a, lateral, limits.a_max, limits.a_decel,
+                                           limits.a_lat_max)
+    else:
+        grip = np.zeros(1)  # not set: reported as 0
+    return {"speed": (speed, v, 1.0), "lateral": (lateral, lateral, limits.a_lat_max),
+            "yaw_rate": (yaw, yaw, limits.yaw_rate_max),
+            "lateral_jerk": (lat_jerk, lat_jerk, limits.j_lat_max),
+            "grip": (grip, grip, 1.0 if limits.ellipse else np.inf)}
+
+
+def _sampled_checks(loads: dict[str, tuple[FloatArray, FloatArray, float]], smp: _Samples,
+                    glob: FloatArray, excess: np.ndarray) -> dict[str, tuple[float, float, float]]:
+    """``name: (maximum, ratio, where)`` of the sampled quantities; flags ``excess`` in place."""
+    out = {}
+    n_b = smp.n_breaks
+    for name, (load, value, limit) in loads.items():
+        if not np.isfinite(limit):  # no limit: the maximum is reported, the ratio is 0
+            out[name] = (float(np.max(value)), 0.0, float(glob[0]))
+            continue
+        ratio_s = load / limit if name != "speed" else load
+        ratio_s = np.where(np.isfinite(ratio_s), ratio_s, np.inf)
+        k = int(np.argmax(ratio_s))
+        out[name] = (float(np.max(value)), float(ratio_s[k]), float(glob[k]))
+        over = ratio_s > 1.0 + TOLERANCES[name]
+        excess |= over[: over.size - n_b].reshape(smp.shape).any(axis=1)
+        if n_b:
+            excess[smp.break_pieces[np.tile(over[over.size - n_b:], 2)]] = True
+    return out
+
+
+def _piece_checks(ex: PieceExtremes, knots: FloatArray, offset: float, limits: Limits,
+                  excess: np.ndarray) -> dict[str, tuple[float, float, float]]:
+    """``name: (maximum, ratio, where)`` of acceleration, braking and jerk.
+
+    From the exact extremes of every piece; flags ``excess`` in place.
+    """
+    j_abs = np.maximum(ex.jerk.maximum, -ex.jerk.minimum)
+    out = {}
+    for name, per_piece, limit in (("accel", ex.a.maximum, limits.a_max),
+                                   ("decel", -ex.a.minimum, limits.a_decel),
+                                   ("jerk", j_abs, limits.j_max)):
+        per_piece = np.where(np.isfinite(per_piece), per_piece, np.inf)
+        k = int(np.argmax(per_piece))
+        ratio = max(float(per_piece[k]) / limit, 0.0) if np.isfinite(limit) else 0.0
+        out[name] = (max(float(per_piece[k]), 0.0), ratio,
+                     float(offset + 0.5 * (knots[k] + knots[k + 1])))
+        if np.isfinite(limit):
+            excess |= per_piece > limit * (1.0 + TOLERANCES[name])
     return out
 
 
@@ -186,107 +428,23 @@ def check_law(law: TimeLaw, offset: float, path: Path,
     """
     ex = law.extremes()
     knots = law.knots
-    width = np.diff(knots)
-    m = width.size
-    frac = np.linspace(0.0, 1.0, SAMPLES_PER_PIECE)
-    top = ex["w"][0]  # each piece's speed maximum, the sixth sample of the piece
     if breaks is None:
         breaks = bound_breakpoints(path, bound)
     local = np.clip(breaks[(breaks >= offset) & (breaks <= offset + law.length)] - offset,
                     0.0, law.length)
-    # Each breakpoint counts for the piece(s) it lies in (both, on a knot).
-    at = np.searchsorted(knots, local, side="right") - 1
-    left = np.searchsorted(knots, local, side="left") - 1
-    extra_piece = np.clip(np.concatenate((at, left)), 0, m - 1)
-    # The law on each piece at its own offsets (both sides of a knot: the acceleration may
-    # jump there); the path once per distinct position: neighbouring pieces share a knot,
-    # and a maximum at a knot is that knot.
-    dx = np.concatenate((width[:, None] * frac[None, :], (top - knots[:-1])[:, None]), axis=1)
-    piece = np.arange(m)[:, None]
-    w_p, v_p, a_p, _ = law._kinematics(piece, dx, width[:, None] - dx)
-    w_b, v_b, a_b, _ = law.kinematics(local)
-    w = np.concatenate((w_p.ravel(), w_b))
-    v = np.concatenate((v_p.ravel(), v_b))
-    a = np.concatenate((a_p.ravel(), a_b))
-    inner = knots[:-1, None] + width[:, None] * frac[None, 1:-1]
-    own = (top != knots[:-1]) & (top != knots[1:])
-    n_inner = inner.size
-    where_at = np.empty((m, SAMPLES_PER_PIECE + 1), dtype=np.intp)  # index into `spots`
-    where_at[:, 0] = np.arange(m)
-    where_at[:, SAMPLES_PER_PIECE - 1] = np.arange(1, m + 1)
-    where_at[:, 1:-2] = m + 1 + np.arange(n_inner).reshape(inner.shape)
-    at_top = np.where(top == knots[1:], np.arange(1, m + 1), np.arange(m))
-    where_at[:, -1] = np.where(own, m + 1 + n_inner + np.cumsum(own) - 1, at_top)
-    spots = np.concatenate((knots, inner.ravel(), top[own], local))
-    sample_spot = np.concatenate((where_at.ravel(), spots.size - local.size
-                                  + np.arange(local.size)))
-    shape = where_at.shape
-    spot_glob = offset + spots
-    if isinstance(bound, SpeedBound) and bound.path is path and bound.offset == 0.0:
-        # The curvature is the bound's own (remembered from the grid where it has a memo).
-        kappa_spot, wb_spot = bound.curvature_and_bound(spot_glob)
-    else:
-        kappa_spot = np.asarray(path.curvature(spot_glob), dtype=np.float64)
-        wb_spot = np.asarray(bound(spot_glob), dtype=np.float64)
-    glob = spot_glob[sample_spot]
-    kappa = kappa_spot[sample_spot]
-    wb = wb_spot[sample_spot]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        speed = np.where(wb > 0, v / np.sqrt(wb), np.where(v > 0, np.inf, 0.0))
-    lateral = np.abs(kappa) * w
-    yaw = np.abs(kappa) * v
-    if np.isfinite(limits.j_lat_max):
-        rate = curvature_rate(path, spot_glob)[sample_spot]
-        lat_jerk = np.abs(v * (rate * w + 2.0 * kappa * a))
-    else:
-        lat_jerk = np.zeros(1)  # no limit: nothing to evaluate, reported as 0
-    if limits.ellipse:  # the friction ellipse's radius, 1 on the ellipse
-        grip = np.hypot(a / np.where(a >= 0.0, limits.a_max, limits.a_decel),
-                        lateral / limits.a_lat_max)
-    else:
-        grip = np.zeros(1)  # not set: reported as 0
-    per_sample = {"speed": (speed, v, 1.0), "lateral": (lateral, lateral, limits.a_lat_max),
-                  "yaw_rate": (yaw, yaw, limits.yaw_rate_max),
-                  "lateral_jerk": (lat_jerk, lat_jerk, limits.j_lat_max),
-                  "grip": (grip, grip, 1.0 if limits.ellipse else np.inf)}
-    maxima: dict[str, float] = {}
-    ratios: dict[str, float] = {}
-    where: dict[str, float] = {}
-    excess = np.zeros(width.size, dtype=bool)
-    for name, (load, value, limit) in per_sample.items():
-        if not np.isfinite(limit):  # no limit: the maximum is reported, the ratio is 0
-            maxima[name] = float(np.max(value))
-            ratios[name], where[name] = 0.0, float(glob[0])
-            continue
-        ratio_s = load / limit if name != "speed" else load
-        ratio_s = np.where(np.isfinite(ratio_s), ratio_s, np.inf)
-        k = int(np.argmax(ratio_s))
-        maxima[name] = float(np.max(value))
-        ratios[name] = float(ratio_s[k])
-        where[name] = float(glob[k])
-        over = ratio_s > 1.0 + TOLERANCES[name]
-        excess |= over[: over.size - local.size].reshape(shape).any(axis=1)
-        if local.size:
-            excess[extra_piece[np.tile(over[over.size - local.size:], 2)]] = True
-    a_top, a_bottom = ex["a"][1], ex["a"][2]
-    j_top, j_bottom = ex["jerk"][1], ex["jerk"][2]
-    j_abs = np.maximum(j_top, -j_bottom)
-    for name, per_piece, limit in (("accel", a_top, limits.a_max),
-                                   ("decel", -a_bottom, limits.a_decel),
-                                   ("jerk", j_abs, limits.j_max)):
-        per_piece = np.where(np.isfinite(per_piece), per_piece, np.inf)
-        k = int(np.argmax(per_piece))
-        maxima[name] = max(float(per_piece[k]), 0.0)
-        ratios[name] = max(float(per_piece[k]) / limit, 0.0) if np.isfinite(limit) else 0.0
-        where[name] = float(offset + 0.5 * (knots[k] + knots[k + 1]))
-        if np.isfinite(limit):
-            excess |= per_piece > limit * (1.0 + TOLERANCES[name])
-    order = {k: i for i, k in enumerate(LIMIT_NAMES)}
-    ratios = dict(sorted(ratios.items(), key=lambda kv: order[kv[0]]))
+    # Each piece's speed maximum is the sixth sample of the piece.
+    smp = _law_samples(law, ex.w.at, local)
+    spot_glob = offset + smp.spots
+    excess = np.zeros(knots.size - 1, dtype=bool)
+    found = _sampled_checks(_sampled_loads(smp, spot_glob, path, bound, limits), smp,
+                            spot_glob[smp.sample_spot], excess)
+    found.update(_piece_checks(ex, knots, offset, limits, excess))
     limit_of = {"speed": limits.v_max, "accel": limits.a_max, "decel": limits.a_decel,
                 "lateral": limits.a_lat_max, "jerk": limits.j_max,
                 "yaw_rate": limits.yaw_rate_max, "lateral_jerk": limits.j_lat_max,
                 "grip": 1.0 if limits.ellipse else np.inf}
-    unset = frozenset(k for k, lim in limit_of.items() if not np.isfinite(lim))
-    return LegCheck(Verification(maxima=maxima, ratios=ratios, where=where, unset=unset),
-                    excess, knots)
+    checks = [LimitCheck(name, ratio=found[name][1], maximum=found[name][0],
+                         limit=float(limit_of[name]), where_s=found[name][2],
+                         unset=not np.isfinite(limit_of[name]))
+              for name in LIMIT_NAMES if name in found]
+    return LegCheck(Verification(checks), excess, knots)

@@ -62,6 +62,16 @@ EXTRA_PUBLIC = (
     "speedplan.core.options.Standstill",
     "speedplan.core.options.Grip",
     "speedplan.core.options.VLimit",
+    "speedplan.timing.LimitCheck",
+    "speedplan.core.kinematics.speed",
+    "speedplan.core.kinematics.acceleration",
+    "speedplan.core.kinematics.lateral_acceleration",
+    "speedplan.core.kinematics.yaw_rate",
+    "speedplan.core.kinematics.lateral_acceleration_rate",
+    "speedplan.core.kinematics.lateral_jerk",
+    "speedplan.core.kinematics.lateral_jerk_from_slope",
+    "speedplan.core.kinematics.lateral_rate_weights",
+    "speedplan.core.kinematics.friction_ellipse",
 )
 #: Members of public classes that are implementation details (the paper's scaled constants,
 #: the solver's internals) and stay off the reference.

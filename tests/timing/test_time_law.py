@@ -103,7 +103,7 @@ def test_jerk_follows_the_discrete_rows_within_the_step_ratio():
     d2 = 2 * (w[:-2] / (h0 * (h0 + h1)) - w[1:-1] / (h0 * h1) + w[2:] / (h1 * (h0 + h1)))
     discrete = np.abs(0.5 * d2 * np.sqrt(w[1:-1])).max()
     ex = law.extremes()
-    realised = max(ex["jerk"][1].max(), -ex["jerk"][2].min())
+    realised = max(ex.jerk.maximum.max(), -ex.jerk.minimum.min())
     assert realised <= discrete * (1 + GRADING) * (1 + 1e-3)
 
 
@@ -130,7 +130,7 @@ def test_no_c1_interpolant_of_a_jerk_switch_stays_within_the_limit():
     s = np.arange(12) * h
     law = TimeLaw(s, w, accel_start=0.0, accel_end=(w[-1] - w[-2]) / (2 * h))
     ex = law.extremes()
-    assert max(ex["jerk"][1].max(), -ex["jerk"][2].min()) <= j * (1 + 1e-3)
+    assert max(ex.jerk.maximum.max(), -ex.jerk.minimum.min()) <= j * (1 + 1e-3)
     # ... at the price of a local node offset of at most h² |w''| / 8 (1e-6 relative here).
     assert np.abs(law.node_offsets()).max() <= h**2 * c / 8 * (1 + 1e-9) + 1e-12
 
@@ -161,7 +161,7 @@ def test_extremes_are_exact_maxima_of_each_piece():
     _, _, a, jerk = law.kinematics(q.ravel())
     a, jerk = a.reshape(q.shape), jerk.reshape(q.shape)
     for name, val in (("a", a), ("jerk", jerk)):
-        top, bottom = ex[name][1], ex[name][2]
+        top, bottom = getattr(ex, name).maximum, getattr(ex, name).minimum
         scale = np.abs(val).max()
         assert np.all(val.max(axis=1) <= top + 1e-12 * scale)
         assert np.all(val.min(axis=1) >= bottom - 1e-12 * scale)
