@@ -45,6 +45,8 @@ __all__ = [
     "CRUISE_STEP",
     "DEFAULT_PER_PHASE",
     "END_PER_PHASE",
+    "END_SHARE",
+    "END_ZONE",
     "GRADING",
     "HIDDEN_DIP",
     "MAX_DEFAULT_NODES",
@@ -65,6 +67,12 @@ __all__ = [
     "uniform_grid",
 ]
 
+#: The end zones a node cap keeps (see `adaptive_grid`): at most this fraction of the
+#: length on each side, and of the nodes in all.
+END_ZONE = 0.125
+END_SHARE = 0.25
+#: How far over the node cap the grid with kept end zones may end (else it grows evenly).
+CAP_SLACK = 0.05
 #: Nodes per jerk transition of the default grid.
 DEFAULT_PER_PHASE = 80
 #: Largest default grid; beyond, every step grows in proportion (the grading ratio with it).
@@ -372,7 +380,13 @@ def adaptive_grid(
     if breakpoints is not None:
         sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
     sf, h = _followed(sf, rule)
-    h = _capped(sf, h, length, max_nodes)
+    # The first transitions next to each end (the max-jerk start from rest, a moving state's
+    # first change of acceleration) keep their steps when the node cap binds: grown there,
+    # the law's jerk at their end breaks its limit, and every finer grid tried after it costs
+    # more than the whole plan. Not on a move made of a few transitions (grown evenly).
+    zone = 2.0 * rule.floor if 2.0 * rule.floor <= END_ZONE * length else 0.0
+    ends = (sf <= zone) | (sf >= length - zone)
+    h = _capped(sf, h, rule.rates(sf), length, max_nodes, ends)
     grid = nodes_from_steps(sf, h, inner_anchors if inner_anchors.size else None)
     grid_size("n", grid.size)
     return grid
@@ -405,9 +419,7 @@ class _StepRule:
         """The graded step on the pre-grid ``sf``."""
         length = self.length
         wb = self.w_bound(sf)
-        hf = np.diff(sf)  # the exact no-jerk optimum at twice the limits (speedplan.solve.nojerk)
-        w_est = largest_under_rates(wb, np.full(sf.size - 1, 2 * self.a_max) * hf,
-                                    np.full(sf.size - 1, 2 * self.a_decel) * hf)
+        w_est = self._no_jerk_w(sf, wb)
         # The floor keeps the steps from vanishing where the speed falls to the ends' states:
         # on the stretches next to each end where λ(v) is below it. A slow stretch farther
         # inside (a zone, a tight curve) has transitions of its own, which may be shorter
@@ -415,21 +427,38 @@ class _StepRule:
         lam = self.scale(np.sqrt(w_est))
         h = np.maximum(np.maximum(lam, np.where(_end_runs(lam < self.floor), self.floor, 0.0))
                        / self.per_phase, MIN_RELATIVE_STEP * length)
+        far = self._cruise(sf, w_est, wb)
+        h = np.where(far, np.maximum(h, CRUISE_STEP * length), h)
+        return graded_steps(sf, h, np.where(far, CRUISE_GRADING, GRADING))
+
+    def rates(self, sf: FloatArray) -> FloatArray:
+        """The grading rate on ``sf``: `CRUISE_GRADING` in cruise, `GRADING` elsewhere."""
+        wb = self.w_bound(sf)
+        far = self._cruise(sf, self._no_jerk_w(sf, wb), wb)
+        out: FloatArray = np.where(far, CRUISE_GRADING, GRADING)
+        return out
+
+    def _no_jerk_w(self, sf: FloatArray, wb: FloatArray) -> FloatArray:
+        hf = np.diff(sf)  # the exact no-jerk optimum at twice the limits (speedplan.solve.nojerk)
+        return largest_under_rates(wb, np.full(sf.size - 1, 2 * self.a_max) * hf,
+                                   np.full(sf.size - 1, 2 * self.a_decel) * hf)
+
+    def _cruise(self, sf: FloatArray, w_est: FloatArray, wb: FloatArray) -> np.ndarray:
+        """Where ``sf`` lies farther than ``margin`` from any kink of the no-jerk profile."""
         # Long stretches where the no-jerk optimum is linear in w (a cruise, a constant
         # acceleration or braking) hold nothing to resolve: coarse, graded faster. The no-jerk
         # pass sums A h along the path, so it is linear (or meets a constant bound) only to
         # ~1e-16 of that sum, which on a long slow move is far above 1e-12 of the bound.
         top = max(float(np.max(wb)), 1e-300)
-        tol = 1e-9 * top + 1e-15 * 2.0 * max(self.a_max, self.a_decel) * length
+        tol = 1e-9 * top + 1e-15 * 2.0 * max(self.a_max, self.a_decel) * self.length
         flat = np.zeros(sf.size, dtype=bool)
         d_left, d_right = np.diff(w_est)[:-1], np.diff(w_est)[1:]
         cells = np.diff(sf)
         curv = np.abs(d_right / cells[1:] - d_left / cells[:-1]) * np.minimum(cells[1:],
                                                                              cells[:-1])
         flat[1:-1] = curv <= tol
-        far = _distance_to(~flat, sf) > self.margin
-        h = np.where(far, np.maximum(h, CRUISE_STEP * length), h)
-        return graded_steps(sf, h, np.where(far, CRUISE_GRADING, GRADING))
+        out: np.ndarray = _distance_to(~flat, sf) > self.margin
+        return out
 
 
 def _pre_grid(length: float, floor: float, anchors: FloatArray) -> FloatArray:
@@ -461,19 +490,52 @@ def _followed(sf: FloatArray, rule: _StepRule) -> tuple[FloatArray, FloatArray]:
     return sf, h
 
 
-def _capped(sf: FloatArray, h: FloatArray, length: float, max_nodes: int) -> FloatArray:
-    """Steps grown in proportion to count at most ``max_nodes`` (at least `MIN_NODES`)."""
+def _count(sf: FloatArray, h: FloatArray) -> FloatArray:
+    """Nodes per cell of ``sf`` at the steps ``h`` (their sum: the grid's node count - 1)."""
+    out: FloatArray = np.diff(sf) * 0.5 * (1.0 / h[1:] + 1.0 / h[:-1])
+    return out
+
+
+def _capped(sf: FloatArray, h: FloatArray, rate: FloatArray, length: float, max_nodes: int,
+            ends: np.ndarray) -> FloatArray:
+    """Steps grown in proportion to count at most ``max_nodes`` (at least `MIN_NODES`).
+
+    Cells within ``ends`` keep their steps while they hold at most `END_SHARE` of the nodes,
+    the others grow (none beyond the cruise step) and ``rate`` grades them again. Where the
+    grading away from the kept steps alone needs more nodes than the cap (a cap of a few
+    hundred nodes), every step grows in proportion instead.
+    """
     h_max = np.maximum(h, CRUISE_STEP * length)
+    budget = max_nodes - 1
+    if float(np.sum(_count(sf, h))) <= budget:
+        return _at_least_min_nodes(sf, h)
+    inside = ends[:-1] & ends[1:]
+    kept = h
+    for _ in range(6):
+        cells = _count(sf, kept)
+        count = float(np.sum(cells))
+        if count <= budget:
+            return _at_least_min_nodes(sf, kept)
+        in_ends = float(np.sum(cells[inside]))
+        grow_ends = max(1.0, in_ends / (END_SHARE * budget))
+        grow_rest = max(1.0, (count - in_ends) / (budget - in_ends / grow_ends))
+        grown = np.where(ends, kept * grow_ends, np.minimum(kept * grow_rest, h_max))
+        kept = graded_steps(sf, grown, rate)
+    if float(np.sum(_count(sf, kept))) <= (1.0 + CAP_SLACK) * budget:
+        return _at_least_min_nodes(sf, kept)
     for _ in range(4):
-        count = float(np.sum(np.diff(sf) * 0.5 * (1.0 / h[1:] + 1.0 / h[:-1])))
-        if count <= max_nodes - 1:
+        count = float(np.sum(_count(sf, h)))
+        if count <= budget:
             break
-        # Too many nodes: every step grows in proportion, but none beyond the cruise step.
-        h = graded_steps(sf, np.minimum(h * (count / (max_nodes - 1)), h_max),
+        h = graded_steps(sf, np.minimum(h * (count / budget), h_max),
                          np.full(sf.size, CRUISE_GRADING))
-    if count < MIN_NODES - 1:
-        h = h * (count / (MIN_NODES - 1))
-    return h
+    return _at_least_min_nodes(sf, h)
+
+
+def _at_least_min_nodes(sf: FloatArray, h: FloatArray) -> FloatArray:
+    """``h``, or finer in proportion where it counts fewer than `MIN_NODES` nodes."""
+    count = float(np.sum(_count(sf, h)))
+    return h * (count / (MIN_NODES - 1)) if count < MIN_NODES - 1 else h
 
 
 #: A breakpoint of the bound joins the first scan of `adaptive_grid` where the bound

@@ -194,3 +194,26 @@ def test_a_hairpin_narrower_than_a_no_jerk_grid_step_is_cut_out() -> None:
     on_arc = (near.s >= before) & (near.s <= before + radius * angle)
     assert on_arc.sum() > 10
     assert near.v[on_arc].max() <= np.sqrt(w_arc) * (1 + 1e-3)
+
+
+def test_a_grid_at_its_node_cap_keeps_the_first_transitions_at_the_ends_resolved() -> None:
+    # Jerk phases of 8 ms on a 4 m path (a_max 0.11 m/s², j_max 13.6 m/s³): the default grid
+    # wants far more than MAX_DEFAULT_NODES and grows its steps; the max-jerk start from rest
+    # (1.2 µm long) must keep its own steps, or the law's jerk at its end goes over the limit
+    # and every finer grid tried after it costs tens of seconds.
+    from speedplan.model import PlanRequest, build_model
+    from speedplan.model.grid import DEFAULT_PER_PHASE, MAX_DEFAULT_NODES, rest_phase_length
+
+    path = Path.from_waypoints([
+        [0, 0], [0.12426521336474784, -0.11657631877453342],
+        [3.021780629947684, 0.018193808385309485], [3.207499798766692, -0.2747489556759499],
+        [3.9813199879850347, 0.1445236020023441]])
+    lim = Limits(v_max=16.418898422873855, a_max=0.11059941918961164,
+                 a_lat_max=0.1453314309003239, j_max=13.58945597172854)
+    s = build_model(PlanRequest.create(path, lim)).legs[0].problem.s
+    assert s.size >= 0.9 * MAX_DEFAULT_NODES  # the cap binds
+    ell = rest_phase_length(lim.a_max, lim.v_max, lim.j_max)
+    for nodes in (np.sum(s <= ell), np.sum(s >= s[-1] - ell)):
+        assert nodes >= 0.5 * DEFAULT_PER_PHASE
+    profile = plan(path, lim)
+    assert profile.verification.ok and not profile.limits_exceeded
