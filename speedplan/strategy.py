@@ -61,7 +61,8 @@ from .solve import DiscreteSolution, solve_problem
 from .timing import TOLERANCES, LegResult, SpeedProfile, Verification, law_for
 
 __all__ = ["ATTEMPTS", "COARSER_GRIDS", "MAX_REFINEMENTS", "REFINE_FACTORS",
-           "STATE_CONSTRAINTS", "Budget", "Record", "coarsenable", "coarser_leg", "model_request",
+           "STATE_CONSTRAINTS", "Budget", "Record", "coarsenable", "coarser_leg", "excess",
+           "model_request",
            "refine_factor", "solve_leg", "solve_legs", "verified_profile"]
 
 #: What the reachability checks of boundary states name when they refuse one.
@@ -412,16 +413,27 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
             grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess, leg.anchors,
                                 refine_factor(leg_check.verification))
             try:
-                legs[i] = record.attempt("local_refinement", i,
+                refined = record.attempt("local_refinement", i,
                                          partial(_solve_on_grid, request, leg, grid))
             except SolverError:  # keep the verified law; its excess is reported below
                 stuck.add(i)
                 continue
+            trial = replace(profile, legs=(*legs[:i], refined, *legs[i + 1:]))
+            trial_check = trial.check_leg(i)
+            if excess(trial_check.verification) > excess(leg_check.verification):
+                # A finer grid the backend solved less well (seen: 1.1x the jerk limit
+                # became 25x): keep the better law, and stop refining this leg.
+                record.mark(len(record.entries) - 1, "replaced",
+                            f"{_exceeds(trial_check.verification)}, more than the law it "
+                            "refined")
+                stuck.add(i)
+                continue
             record.mark_previous(i, _exceeds(leg_check.verification))
+            legs[i], leg_checks[i] = refined, trial_check
             changed.append(i)
         profile = replace(profile, legs=tuple(legs))
-        for i in changed:
-            leg_checks[i] = profile.check_leg(i)
+        if not changed:
+            break
     # A leg planned on a coarser grid (its backend had stalled on the default one) whose law
     # still exceeds a limit: the default grid with the other backend as well, if that law
     # passes (seen on a zone path whose eighth grid left six steps for the last rest phase).
@@ -459,6 +471,19 @@ def _solve_on_grid(request: PlanRequest, leg: Leg, grid: FloatArray) -> LegResul
     """``leg`` on another grid (a local refinement of its own), solved."""
     return solve_leg(leg_on_grid(request, leg.bound, grid, leg.start, leg.v0, leg.a0, leg.vf,
                                  leg.af))
+
+
+def excess(check: Verification) -> float:
+    """How far the worst limit is exceeded, in its own tolerances (``<= 1``: within them).
+
+    Examples
+    --------
+    >>> from speedplan.timing import Verification
+    >>> round(excess(Verification(maxima={}, ratios={"jerk": 1.1, "speed": 1.0}, where={})), 6)
+    2.0
+    """
+    return max(((ratio - 1.0) / TOLERANCES[name] for name, ratio in check.ratios.items()),
+               default=0.0)
 
 
 def _exceeds(check: Verification) -> str:

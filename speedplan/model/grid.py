@@ -71,8 +71,6 @@ __all__ = [
 #: length on each side, and of the nodes in all.
 END_ZONE = 0.125
 END_SHARE = 0.25
-#: How far over the node cap the grid with kept end zones may end (else it grows evenly).
-CAP_SLACK = 0.05
 #: Nodes per jerk transition of the default grid.
 DEFAULT_PER_PHASE = 80
 #: Largest default grid; beyond, every step grows in proportion (the grading ratio with it).
@@ -501,9 +499,9 @@ def _capped(sf: FloatArray, h: FloatArray, rate: FloatArray, length: float, max_
     """Steps grown in proportion to count at most ``max_nodes`` (at least `MIN_NODES`).
 
     Cells within ``ends`` keep their steps while they hold at most `END_SHARE` of the nodes,
-    the others grow (none beyond the cruise step) and ``rate`` grades them again. Where the
-    grading away from the kept steps alone needs more nodes than the cap (a cap of a few
-    hundred nodes), every step grows in proportion instead.
+    the others grow (none beyond the cruise step) and ``rate`` grades them again. Where that
+    does not bring the count under the cap (a cap of a few hundred nodes: the grading away
+    from the kept steps alone needs more), every step grows in proportion instead.
     """
     h_max = np.maximum(h, CRUISE_STEP * length)
     budget = max_nodes - 1
@@ -511,18 +509,17 @@ def _capped(sf: FloatArray, h: FloatArray, rate: FloatArray, length: float, max_
         return _at_least_min_nodes(sf, h)
     inside = ends[:-1] & ends[1:]
     kept = h
-    for _ in range(6):
+    for _ in range(8):
         cells = _count(sf, kept)
         count = float(np.sum(cells))
         if count <= budget:
             return _at_least_min_nodes(sf, kept)
         in_ends = float(np.sum(cells[inside]))
-        grow_ends = max(1.0, in_ends / (END_SHARE * budget))
-        grow_rest = max(1.0, (count - in_ends) / (budget - in_ends / grow_ends))
+        target = 0.995 * budget  # the grading after the growth adds nodes: aim below the cap
+        grow_ends = max(1.0, in_ends / (END_SHARE * target))
+        grow_rest = max(1.0, (count - in_ends) / (target - in_ends / grow_ends))
         grown = np.where(ends, kept * grow_ends, np.minimum(kept * grow_rest, h_max))
         kept = graded_steps(sf, grown, rate)
-    if float(np.sum(_count(sf, kept))) <= (1.0 + CAP_SLACK) * budget:
-        return _at_least_min_nodes(sf, kept)
     for _ in range(4):
         count = float(np.sum(_count(sf, h)))
         if count <= budget:
