@@ -3,19 +3,41 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TypedDict, Unpack
+
+from numpy.typing import ArrayLike
 
 from .core.limits import Limits
-from .geometry import Path, SpeedZone
+from .core.options import Backend, Refine, Standstill, VLimit
+from .geometry import Path, SpanLimit, SpeedZone
 from .geometry.fitting import DEFAULT_KIND
 from .plan import plan
 from .timing import Trajectory
 
-__all__ = ["profile_from_waypoints"]
+__all__ = ["WaypointPlanOptions", "profile_from_waypoints"]
+
+
+class WaypointPlanOptions(TypedDict, total=False):
+    """The [`speedplan.plan`][speedplan.plan] keywords `profile_from_waypoints` passes on.
+
+    ``n``, ``ds``, ``v_limit``, ``refine``, ``standstill``, ``backend``, ``stops``,
+    ``spans`` and ``time_limit``, as for `speedplan.plan`; the zones and the boundary states
+    are keywords of `profile_from_waypoints` itself.
+    """
+
+    n: int | None
+    ds: float | None
+    v_limit: VLimit | None
+    refine: Refine
+    standstill: Standstill
+    backend: Backend
+    stops: Sequence[float] | None
+    spans: Sequence[SpanLimit] | None
+    time_limit: float | None
 
 
 def profile_from_waypoints(
-    xy: Any,
+    xy: ArrayLike,
     *,
     v_max: float,
     a_max: float,
@@ -24,7 +46,7 @@ def profile_from_waypoints(
     a_decel: float | None = None,
     dt: float = 0.01,
     kind: str = DEFAULT_KIND,
-    headings: Any = None,
+    headings: ArrayLike | None = None,
     corner_radius: float | None = None,
     max_deviation: float | None = None,
     transition: float | None = None,
@@ -33,7 +55,7 @@ def profile_from_waypoints(
     a0: float = 0.0,
     vf: float = 0.0,
     af: float = 0.0,
-    **plan_options: Any,
+    **plan_options: Unpack[WaypointPlanOptions],
 ) -> Trajectory:
     """Plan through waypoints and return the trajectory sampled every ``dt`` seconds.
 

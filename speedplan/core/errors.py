@@ -6,7 +6,10 @@ Every error a user can meet derives from [`SpeedplanError`][speedplan.SpeedplanE
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .attempts import Attempt
 
 __all__ = [
     "InfeasibleError",
@@ -71,17 +74,17 @@ class PlanTimeout(SpeedplanError):
         The attempts made, in order ([`Attempt`][speedplan.core.attempts.Attempt]).
     """
 
-    def __init__(self, message: str, *, time_limit: float, attempts: tuple[Any, ...] = ()
+    def __init__(self, message: str, *, time_limit: float, attempts: tuple[Attempt, ...] = ()
                  ) -> None:
         super().__init__(message)
         self.time_limit = time_limit
         self.attempts = attempts
 
-    def __reduce__(self) -> tuple[Any, ...]:  # picklable for plan_many's workers
+    def __reduce__(self) -> tuple[object, ...]:  # picklable for plan_many's workers
         return (_plan_timeout, (str(self), self.time_limit, self.attempts))
 
 
-def _plan_timeout(message: str, time_limit: float, attempts: tuple[Any, ...]) -> PlanTimeout:
+def _plan_timeout(message: str, time_limit: float, attempts: tuple[Attempt, ...]) -> PlanTimeout:
     return PlanTimeout(message, time_limit=time_limit, attempts=attempts)
 
 

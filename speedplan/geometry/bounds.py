@@ -3,23 +3,24 @@
 from __future__ import annotations
 
 import weakref
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
 
 import numpy as np
 import shapely
+from numpy.typing import ArrayLike
 
 from ..core.checks import FloatArray, as_array, as_scalar, instances
 from ..core.errors import InvalidInputError
 from ..core.limits import Limits
+from ..core.options import VLimit
 from .path import Path
 
 __all__ = ["ZONE_RESCAN", "SpanLimit", "SpeedBound", "SpeedZone", "bound_breakpoints",
            "check_spans", "check_zones", "speed_bounds", "zone_intervals"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class SpeedZone:
     """A region with its own speed limit.
 
@@ -45,11 +46,14 @@ class SpeedZone:
     2.0
     """
 
-    polygon: Any
+    polygon: shapely.Polygon | shapely.MultiPolygon
     v_max: float
 
-    def __post_init__(self) -> None:
-        poly = self.polygon
+    def __init__(self, polygon: shapely.Polygon | shapely.MultiPolygon | ArrayLike,
+                 v_max: float) -> None:
+        # The generated constructor would type ``polygon`` as the field (always a shapely
+        # polygon once built); vertices are accepted too.
+        poly = polygon
         if isinstance(poly, shapely.Geometry) and not isinstance(
                 poly, shapely.Polygon | shapely.MultiPolygon):
             raise InvalidInputError(
@@ -71,7 +75,7 @@ class SpeedZone:
             )
         shapely.prepare(poly)  # speeds up the vectorised point-in-polygon tests
         object.__setattr__(self, "polygon", poly)
-        object.__setattr__(self, "v_max", as_scalar("v_max", self.v_max, nonnegative=True))
+        object.__setattr__(self, "v_max", as_scalar("v_max", v_max, nonnegative=True))
 
 
 @dataclass(frozen=True)
@@ -114,7 +118,7 @@ class SpanLimit:
                 set_(self, name, as_scalar(name, value, positive=True, allow_inf=True))
 
 
-def check_spans(spans: Any, length: float | None = None) -> list[SpanLimit]:
+def check_spans(spans: object, length: float | None = None) -> list[SpanLimit]:
     """``spans`` as a list of [`SpanLimit`][speedplan.SpanLimit] (one, a sequence, or ``None``)."""
     out = instances("spans", spans, SpanLimit)
     for i, span in enumerate(out):
@@ -129,10 +133,10 @@ def check_spans(spans: Any, length: float | None = None) -> list[SpanLimit]:
 def speed_bounds(
     path: Path,
     limits: Limits,
-    s: Any,
+    s: ArrayLike,
     *,
     zones: Sequence[SpeedZone] | SpeedZone | None = None,
-    v_limit: Any = None,
+    v_limit: VLimit | None = None,
     spans: Sequence[SpanLimit] | SpanLimit | None = None,
 ) -> FloatArray:
     """Upper bound ``mu+(s)`` on ``w = v²`` [m²/s²] at arc lengths ``s`` [m].
@@ -191,7 +195,7 @@ def speed_bounds(
 
 def _bounds(
     path: Path, limits: Limits, q: FloatArray, curvature: FloatArray,
-    zone_list: list[SpeedZone], v_limit: Any, span_list: Sequence[SpanLimit] = (),
+    zone_list: list[SpeedZone], v_limit: VLimit | None, span_list: Sequence[SpanLimit] = (),
 ) -> FloatArray:
     """`speed_bounds` at ``q`` once the path's curvature there is known."""
     w = np.full(q.shape, limits.v_max**2)
@@ -240,7 +244,7 @@ class SpeedBound:
     path: Path
     limits: Limits
     zones: list[SpeedZone] | None = None
-    v_limit: Any = None
+    v_limit: VLimit | None = None
     offset: float = 0.0
     spans: tuple[SpanLimit, ...] = ()
     memo: BoundMemo | None = field(default=None, compare=False, repr=False)
@@ -289,7 +293,7 @@ class SpeedBound:
         return speed_bounds(self.path, self.limits, q, zones=self.zones, v_limit=self.v_limit,
                             spans=self.spans)
 
-    def curvature_and_bound(self, s: Any) -> tuple[FloatArray, FloatArray]:
+    def curvature_and_bound(self, s: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The path's curvature [1/m] and the bound [m²/s²] at arc lengths ``s`` [m]."""
         q = as_array("s", s) + self.offset
         if self.memo is None:
@@ -305,7 +309,7 @@ class SpeedBound:
         return _bounds(self.path, self.limits, q, kappa, check_zones(self.zones), self.v_limit,
                        self.spans)
 
-    def given_curvature(self, s: Any, curvature: Any) -> FloatArray:
+    def given_curvature(self, s: ArrayLike, curvature: ArrayLike) -> FloatArray:
         """Bound at arc lengths ``s`` [m] where the path's ``curvature`` [1/m] is known.
 
         Saves evaluating the curvature again, which on spline and NURBS paths is an
@@ -341,7 +345,9 @@ class BoundMemo:
         """Number of positions remembered."""
         return int(self._table[0].size)
 
-    def lookup(self, q: FloatArray, fresh: Any) -> tuple[FloatArray, FloatArray]:
+    def lookup(self, q: FloatArray,
+               fresh: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
+               ) -> tuple[FloatArray, FloatArray]:
         """``(curvature, bound)`` at ``q``, with ``fresh(positions)`` for the unseen ones."""
         keys, kappa_k, w_k = self._table
         flat = q.ravel()
@@ -364,7 +370,7 @@ class BoundMemo:
         return (BoundMemo, ())
 
 
-def _check_v_limit(v_limit: Any) -> tuple[FloatArray, FloatArray]:
+def _check_v_limit(v_limit: VLimit) -> tuple[FloatArray, FloatArray]:
     try:
         sk, vk = v_limit
     except (TypeError, ValueError) as exc:
@@ -525,7 +531,7 @@ def _rescanned(path: Path, zone: SpeedZone, s: FloatArray, xy: FloatArray,
     return fine[row, col], fine[row, col + 1], inside[row, col + 1]
 
 
-def bound_breakpoints(path: Path, bound: Any) -> FloatArray:
+def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> FloatArray:
     """Arc lengths [m] where the speed bound ``bound`` may have a kink, a step or a dip.
 
     The joins of the path's pieces (where the curvature may jump or change its law: the
@@ -559,7 +565,7 @@ def bound_breakpoints(path: Path, bound: Any) -> FloatArray:
     return out
 
 
-def check_zones(zones: Any) -> list[SpeedZone]:
+def check_zones(zones: object) -> list[SpeedZone]:
     """``zones`` as a list of `SpeedZone`; raise naming the entry that is not one.
 
     A single zone counts as a list of one.

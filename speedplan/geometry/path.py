@@ -6,12 +6,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from itertools import pairwise
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..core.checks import FloatArray, IntArray, as_array, as_scalar, grid_size
 from ..core.errors import InvalidInputError
+from ..core.options import JsonObject
 from ._checks import as_int
 from .pieces import Piece, SubPiece
 from .primitives import (
@@ -26,6 +28,9 @@ from .primitives import (
     segment_spec,
     turn_integral,
 )
+
+if TYPE_CHECKING:
+    from shapely import LineString
 
 __all__ = ["Arc", "Clothoid", "Line", "Path", "PathSamples"]
 
@@ -147,7 +152,7 @@ class Path:
         return bool(np.linalg.norm(ends[1] - ends[0]) <= 1e-9 * self.length)
 
     # ---- evaluation -------------------------------------------------------------------------
-    def _locate(self, s: Any) -> tuple[FloatArray, IntArray]:
+    def _locate(self, s: ArrayLike) -> tuple[FloatArray, IntArray]:
         """Checked, clipped ``s`` and the index of the piece holding each value."""
         q = as_array("s", s)
         L = self.length
@@ -275,7 +280,7 @@ class Path:
             out = table[3][idx] + u * (k0 + 0.5 * sharpness * u)
         return np.asarray(out, dtype=np.float64)
 
-    def _dispatch(self, s: Any, attr: str) -> FloatArray:
+    def _dispatch(self, s: ArrayLike, attr: str) -> FloatArray:
         q, idx = self._locate(s)
         if self._clothoids is not None:
             if attr in ("curvature", "heading"):
@@ -299,7 +304,7 @@ class Path:
             out[sel] = getattr(self.pieces[k], attr)(flat[sel] - self.offsets[k])
         return out.reshape(q.shape + trailing)
 
-    def point(self, s: Any) -> FloatArray:
+    def point(self, s: ArrayLike) -> FloatArray:
         """Positions ``(x, y)`` [m] at arc lengths ``s`` [m], shape ``s.shape + (2,)``.
 
         Examples
@@ -310,7 +315,7 @@ class Path:
         """
         return self._dispatch(s, "point")
 
-    def heading(self, s: Any) -> FloatArray:
+    def heading(self, s: ArrayLike) -> FloatArray:
         """Vehicle heading (yaw) [rad] at arc lengths ``s`` [m], continuous along the path.
 
         The direction of travel on forward pieces, that plus π on reverse ones; continuous
@@ -326,7 +331,7 @@ class Path:
         """
         return self._dispatch(s, "heading")
 
-    def curvature(self, s: Any) -> FloatArray:
+    def curvature(self, s: ArrayLike) -> FloatArray:
         """Signed curvature [1/m] at arc lengths ``s`` [m] (positive: turning left).
 
         That of the curve traversed in the direction of travel.
@@ -340,7 +345,7 @@ class Path:
         """
         return self._dispatch(s, "curvature")
 
-    def curvature_rate(self, s: Any) -> FloatArray:
+    def curvature_rate(self, s: ArrayLike) -> FloatArray:
         """``dκ/ds`` [1/m²] at arc lengths ``s`` [m], within each piece.
 
         At a join the value is that of the piece after it; where the curvature jumps there
@@ -384,7 +389,7 @@ class Path:
                 jumps.append(k_start - k_end)
         return np.array(joins, dtype=np.float64), np.array(jumps, dtype=np.float64)
 
-    def direction(self, s: Any) -> IntArray:
+    def direction(self, s: ArrayLike) -> IntArray:
         """Direction of travel at arc lengths ``s`` [m]: ``+1`` forward, ``-1`` reverse.
 
         At a cusp the value is that of the piece after it.
@@ -471,7 +476,7 @@ class Path:
                 out.append(SubPiece(piece, cut_lo - a, cut_hi - cut_lo))
         return Path(tuple(out))
 
-    def evaluate(self, s: Any) -> tuple[FloatArray, FloatArray, FloatArray]:
+    def evaluate(self, s: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``(point, heading, curvature)`` at arc lengths ``s`` in one pass.
 
         Cheaper than three calls for spline and NURBS pieces (one arc-length inversion).
@@ -560,7 +565,7 @@ class Path:
         """
         return Path(tuple(p.reversed(swap_direction) for p in reversed(self.pieces)))
 
-    def to_linestring(self, ds: float | None = None) -> Any:
+    def to_linestring(self, ds: float | None = None) -> LineString:
         """A shapely ``LineString`` through the path.
 
         Parameters
@@ -587,7 +592,7 @@ class Path:
     @classmethod
     def from_segments(
         cls,
-        segments: Sequence[Any],
+        segments: Sequence[Line | Arc | Clothoid | JsonObject],
         start: Sequence[float] = (0.0, 0.0),
         heading: float = 0.0,
     ) -> Path:
@@ -625,9 +630,10 @@ class Path:
         >>> back.cusps.tolist(), back.direction([1.0, 6.0]).tolist()
         ([5.0], [1, -1])
         """
-        if isinstance(segments, str | bytes) or not isinstance(segments, Sequence):
+        given: object = segments  # untyped callers pass anything: refuse a string too
+        if isinstance(given, str | bytes) or not isinstance(given, Sequence):
             raise InvalidInputError(
-                f"`segments` must be a list of segments; got {type(segments).__name__}"
+                f"`segments` must be a list of segments; got {type(given).__name__}"
             )
         if len(segments) == 0:
             raise InvalidInputError("`segments` is empty; pass at least one segment")
@@ -644,10 +650,10 @@ class Path:
     @classmethod
     def from_waypoints(
         cls,
-        xy: Any,
+        xy: ArrayLike,
         kind: str = "g2",
         *,
-        headings: Any = None,
+        headings: ArrayLike | None = None,
         corner_radius: float | None = None,
         max_deviation: float | None = None,
         transition: float | None = None,
@@ -715,7 +721,8 @@ class Path:
 
     @classmethod
     def from_nurbs(
-        cls, degree: int, knots: Any, control_points: Any, weights: Any = None
+        cls, degree: int, knots: ArrayLike, control_points: ArrayLike,
+        weights: ArrayLike | None = None,
     ) -> Path:
         """NURBS curve, as in a VDA 5050 edge ``trajectory``, reparametrised by arc length.
 
@@ -743,7 +750,8 @@ class Path:
         return cls((nurbs_piece(degree, knots, control_points, weights),))
 
     @classmethod
-    def from_linestring(cls, ls: Any, kind: str = "g2", *, headings: Any = None,
+    def from_linestring(cls, ls: LineString, kind: str = "g2", *,
+                        headings: ArrayLike | None = None,
                         corner_radius: float | None = None, max_deviation: float | None = None,
                         transition: float | None = None) -> Path:
         """Path through the vertices of a shapely ``LineString`` (z ignored).

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._version import __version__
 from ..core.checks import FloatArray, as_array
@@ -288,7 +288,7 @@ class RouteProfile:
         return out
 
     # ---- sampling in time -------------------------------------------------------------------
-    def edge_at(self, s: Any) -> FloatArray:
+    def edge_at(self, s: ArrayLike) -> FloatArray:
         """Index into ``route.edges`` of the edge at arc lengths ``s`` along the route."""
         q = as_array("s", s)
         node_s = self.route.node_s
@@ -297,7 +297,7 @@ class RouteProfile:
         out: FloatArray = idx.astype(np.float64)
         return out
 
-    def at(self, t: Any) -> RouteTrajectory:
+    def at(self, t: ArrayLike) -> RouteTrajectory:
         """States at times ``t`` [s from the start] (clipped to ``[0, duration]``).
 
         During a turn on the spot the vehicle stands on its node (``v``, ``a``, ``j`` and the
@@ -354,7 +354,7 @@ class RouteProfile:
         traj = self.at(sample_times(self.duration, dt))
         return replace(traj, metadata={**traj.metadata, "dt": float(dt)})
 
-    def _metadata(self) -> dict[str, Any]:
+    def _metadata(self) -> dict[str, object]:
         route = self.route
         return {
             "speedplan_version": __version__,

@@ -13,6 +13,7 @@ import numpy as np
 from ..core.checks import FloatArray, instances
 from ..core.errors import InvalidInputError
 from ..core.numerics import wrap_angle
+from ..core.options import JsonObject
 from ..geometry import Path
 from ..geometry.corners import CUSP_ANGLE, g2_chain
 from ..geometry.primitives import ClothoidPiece
@@ -415,7 +416,7 @@ class Route:
 
     # ---- constructors -----------------------------------------------------------------------
     @classmethod
-    def from_vda5050(cls, order: dict[str, Any] | str | os.PathLike[str]) -> Route:
+    def from_vda5050(cls, order: JsonObject | str | os.PathLike[str]) -> Route:
         """Read a VDA 5050 order (versions 2.0, 2.1 and 3.0).
 
         Parameters

@@ -5,9 +5,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._version import __version__
 from ..core import kinematics
@@ -25,6 +26,7 @@ from .verify import LegCheck, Verification, bound_breakpoints, check_law, curvat
 if TYPE_CHECKING:
     from ..geometry import Path
     from ..model import PlanRequest
+    from ..model.legs import TimeLawSpec
 
 __all__ = ["PROFILE_STATUSES", "LegResult", "ProfileStatus", "SpeedProfile", "combine",
            "sample_times"]
@@ -208,7 +210,7 @@ class SpeedProfile:
         return PROFILE_STATUSES[self.status]
 
     # ---- sampling in time -------------------------------------------------------------------
-    def at(self, t: Any) -> Trajectory:
+    def at(self, t: ArrayLike) -> Trajectory:
         """States at the given times [s] (clipped to ``[0, duration]``).
 
         Examples
@@ -261,7 +263,7 @@ class SpeedProfile:
         return replace(self.at(times), metadata={**self.metadata, "dt": float(dt)})
 
     @property
-    def metadata(self) -> dict[str, Any]:
+    def metadata(self) -> dict[str, object]:
         """What a trajectory file records about this plan: version, certificate, limits, inputs.
 
         Keys: ``speedplan_version``, ``status``, ``duration`` [s], ``objective`` and
@@ -269,7 +271,7 @@ class SpeedProfile:
         and, for a profile from `speedplan.plan`, ``boundary`` (``v0``, ``a0``, ``vf``,
         ``af``) and ``standstill``.
         """
-        meta: dict[str, Any] = {
+        meta: dict[str, object] = {
             "speedplan_version": __version__,
             "status": self.status,
             "duration": self.duration,
@@ -317,7 +319,7 @@ class SpeedProfile:
         )
 
 
-def law_for(s: FloatArray, w: FloatArray, spec: Any) -> TimeLaw:
+def law_for(s: FloatArray, w: FloatArray, spec: TimeLawSpec) -> TimeLaw:
     """The `TimeLaw` of a leg's solution under its `TimeLawSpec`."""
     return TimeLaw(s, w, accel_start=spec.accel_start, accel_end=spec.accel_end,
                    j_max=spec.j_max, linear=spec.linear)

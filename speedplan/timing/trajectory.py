@@ -48,15 +48,15 @@ HEADING_RANGE = "[-pi, pi)"
 TextFile = str | PathLike[str] | IO[str]
 
 
-class _FrozenDict(Mapping[str, Any]):
+class _FrozenDict(Mapping[str, object]):
     """A read-only mapping (nested mappings and lists frozen too) that pickles."""
 
     __slots__ = ("_data",)
 
-    def __init__(self, data: Mapping[str, Any] | None = None) -> None:
+    def __init__(self, data: Mapping[str, object] | None = None) -> None:
         self._data = {str(k): _freeze(v) for k, v in (data or {}).items()}
 
-    def __getitem__(self, key: str) -> Any:
+    def __getitem__(self, key: str) -> object:
         return self._data[key]
 
     def __iter__(self) -> Iterator[str]:
@@ -187,7 +187,7 @@ class Trajectory:
     yaw_rate: FloatArray
     j_lat: FloatArray
     direction: FloatArray
-    metadata: Mapping[str, Any] = field(default_factory=_FrozenDict, compare=False)
+    metadata: Mapping[str, object] = field(default_factory=_FrozenDict, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "metadata", _freeze(dict(self.metadata)))
