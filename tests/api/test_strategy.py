@@ -62,6 +62,25 @@ def test_a_refined_leg_records_the_law_it_replaced_and_why(ungraded):
     assert profile.verification.ok
 
 
+def test_a_refinement_whose_law_is_worse_is_dropped_and_not_refined_again(ungraded,
+                                                                          monkeypatch):
+    # Stand-in for a finer grid the backend solves less well: a 30-node grid instead.
+    def coarse(request, leg, grid):
+        s = np.linspace(0.0, float(grid[-1]), 30)
+        return strategy.solve_leg(strategy.leg_on_grid(request, leg.bound, s, leg.start, leg.v0,
+                                                       leg.a0, leg.vf, leg.af))
+
+    monkeypatch.setattr(strategy, "_solve_on_grid", coarse)
+    with pytest.warns(sp.LimitWarning):
+        profile = sp.plan(STRAIGHT, LGV, n=300)
+    names = [(a.name, a.outcome) for a in profile.attempts]
+    assert names == [("model", "answered"), ("given_grid", "answered"),
+                     ("local_refinement", "replaced")]
+    assert "more than the law it refined" in profile.attempts[-1].reason
+    assert profile.s.size == 300  # the given grid's law, not the 30-node one
+    assert 1.0 < strategy.excess(profile.verification) < 2.0
+
+
 def test_a_tiny_time_limit_raises_plan_timeout_naming_the_attempts():
     with pytest.raises(sp.PlanTimeout) as info:
         sp.plan(STRAIGHT, LGV, time_limit=1e-9)
