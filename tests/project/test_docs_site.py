@@ -40,6 +40,9 @@ LITERAL_ROLE = re.compile(
 #: Public names beyond ``speedplan.__all__``: the readers, writers and figures of the lazily
 #: imported modules, the geometry primitives of ``Path.from_segments``, the route's parts.
 EXTRA_PUBLIC = (
+    "speedplan.waypoints.WaypointPlanOptions",
+    "speedplan.core.options.JsonObject",
+    "speedplan.core.options.JsonValue",
     "speedplan.geometry.Line",
     "speedplan.geometry.Arc",
     "speedplan.geometry.Clothoid",
