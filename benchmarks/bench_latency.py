@@ -12,9 +12,9 @@ paths through random waypoints, slow zones, comfort limits (``j_lat_max``, ``yaw
 and moving boundary states. The named cases are plans whose latency or outcome is known to be
 hard: a 4 m G2 path with a tiny ``a_max``, a 7-waypoint comfort path, long straight moves
 with jerk phases far shorter than the move, a nearly-at-rest braking start, and replanning
-from a state sampled off a plan. Every plan is timed on its own (wall clock, after one warm-up
-plan that compiles the kernels) and its outcome recorded: the profile's status, or the error's
-class.
+from a state sampled off a plan. Every plan is timed on its own (wall clock, after the kernels
+are compiled, as by ``speedplan compile``, and one warm-up plan) and its outcome recorded: the
+profile's status, or the error's class.
 
 With ``--baseline DIR`` the same measurement is also run on the speedplan checkout in ``DIR``
 (a subprocess with ``PYTHONPATH=DIR``) and both are printed side by side, so the two runs
@@ -169,7 +169,9 @@ def plan_one(job: Job, time_limit: float | None) -> dict[str, Any]:
 
 def _warm() -> None:
     import speedplan as sp
+    from speedplan.core.jit import compile_families
 
+    compile_families()  # as `speedplan compile`: no plan runs while a kernel compiles
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         sp.plan(_straight(sp, 5.0), sp.Limits(2.0, 1.0, 1.0, 0.5))  # compile the kernels
