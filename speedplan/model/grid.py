@@ -41,6 +41,7 @@ from ..core.checks import FloatArray, grid_size
 from ..core.rates import largest_under_rates
 
 __all__ = [
+    "ANCHOR_ROOM",
     "CRUISE_GRADING",
     "CRUISE_STEP",
     "DEFAULT_PER_PHASE",
@@ -89,6 +90,8 @@ GRADING = 0.01
 #: pieces where the curvature rate jumps): the steps on either side are scaled by at most
 #: ``1 ± 0.5 / MIN_ANCHOR_NODES`` (1 %), within the grading.
 MIN_ANCHOR_NODES = 50
+#: The default grid's steps leave this many times `MIN_ANCHOR_NODES` between two anchors.
+ANCHOR_ROOM = 1.5
 #: Largest relative change between neighbouring steps inside long constant-bound stretches.
 CRUISE_GRADING = 0.1
 #: Nodes per boundary transient of a user grid (``n`` or ``ds``): the first jerk phase from
@@ -374,6 +377,8 @@ def adaptive_grid(
         rule = replace(rule, floor=min(rule.floor, float(rule.scale(np.array(v_low)))))
     inner_anchors = np.zeros(0) if anchors is None else np.asarray(anchors, dtype=np.float64)
     inner_anchors = inner_anchors[(inner_anchors > 0.0) & (inner_anchors < length)]
+    if inner_anchors.size:
+        rule = replace(rule, anchors=np.concatenate(([0.0], np.sort(inner_anchors), [length])))
     sf = _pre_grid(length, rule.floor, inner_anchors)
     if breakpoints is not None:
         sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
@@ -407,6 +412,7 @@ class _StepRule:
     per_phase: float
     floor: float
     margin: float
+    anchors: FloatArray | None = None  # sorted, with both ends: every anchor becomes a node
 
     def scale(self, v: FloatArray) -> FloatArray:
         """``λ(v) = v min(t_j, sqrt(v / j))``: the length of a jerk transition at speed ``v``."""
@@ -427,6 +433,13 @@ class _StepRule:
                        / self.per_phase, MIN_RELATIVE_STEP * length)
         far = self._cruise(sf, w_est, wb)
         h = np.where(far, np.maximum(h, CRUISE_STEP * length), h)
+        if self.anchors is not None:
+            # Room for MIN_ANCHOR_NODES steps between neighbouring anchors, so that each one
+            # is a node (`nodes_from_steps` skips an anchor closer than that to the last).
+            k = np.clip(np.searchsorted(self.anchors, sf, side="right"), 1,
+                        self.anchors.size - 1)
+            gap = self.anchors[k] - self.anchors[k - 1]
+            h = np.minimum(h, gap / (ANCHOR_ROOM * MIN_ANCHOR_NODES))
         return graded_steps(sf, h, np.where(far, CRUISE_GRADING, GRADING))
 
     def rates(self, sf: FloatArray) -> FloatArray:

@@ -194,3 +194,29 @@ def test_the_lower_bound_is_below_every_feasible_point_multistart_ipopt_finds(co
     assert solution.objective <= best * (1 + 1e-6)  # and the refined point is as good
     # The speed caps are what makes the bound tight: without them it is looser.
     assert loose.lower_bound < solution.lower_bound
+
+
+def test_every_join_of_pieces_is_a_node_and_its_lateral_jerk_is_held_on_both_sides():
+    # Corners of arcs about 1 m long: the bound is v_max all along, so the grid's steps were
+    # cruise steps (~0.7 m) and the joins fewer than MIN_ANCHOR_NODES steps apart were dropped
+    # as nodes; right after an arc→clothoid join the lateral jerk then reached 1.07× (the node
+    # before it held the arc's rate), independently measured by finite differences.
+    from speedplan.model import PlanRequest, build_model
+
+    path = Path.from_waypoints([
+        [0.0, 0.0], [14.311490983543214, -10.571475882666332],
+        [28.58418924559986, -4.732018173742068], [36.34277588437944, 5.511226248196638],
+        [57.489532475393474, 7.4360154180214595]])
+    lim = Limits(v_max=0.8717526339173568, a_max=0.10774250869482635,
+                 a_lat_max=0.775497295997715, j_max=2.8114130185812756,
+                 j_lat_max=0.1794074931077713, yaw_rate_max=0.75634142625756)
+    s = build_model(PlanRequest.create(path, lim)).legs[0].problem.s
+    joins = path.offsets[1:-1]
+    assert np.min(np.abs(s[:, None] - joins[None, :]), axis=0).max() == 0.0
+    profile = plan(path, lim)
+    assert profile.verification.ok
+    t = np.linspace(0.0, profile.duration, 400_001)
+    traj = profile.at(t)
+    a_lat = np.asarray(path.curvature(traj.s)) * traj.v**2
+    j_lat = np.abs(np.diff(a_lat) / (t[1] - t[0]))
+    assert j_lat.max() <= (1.0 + PROMISED["lateral"]) * lim.j_lat_max
