@@ -137,16 +137,26 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
     legs: list[Leg | ForcedLeg] = []
     j_state = request.moving_state_jerk
     # A state read off a plan's final stop lies on the stop's curve up to the law's rounding.
-    touch = TOUCH_ZERO if request.state_jerk is None or j_state > lim.j_max * (
-        1.0 + STATE_JERK_ROUNDING) else max(TOUCH_ZERO, 2.0 * STATE_JERK_ROUNDING)
+    rounded = request.state_jerk is not None and j_state <= lim.j_max * (1.0 + STATE_JERK_ROUNDING)
+    touch = max(TOUCH_ZERO, 4.0 * STATE_JERK_ROUNDING) if rounded else TOUCH_ZERO
     touching = {"touch": touch, "least_duration": length / lim.v_max}
     head = _forced_stop(v0, a0, j_state, end=False, **touching) if request.jerk_limited else None
     tail = _forced_stop(vf, af, j_state, end=True, **touching) if request.jerk_limited else None
     inner_lo, inner_hi = lo, hi
+    # A state read off a plan's final stop lies on the stop's curve to the law's rounding
+    # (a few 1e-5): its own stop, like a³/j², ends a few times that before or past the end.
+    past = 5.0 * STATE_JERK_ROUNDING if rounded else STATE_ROUNDING
     for forced in (head, tail):
-        if forced is not None and length < forced.length <= length * (1.0 + STATE_ROUNDING):
-            # A state on a stop's curve a rounding past the stretch (read off a plan's
-            # final stop): the stop spans the stretch.
+        if forced is not None and forced.length > length * (1.0 + past):
+            state = (f"v0={v0:.6g} m/s, a0={a0:.6g} m/s²" if forced is head
+                     else f"vf={vf:.6g} m/s, af={af:.6g} m/s²")
+            raise InfeasibleError(
+                f"the stretch from s={lo:.6g} m to s={hi:.6g} m is too short for the state "
+                f"{state}: it forces a stop (+j_max until at rest) {forced.length:.6g} m long, "
+                f"and {length:.6g} m are left", constraint="length", s=hi)
+        if forced is not None and abs(forced.length - length) <= past * length:
+            # A state on a stop's curve a rounding before or past the stretch's end: its stop
+            # spans the stretch.
             forced = replace(forced, length=length, s=forced.s * (length / forced.length))
             head, tail = (forced, None) if forced.v0 > 0 else (None, forced)
     if head is not None:

@@ -20,7 +20,7 @@ from ..core.deadline import remaining
 from ..core.errors import SolverError
 from .problem import DiscreteProblem
 
-__all__ = ["IPOPT_OPTIONS", "RefineResult", "refine_ipopt"]
+__all__ = ["IPOPT_MAX_SECONDS", "IPOPT_OPTIONS", "RefineResult", "refine_ipopt"]
 
 #: IPOPT's defaults (monotone barrier update, gradient-based scaling, bound_push 1e-2) with
 #: tolerances tight enough for our acceptance test. Measured on the benchmark corpus (150
@@ -36,6 +36,11 @@ IPOPT_OPTIONS: dict[str, Any] = {
     "acceptable_tol": 1e-8,
     "max_iter": 300,
 }
+#: Longest IPOPT run [s], whatever the plan's time limit. Successful runs take well under a
+#: second on the corpus; a run whose linear solves degenerate (MUMPS reallocating its memory
+#: at every factorisation, seen on a state read off a plan's final stop: 7 s per iteration,
+#: 300 iterations allowed) would otherwise take most of an hour.
+IPOPT_MAX_SECONDS = 5.0
 #: Building the NLP: CasADi's extra functions for parametric sensitivities and multipliers
 #: are not needed and cost more than half of the build at n = 4000.
 NLPSOL_OPTIONS: dict[str, Any] = {"print_time": False, "no_nlp_grad": True, "calc_lam_p": False}
@@ -165,7 +170,8 @@ def refine_ipopt(problem: DiscreteProblem, w0: FloatArray) -> RefineResult:
     nlp = {"x": variables, "f": ca.dot(ca.DM(problem.tau), 1.0 / ca.sqrt(x)), "g": g}
     try:
         left = remaining()  # the plan's deadline (speedplan.core.deadline), if any
-        options = IPOPT_OPTIONS if left is None else {**IPOPT_OPTIONS, "max_wall_time": left}
+        wall = IPOPT_MAX_SECONDS if left is None else min(left, IPOPT_MAX_SECONDS)
+        options = {**IPOPT_OPTIONS, "max_wall_time": wall}
         solver = ca.nlpsol("refine", "ipopt", nlp, {"ipopt": options, **NLPSOL_OPTIONS})
         sol = solver(x0=x0, lbx=lb, ubx=ub, lbg=lbg, ubg=ubg)
     except RuntimeError as exc:

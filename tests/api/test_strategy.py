@@ -230,6 +230,24 @@ def test_states_read_off_a_plan_replan_without_a_warning():
     assert rounded > 0  # the case is exercised
 
 
+def test_states_read_off_a_plans_final_stop_replan_to_rest():
+    # In the final max-jerk stop a state needs a little more jerk than j_max (the law's
+    # rounding), and its stop then ends a hair past the path's end: it spans the stretch
+    # left (it raised an error from deep inside the check, an `s` past the path's end).
+    from speedplan.io import read_path
+
+    u_turn = read_path(os.path.join(os.path.dirname(__file__), "..", "..", "paths", "u_turn.json"))
+    first = sp.plan(u_turn, LGV)
+    for t in np.linspace(first.duration - 1.5, first.duration - 0.02, 25):
+        state = first.at(t)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            again = sp.plan(u_turn.sub(float(state.s[0])), LGV, v0=float(state.v[0]),
+                            a0=float(state.a[0]))
+        assert again.verification.ok, (t, again.verification.summary())
+        assert abs(t + again.duration - first.duration) <= 1e-3 * first.duration, t
+
+
 def _final_stop_jerk(profile: sp.SpeedProfile, seconds: float) -> float:
     """Largest finite-difference jerk over the last ``seconds`` of the profile [m/s³]."""
     dt = 1e-3

@@ -446,3 +446,16 @@ def test_the_compiled_kernels_use_the_numpy_paths_inertia_constants():
     names = ("DELTA_W_FIRST", "DELTA_W_MIN", "DELTA_W_MAX", "KAPPA_W_PLUS_FIRST",
              "KAPPA_W_PLUS", "KAPPA_W_MINUS")
     assert {n: getattr(kernels, n) for n in names} == {n: getattr(banded_nlp, n) for n in names}
+
+
+def test_ipopt_stops_at_its_own_wall_time_without_a_plan_deadline(monkeypatch):
+    # A run whose linear solves degenerate took 7 s per iteration (300 allowed): the fallback
+    # has a wall-time cap of its own, so that no plan waits on it for most of an hour.
+    from speedplan.solve import ipopt_
+
+    n = 400
+    p = DiscreteProblem(s=np.linspace(0.0, 10.0, n), w_max=np.ones(n), accel=np.full(n - 1, 4.0),
+                        decel=np.full(n - 1, 4.0), jerk=np.full(n - 2, 8.0))
+    monkeypatch.setattr(ipopt_, "IPOPT_MAX_SECONDS", 1e-6)
+    res = ipopt_.refine_ipopt(p, np.full(n, 0.5))
+    assert not res.success and "WallTime" in res.status
