@@ -258,3 +258,11 @@ def ruckig_turn(angle, rate_max, acc_max, jerk_max=np.inf):
     traj = Trajectory(1)
     assert otg.calculate(inp, traj) == Result.Working
     return traj.duration
+
+
+def assert_physical(profile, length, lim, **states):
+    """A straight move within the promised tolerances, never faster than ruckig beyond 1e-4."""
+    m = measure(profile, samples=12_000)
+    assert within_promise(m), m
+    assert profile.duration >= ruckig_duration(length, lim, **states) * (1 - 1e-4)
+    assert profile.status in ("optimal", "refined")

@@ -209,21 +209,32 @@ def test_plan_many_survives_a_worker_killed_mid_batch():
     assert all(r.ok for r in results), [repr(r.error) for r in results if not r.ok]
 
 
-def test_states_read_off_a_plan_replan_without_a_warning():
-    # A controller replanning at 10 Hz from its own plan's state: e.g. the U-turn at t = 3 s,
-    # whose state needs 2.6e-5 more jerk than j_max (the law's rounding), warned per cycle.
+def _u_turn_plan() -> tuple[sp.Path, sp.SpeedProfile]:
     from speedplan.io import read_path
 
     u_turn = read_path(os.path.join(os.path.dirname(__file__), "..", "..", "paths", "u_turn.json"))
-    first = sp.plan(u_turn, LGV)
+    return u_turn, sp.plan(u_turn, LGV)
+
+
+def _replanned(path: sp.Path, first: sp.SpeedProfile, t: float) -> sp.SpeedProfile:
+    """The rest of ``path`` planned from ``first``'s state at ``t``: verified, no warning."""
+    state = first.at(t)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        again = sp.plan(path.sub(float(state.s[0])), LGV, v0=float(state.v[0]),
+                        a0=float(state.a[0]))
+    assert again.verification.ok, (t, again.verification.summary())
+    return again
+
+
+def test_states_read_off_a_plan_replan_without_a_warning():
+    # A controller replanning at 10 Hz from its own plan's state: e.g. the U-turn at t = 3 s,
+    # whose state needs 2.6e-5 more jerk than j_max (the law's rounding), warned per cycle.
+
+    u_turn, first = _u_turn_plan()
     rounded = 0
     for t in (*np.linspace(0.25, first.duration - 0.5, 13), 3.0):
-        state = first.at(t)
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            again = sp.plan(u_turn.sub(float(state.s[0])), LGV, v0=float(state.v[0]),
-                            a0=float(state.a[0]))
-        assert again.verification.ok, (t, again.verification.summary())
+        again = _replanned(u_turn, first, t)
         assert t + again.duration >= first.duration * (1 - 1e-4), t
         rounded += any(a.name.endswith("state_rounding") for a in again.attempts
                        if a.outcome == "answered")
@@ -232,19 +243,12 @@ def test_states_read_off_a_plan_replan_without_a_warning():
 
 def test_states_read_off_a_plans_final_stop_replan_to_rest():
     # In the final max-jerk stop a state needs a little more jerk than j_max (the law's
-    # rounding), and its stop then ends a hair past the path's end: it spans the stretch
-    # left (it raised an error from deep inside the check, an `s` past the path's end).
-    from speedplan.io import read_path
-
-    u_turn = read_path(os.path.join(os.path.dirname(__file__), "..", "..", "paths", "u_turn.json"))
-    first = sp.plan(u_turn, LGV)
+    # rounding), and its own stop ends a hair before or past the path's end: that stop spans
+    # the stretch left, rather than leaving a micrometre dip for the relaxation or sampling
+    # the law past the path's end.
+    u_turn, first = _u_turn_plan()
     for t in np.linspace(first.duration - 1.5, first.duration - 0.02, 25):
-        state = first.at(t)
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            again = sp.plan(u_turn.sub(float(state.s[0])), LGV, v0=float(state.v[0]),
-                            a0=float(state.a[0]))
-        assert again.verification.ok, (t, again.verification.summary())
+        again = _replanned(u_turn, first, t)
         assert abs(t + again.duration - first.duration) <= 1e-3 * first.duration, t
 
 

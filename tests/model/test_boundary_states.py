@@ -8,7 +8,7 @@ sampled trajectory (``oracles.measure``).
 from __future__ import annotations
 
 import pytest
-from oracles import PROMISED, measure, ruckig_duration, within_promise
+from oracles import PROMISED, assert_physical, measure
 
 from speedplan import InfeasibleError, Limits, Path, plan
 from speedplan.geometry import Line
@@ -16,14 +16,6 @@ from speedplan.geometry import Line
 
 def _line(length: float) -> Path:
     return Path.from_segments([Line(length)])
-
-
-def _physical(profile, length, lim, **states):
-    """Within the promised tolerances, and never faster than ruckig beyond 1e-4."""
-    m = measure(profile, samples=12_000)
-    assert within_promise(m), m
-    assert profile.duration >= ruckig_duration(length, lim, **states) * (1 - 1e-4)
-    assert profile.status in ("optimal", "refined")
 
 
 @pytest.mark.parametrize(("length", "lim", "states", "named"), [
@@ -63,7 +55,7 @@ def test_unreachable_boundary_states_are_refused_by_name(length, lim, states, na
      {"v0": 0.01885758778079534, "a0": -0.1145144643144487}),
 ])
 def test_feasible_moving_states_meet_physics(length, lim, states):
-    _physical(plan(_line(length), lim, **states), length, lim, **states)
+    assert_physical(plan(_line(length), lim, **states), length, lim, **states)
 
 
 def test_free_standstill_from_a_moving_start_keeps_the_jerk_limit():

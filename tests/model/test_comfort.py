@@ -197,10 +197,10 @@ def test_the_lower_bound_is_below_every_feasible_point_multistart_ipopt_finds(co
 
 
 def test_every_join_of_pieces_is_a_node_and_its_lateral_jerk_is_held_on_both_sides():
-    # Corners of arcs about 1 m long: the bound is v_max all along, so the grid's steps were
-    # cruise steps (~0.7 m) and the joins fewer than MIN_ANCHOR_NODES steps apart were dropped
-    # as nodes; right after an arc→clothoid join the lateral jerk then reached 1.07× (the node
-    # before it held the arc's rate), independently measured by finite differences.
+    # Corners of arcs about 1 m long at v_max: the speed bound is flat, its cruise steps
+    # (~0.7 m) would leave joins fewer than MIN_ANCHOR_NODES steps apart, which cannot be nodes;
+    # right after an arc→clothoid join without a node the lateral jerk reaches 1.07× (the node
+    # before it holds the arc's rate only). Measured here by finite differences in time.
     from speedplan.model import PlanRequest, build_model
 
     path = Path.from_waypoints([

@@ -10,7 +10,7 @@ import warnings
 
 import numpy as np
 import pytest
-from oracles import measure, ruckig_duration, within_promise
+from oracles import assert_physical
 from shared import LGV
 
 import speedplan as sp
@@ -24,14 +24,6 @@ from speedplan.solve.problem import DiscreteProblem
 
 def _line(length: float) -> Path:
     return Path.from_segments([Line(length)])
-
-
-def _physical(profile, length, lim, **states):
-    """Within the promised tolerances, and never faster than ruckig beyond 1e-4."""
-    m = measure(profile, samples=12_000)
-    assert within_promise(m), m
-    assert profile.duration >= ruckig_duration(length, lim, **states) * (1 - 1e-4)
-    assert profile.status in ("optimal", "refined")
 
 
 def _straight(n: int, h: float, w_max: float, a: float, j: float) -> DiscreteProblem:
@@ -104,7 +96,7 @@ def test_a_fine_grid_answers_or_refuses_at_once():
             assert "too fine" in str(exc) and "n <=" in str(exc)
             assert time.perf_counter() - t0 < 30  # refused before any solve, not after one
         else:
-            _physical(profile, 10.0, lgv)
+            assert_physical(profile, 10.0, lgv)
 
 
 def test_a_short_move_with_tiny_jerk_phases_is_answered_by_the_banded_method():
@@ -117,4 +109,4 @@ def test_a_short_move_with_tiny_jerk_phases_is_answered_by_the_banded_method():
     profile = plan(_line(length), lim)
     assert all(leg.solution.relaxation is None or leg.solution.relaxation.fallback is None
                for leg in profile.legs)
-    _physical(profile, length, lim)
+    assert_physical(profile, length, lim)
