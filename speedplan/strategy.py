@@ -426,7 +426,7 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
             if excess(trial_check.verification) > EXCESS_GROWTH * excess(leg_check.verification):
                 # A finer grid the backend solved far less well (seen: 1.1x the jerk limit
                 # became 25x): keep the better law, and stop refining this leg. A moderate
-                # growth is kept: the next round often passes (seen: 1.17x, 1.19x, 1.28x, ok).
+                # growth is kept: a later refinement often passes (seen: 1.17x, 1.19x, 1.28x, ok).
                 record.mark(len(record.entries) - 1, "replaced",
                             f"{_exceeds(trial_check.verification)}, more than the law it "
                             "refined")
