@@ -43,8 +43,6 @@ __all__ = ["FORCED_NODES", "TOUCH_TIME", "TOUCH_ZERO", "build_leg", "build_model
 #: (``v - a²/(2 j)``) of zero comes to rest on the way: the gain of passing through at that
 #: speed is below any resolvable time, and the dip could not be gridded.
 TOUCH_ZERO = 1e-6
-
-
 #: ... or when passing through the dip instead of restarting from rest gains less than this
 #: fraction of the move's least duration (far below the 1e-4 of the optimum plans promise).
 TOUCH_TIME = 1e-6
@@ -136,16 +134,16 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
                 s=None if exc.s is None else lo + exc.s) from exc
     legs: list[Leg | ForcedLeg] = []
     j_state = request.moving_state_jerk
-    # A state read off a plan's final stop lies on the stop's curve up to the law's rounding.
+    # A state read off a plan's final stop (it needs the rounding jerk) lies on the stop's
+    # curve to the law's rounding, a few 1e-5: it touches zero within a few times that, and
+    # its own stop, like a³/j², ends a few times that before or past the stretch's end.
     rounded = request.state_jerk is not None and j_state <= lim.j_max * (1.0 + STATE_JERK_ROUNDING)
     touch = max(TOUCH_ZERO, 4.0 * STATE_JERK_ROUNDING) if rounded else TOUCH_ZERO
+    past = 5.0 * STATE_JERK_ROUNDING if rounded else STATE_ROUNDING
     touching = {"touch": touch, "least_duration": length / lim.v_max}
     head = _forced_stop(v0, a0, j_state, end=False, **touching) if request.jerk_limited else None
     tail = _forced_stop(vf, af, j_state, end=True, **touching) if request.jerk_limited else None
     inner_lo, inner_hi = lo, hi
-    # A state read off a plan's final stop lies on the stop's curve to the law's rounding
-    # (a few 1e-5): its own stop, like a³/j², ends a few times that before or past the end.
-    past = 5.0 * STATE_JERK_ROUNDING if rounded else STATE_ROUNDING
     for forced in (head, tail):
         if forced is not None and forced.length > length * (1.0 + past):
             state = (f"v0={v0:.6g} m/s, a0={a0:.6g} m/s²" if forced is head
