@@ -383,6 +383,12 @@ def adaptive_grid(
     if breakpoints is not None:
         sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
     sf, h = _followed(sf, rule)
+    if rule.anchors is not None and float(np.sum(_count(sf, h))) > max_nodes - 1:
+        # At the node cap the room for every anchor takes nodes from the jerk transitions: the
+        # anchors then become nodes where they fit (a random comfort path of 21 pieces at the
+        # cap: limits exceeded after three refinements with the room, verified after one
+        # without it).
+        sf, h = _followed(sf, replace(rule, anchors=None))
     # The first transitions next to each end (the max-jerk start from rest, a moving state's
     # first change of acceleration) keep their steps when the node cap binds: grown there,
     # the law's jerk at their end breaks its limit, and every finer grid tried after it costs
