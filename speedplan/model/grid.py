@@ -539,11 +539,11 @@ def _capped(sf: FloatArray, h: FloatArray, rate: FloatArray, length: float, max_
         grow_rest = max(1.0, (count - in_ends) / (target - in_ends / grow_ends))
         grown = np.where(ends, kept * grow_ends, np.minimum(kept * grow_rest, h_max))
         kept = graded_steps(sf, grown, rate)
-    for _ in range(4):
+    for _ in range(8):
         count = float(np.sum(_count(sf, h)))
         if count <= budget:
             break
-        h = graded_steps(sf, np.minimum(h * (count / budget), h_max),
+        h = graded_steps(sf, np.minimum(h * (count / (0.995 * budget)), h_max),
                          np.full(sf.size, CRUISE_GRADING))
     return _at_least_min_nodes(sf, h)
 

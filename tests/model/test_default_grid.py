@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from oracles import (
     PROMISED,
     assert_physical,
@@ -31,6 +33,7 @@ from oracles import (
     ruckig_move,
     within_promise,
 )
+from shared import examples
 
 from speedplan import Limits, Path, SpanLimit, SpeedZone, plan
 from speedplan.geometry import Arc, Line, SpeedBound, bound_breakpoints, zone_intervals
@@ -210,3 +213,35 @@ def test_a_grid_at_its_node_cap_keeps_the_first_transitions_at_the_ends_resolved
         assert nodes >= 0.5 * DEFAULT_PER_PHASE
     profile = plan(path, lim)
     assert profile.verification.ok and not profile.limits_exceeded
+
+
+@settings(max_examples=examples(10), deadline=None)
+@given(length=st.floats(0.5, 2_000.0), a_max=st.floats(0.02, 2.0), j_max=st.floats(5.0, 100.0),
+       v_max=st.floats(0.5, 20.0), max_nodes=st.sampled_from([200, 2_000, 20_000]))
+def test_a_capped_default_grid_is_graded_and_keeps_its_end_transitions(length, a_max, j_max,
+                                                                       v_max, max_nodes):
+    # Ten slow-downs along the move (a speed bound dipping to 10 % of v_max²) with jerk phases
+    # of milliseconds: more nodes wanted than the cap allows. The grid stays a grid (from 0
+    # to the length, increasing, about the cap's size: no step grows beyond the cruise step,
+    # so a cap of a few hundred nodes may be exceeded) and, when its end zones fit a quarter
+    # of the cap, keeps their steps.
+    from speedplan.model.grid import END_SHARE, END_ZONE, adaptive_grid, rest_phase_length
+
+    def bound(q):
+        return v_max**2 * (0.55 + 0.45 * np.cos(20.0 * np.pi * np.asarray(q) / length))
+
+    def grid(cap):
+        return adaptive_grid(length, bound, a_max=a_max, a_decel=a_max, v_max=v_max,
+                             j_max=j_max, w_start=0.0, w_end=0.0, max_nodes=cap)
+
+    s = grid(max_nodes)
+    assert s[0] == 0.0 and s[-1] == length and np.all(np.diff(s) > 0)
+    if max_nodes >= 2_000:  # a cap of a few hundred is bounded below by the cruise steps
+        assert s.size <= 1.02 * max_nodes + 5
+    ell = rest_phase_length(a_max, v_max, j_max, length)
+    uncapped = grid(10**7)
+    wanted = int(np.sum(uncapped <= ell))
+    if (uncapped.size > max_nodes and 2.0 * ell <= END_ZONE * length and wanted >= 20
+            and 4 * wanted <= END_SHARE * max_nodes):
+        assert np.sum(s <= ell) >= 0.9 * wanted
+        assert np.sum(s >= length - ell) >= 0.9 * wanted
