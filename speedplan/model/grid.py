@@ -382,20 +382,20 @@ def adaptive_grid(
     sf = _pre_grid(length, rule.floor, inner_anchors)
     if breakpoints is not None:
         sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
-    sf, h = _followed(sf, rule)
+    sf, h, rate = _followed(sf, rule)
     if rule.anchors is not None and float(np.sum(_count(sf, h))) > max_nodes - 1:
         # At the node cap the room for every anchor takes nodes from the jerk transitions: the
         # anchors then become nodes where they fit (a random comfort path of 21 pieces at the
         # cap: limits exceeded after three refinements with the room, verified after one
         # without it).
-        sf, h = _followed(sf, replace(rule, anchors=None))
+        sf, h, rate = _followed(sf, replace(rule, anchors=None))
     # The first transitions next to each end (the max-jerk start from rest, a moving state's
     # first change of acceleration) keep their steps when the node cap binds: grown there,
     # the law's jerk at their end breaks its limit, and every finer grid tried after it costs
     # more than the whole plan. Not on a move made of a few transitions (grown evenly).
     zone = 2.0 * rule.floor if 2.0 * rule.floor <= END_ZONE * length else 0.0
     ends = (sf <= zone) | (sf >= length - zone)
-    h = _capped(sf, h, rule.rates(sf), length, max_nodes, ends)
+    h = _capped(sf, h, rate, length, max_nodes, ends)
     grid = nodes_from_steps(sf, h, inner_anchors if inner_anchors.size else None)
     grid_size("n", grid.size)
     return grid
@@ -425,8 +425,11 @@ class _StepRule:
         out: FloatArray = v * np.minimum(self.t_j, np.sqrt(v / self.j_max))
         return out
 
-    def __call__(self, sf: FloatArray) -> FloatArray:
-        """The graded step on the pre-grid ``sf``."""
+    def __call__(self, sf: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The graded step on the pre-grid ``sf``, and the grading rate it was graded with.
+
+        The rate is `CRUISE_GRADING` in cruise, `GRADING` elsewhere.
+        """
         length = self.length
         wb = self.w_bound(sf)
         w_est = self._no_jerk_w(sf, wb)
@@ -446,14 +449,8 @@ class _StepRule:
                         self.anchors.size - 1)
             gap = self.anchors[k] - self.anchors[k - 1]
             h = np.minimum(h, gap / (ANCHOR_ROOM * MIN_ANCHOR_NODES))
-        return graded_steps(sf, h, np.where(far, CRUISE_GRADING, GRADING))
-
-    def rates(self, sf: FloatArray) -> FloatArray:
-        """The grading rate on ``sf``: `CRUISE_GRADING` in cruise, `GRADING` elsewhere."""
-        wb = self.w_bound(sf)
-        far = self._cruise(sf, self._no_jerk_w(sf, wb), wb)
-        out: FloatArray = np.where(far, CRUISE_GRADING, GRADING)
-        return out
+        rate: FloatArray = np.where(far, CRUISE_GRADING, GRADING)
+        return graded_steps(sf, h, rate), rate
 
     def _no_jerk_w(self, sf: FloatArray, wb: FloatArray) -> FloatArray:
         hf = np.diff(sf)  # the exact no-jerk optimum at twice the limits (speedplan.solve.nojerk)
@@ -491,9 +488,13 @@ def _pre_grid(length: float, floor: float, anchors: FloatArray) -> FloatArray:
     return out
 
 
-def _followed(sf: FloatArray, rule: _StepRule) -> tuple[FloatArray, FloatArray]:
-    """The pre-grid refined where its cells are too coarse to follow the steps, and the steps."""
-    h = rule(sf)
+def _followed(sf: FloatArray, rule: _StepRule
+              ) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The pre-grid refined where its cells are too coarse to follow the steps.
+
+    Returns the pre-grid, the steps on it and their grading rate (`_StepRule`).
+    """
+    h, rate = rule(sf)
     for _ in range(3):
         cell = np.diff(sf)
         need = np.ceil(cell / (2.0 * np.minimum(h[:-1], h[1:]))).astype(np.int64)
@@ -503,8 +504,8 @@ def _followed(sf: FloatArray, rule: _StepRule) -> tuple[FloatArray, FloatArray]:
         extra = [sf[k] + cell[k] * np.arange(1, min(int(need[k]), 64)) / min(int(need[k]), 64)
                  for k in coarse]
         sf = np.unique(np.concatenate([sf, *extra]))
-        h = rule(sf)
-    return sf, h
+        h, rate = rule(sf)
+    return sf, h, rate
 
 
 def _count(sf: FloatArray, h: FloatArray) -> FloatArray:

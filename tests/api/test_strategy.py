@@ -13,6 +13,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
+from oracles import measure, within_promise
 from shared import LGV
 
 import speedplan as sp
@@ -224,6 +225,7 @@ def _replanned(path: sp.Path, first: sp.SpeedProfile, t: float) -> sp.SpeedProfi
         again = sp.plan(path.sub(float(state.s[0])), LGV, v0=float(state.v[0]),
                         a0=float(state.a[0]))
     assert again.verification.ok, (t, again.verification.summary())
+    assert within_promise(measure(again, samples=3_000)), t  # finite differences in time
     return again
 
 
