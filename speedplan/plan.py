@@ -151,9 +151,13 @@ def plan(
     >>> bool(traj.v.max() <= 2.0 * 1.001)
     True
 
-    Which attempt of the strategy answered:
+    Which attempt of the strategy answered: a straight move between states at rest is
+    planned in closed form (its exact optimum, no grid), a curved one on the default grid:
 
     >>> [(a.name, a.outcome) for a in prof.attempts]
+    [('model', 'answered'), ('closed_form', 'answered')]
+    >>> corner = Path.from_waypoints([[0, 0], [30, 0], [30, 10]])
+    >>> [(a.name, a.outcome) for a in plan(corner, Limits(2, 1, 1, 0.5)).attempts]
     [('model', 'answered'), ('default_grid', 'answered')]
     """
     budget = Budget.of(time_limit)

@@ -11,7 +11,8 @@ only when the ones before it did not answer:
   ``"jerk_slack"`` and ``"exact_reach_jerk_slack"`` with ``j_max (1 + STATE_JERK_SLACK)``,
   for moving states just outside what ``j_max`` reaches (with a
   [`SpeedplanWarning`][speedplan.SpeedplanWarning]).
-* **solve** (per leg): ``"forced_motion"`` for a leg with no freedom left; ``"given_grid"``
+* **solve** (per leg): ``"forced_motion"`` for a leg with no freedom left; ``"closed_form"``
+  for a straight leg whose minimum-time motion is known exactly (`StraightLeg`); ``"given_grid"``
   for the caller's grid (``n`` or ``ds``: both relaxation backends, never another grid);
   otherwise ``"default_grid"`` with the request's backend, then ``"coarser_grid_1/2"``,
   ``"coarser_grid_1/4"``, ``"coarser_grid_1/8"`` (`COARSER_GRIDS`) with it, then
@@ -51,14 +52,22 @@ from .core.errors import (
     SpeedplanWarning,
 )
 from .core.options import RelaxationBackend
-from .model import ForcedLeg, Leg, Model, PlanRequest, build_model
+from .model import ForcedLeg, Leg, Model, PlanRequest, StraightLeg, build_model
 from .model.boundary import STATE_JERK_ROUNDING, STATE_JERK_SLACK, state_jerk
 from .model.build import leg_on_grid
 from .model.grid import MIN_NODES, refined_grid
 from .model.leg_grid import default_grid
 from .model.legs import explain_infeasible
 from .solve import DiscreteSolution, solve_problem
-from .timing import TOLERANCES, LegResult, SpeedProfile, Verification, law_for
+from .timing import (
+    TOLERANCES,
+    LegResult,
+    MotionLaw,
+    SpeedLaw,
+    SpeedProfile,
+    Verification,
+    law_for,
+)
 
 __all__ = ["ATTEMPTS", "COARSER_GRIDS", "EXCESS_GROWTH", "MAX_REFINEMENTS", "REFINE_FACTORS",
            "STATE_CONSTRAINTS", "Budget", "Record", "coarsenable", "coarser_leg", "excess",
@@ -83,7 +92,7 @@ COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
 ATTEMPTS: tuple[str, ...] = (
     "model", "exact_reach", "state_rounding", "exact_reach_state_rounding", "jerk_slack",
     "exact_reach_jerk_slack",
-    "forced_motion", "given_grid", "default_grid",
+    "forced_motion", "closed_form", "given_grid", "default_grid",
     *(f"coarser_grid_1/{round(1 / f)}" for f in COARSER_GRIDS),
     "other_backend", "local_refinement", "default_grid_other_backend",
 )
@@ -198,12 +207,12 @@ def coarser_leg(request: PlanRequest, leg: Leg, factor: float) -> Leg | None:
     --------
     >>> from speedplan import Limits, Path
     >>> from speedplan.model import PlanRequest, build_model
-    >>> path = Path.from_waypoints([[0, 0], [30, 0]], kind="polyline")
+    >>> path = Path.from_waypoints([[0, 0], [30, 0], [30, 10]])
     >>> model = build_model(PlanRequest.create(path, Limits(2, 1, 1, 0.5)))
     >>> leg = model.legs[0]
     >>> from speedplan.strategy import coarser_leg
     >>> half = coarser_leg(model.request, leg, 0.5)
-    >>> bool(half.problem.n <= leg.problem.n // 2 + 1), bool(half.problem.s[-1] == 30.0)
+    >>> bool(half.problem.n <= leg.problem.n // 2 + 1), bool(half.problem.s[-1] == leg.length)
     (True, True)
     """
     if not coarsenable(request, leg):
@@ -284,22 +293,17 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
 
 
 # ---- solve ----------------------------------------------------------------------------------
-def solve_leg(leg: Leg | ForcedLeg, *, fallback: bool = True) -> LegResult:
+def solve_leg(leg: Leg | ForcedLeg | StraightLeg, *, fallback: bool = True) -> LegResult:
     """Solve one leg and build its law; an infeasibility is restated in metres.
 
     ``fallback``: whether a failed relaxation backend is retried with the other one
-    (`solve_problem`).
+    (`solve_problem`). A `ForcedLeg` or a `StraightLeg` carries its motion: only its law
+    is built.
     """
     if isinstance(leg, ForcedLeg):
-        t0 = time.perf_counter()
-        law = law_for(leg.s, leg.w, leg.time_law)
-        duration = law.duration
-        solution = DiscreteSolution(
-            w=leg.w, objective=duration, lower_bound=duration, gap=0.0, exact=True,
-            exact_a_priori=True, jerk_violation=0.0, refined=False, status="optimal",
-            solve_time=time.perf_counter() - t0, backend="forced",
-        )
-        return LegResult(start=leg.start, s=leg.s, solution=solution, law=law)
+        return _known_motion(leg.start, law_for(leg.s, leg.w, leg.time_law), "forced")
+    if isinstance(leg, StraightLeg):
+        return _known_motion(leg.start, MotionLaw(leg.motion), "closed_form")
     try:
         solution = solve_problem(leg.problem, refine=leg.refine, backend=leg.backend,
                                  fallback=fallback)
@@ -313,6 +317,17 @@ def solve_leg(leg: Leg | ForcedLeg, *, fallback: bool = True) -> LegResult:
     return LegResult(start=leg.start, s=leg.problem.s, solution=solution, law=law)
 
 
+def _known_motion(start: float, law: SpeedLaw, backend: str) -> LegResult:
+    """The result of a leg whose motion is known exactly: its optimum, certified as such."""
+    duration = law.duration
+    solution = DiscreteSolution(
+        w=law.w, objective=duration, lower_bound=duration, gap=0.0, exact=True,
+        exact_a_priori=True, jerk_violation=0.0, refined=False, status="optimal",
+        solve_time=0.0, backend=backend,
+    )
+    return LegResult(start=start, s=law.s, solution=solution, law=law)
+
+
 def solve_legs(request: PlanRequest, model: Model, record: Record
                ) -> tuple[list[LegResult], list[bool]]:
     """Every leg's first answer, and whether it came from a coarser grid (see the module)."""
@@ -324,8 +339,8 @@ def solve_legs(request: PlanRequest, model: Model, record: Record
     return results, coarsened
 
 
-def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg, i: int, record: Record
-                  ) -> tuple[LegResult, bool]:
+def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg | StraightLeg, i: int,
+                  record: Record) -> tuple[LegResult, bool]:
     """The first of the leg's solve attempts that answers.
 
     Measured on slow-zone paths (``benchmarks/fuzz_zones.py``): both interior-point methods
@@ -337,6 +352,8 @@ def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg, i: int, record: Re
     """
     if isinstance(leg, ForcedLeg):
         return record.attempt("forced_motion", i, lambda: solve_leg(leg)), False
+    if isinstance(leg, StraightLeg):
+        return record.attempt("closed_form", i, lambda: solve_leg(leg)), False
     if not coarsenable(request, leg):
         return record.attempt("given_grid" if request.n is not None or request.ds is not None
                               else "default_grid", i, lambda: solve_leg(leg)), False

@@ -76,6 +76,11 @@ class Measured:
     jerk: float
     lateral: float
     samples: int
+    #: What a rounding of the sampled speeds and times by a few ulps adds to the acceleration
+    #: and jerk ratios (first and second differences over the shortest step): the finite
+    #: differences of an exact trajectory stay within ``1 + rounding``.
+    accel_rounding: float = 0.0
+    jerk_rounding: float = 0.0
 
 
 def measure(profile, samples=20_000):
@@ -93,7 +98,8 @@ def measure(profile, samples=20_000):
     t1 = min(T, 3.0 * (max(lim.a_max, lim.a_decel) / lim.j_max + lim.v_max / min(lim.a_max,
                                                                                lim.a_decel)))
     per = max(samples // 3, 10)
-    worst = {"speed": 0.0, "accel": 0.0, "decel": 0.0, "jerk": 0.0, "lateral": 0.0}
+    worst = {"speed": 0.0, "accel": 0.0, "decel": 0.0, "jerk": 0.0, "lateral": 0.0,
+             "accel_rounding": 0.0, "jerk_rounding": 0.0}
     count = 0
     for lo, hi in ((0.0, t1), (max(T - t1, 0.0), T), (0.0, T)):
         t = np.linspace(lo, hi, per)
@@ -121,6 +127,12 @@ def measure(profile, samples=20_000):
         worst["jerk"] = max(worst["jerk"], float(np.abs(j_fd).max() / lim.j_max))
         if np.isfinite(lim.a_lat_max):
             worst["lateral"] = max(worst["lateral"], float(lateral.max() / lim.a_lat_max))
+        # A few ulps of each speed, and of each sample time (times the acceleration).
+        ulps = 4.0 * np.finfo(float).eps * (float(np.abs(v).max())
+                                            + max(lim.a_max, lim.a_decel) * hi)
+        worst["accel_rounding"] = max(worst["accel_rounding"],
+                                      2.0 * ulps / dt / min(lim.a_max, lim.a_decel))
+        worst["jerk_rounding"] = max(worst["jerk_rounding"], 4.0 * ulps / dt**2 / lim.j_max)
         count += t.size
     return Measured(samples=count, **worst)
 

@@ -15,7 +15,7 @@ from .pieces import CurvePiece
 if TYPE_CHECKING:  # scipy.interpolate costs ~0.2 s to import: only NURBS edges need it
     from scipy.interpolate import BSpline
 
-__all__ = ["NurbsCurve", "nurbs_piece"]
+__all__ = ["NurbsCurve", "nurbs_piece", "straight_chord"]
 
 #: Positions closer than this fraction of the control polygon's extent count as equal (end
 #: points against control points, the two sides of a repeated knot).
@@ -104,6 +104,36 @@ class NurbsCurve:
         h2 = self._homogeneous(tau, 2)
         out: FloatArray = (h2[:, :2] - 2.0 * r1 * h1[:, 2:3] - r * h2[:, 2:3]) / wt
         return out
+
+
+def straight_chord(control_points: FloatArray) -> tuple[tuple[float, float], float, float] | None:
+    """``(start, heading, length)`` of the segment a NURBS traces, if it is one; else ``None``.
+
+    A curve from its first to its last control point whose control points all lie on the
+    segment between them (within ``1e-9`` of its length), in order along it, is that segment
+    traced once (rational B-splines with positive weights diminish variation: the position
+    along the segment never turns back).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> start, heading, length = straight_chord(np.array([[0.0, 0.0], [1.5, 2.0], [3.0, 4.0]]))
+    >>> start, round(heading, 12), length
+    ((0.0, 0.0), 0.927295218002, 5.0)
+    >>> straight_chord(np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]])) is None
+    True
+    """
+    first, last = control_points[0], control_points[-1]
+    length = float(np.hypot(*(last - first)))
+    if not length > 0:
+        return None
+    unit = (last - first) / length
+    rel = control_points - first
+    along = rel @ unit
+    across = rel @ np.array([-unit[1], unit[0]])
+    if np.abs(across).max() > 1e-9 * length or (np.diff(along) < 0).any():
+        return None
+    return (float(first[0]), float(first[1])), float(np.arctan2(unit[1], unit[0])), length
 
 
 def nurbs_piece(degree: Any, knots: Any, control_points: Any, weights: Any = None) -> CurvePiece:

@@ -476,6 +476,24 @@ class Path:
                 out.append(SubPiece(piece, cut_lo - a, cut_hi - cut_lo))
         return Path(tuple(out))
 
+    def straight_between(self, lo: float, hi: float) -> bool:
+        """Whether the stretch ``[lo, hi]`` [m] is straight: every piece it crosses is a line.
+
+        Pieces that only touch the stretch at one end do not count. Lines driven in reverse
+        count as straight (the stretch of a path between two cusps).
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Arc, Line, Path
+        >>> p = Path.from_segments([Line(2.0), Arc(radius=1.0, angle=1.0), Line(1.0)])
+        >>> p.straight_between(0.0, 2.0), p.straight_between(1.0, 2.5), p.straight_between(3.0, 4.0)
+        (True, False, True)
+        """
+        ends = self.offsets
+        crossed = (ends[1:] > lo) & (ends[:-1] < hi)
+        return all(piece.straight for piece, hit in zip(self.pieces, crossed, strict=True)
+                   if hit)
+
     def evaluate(self, s: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``(point, heading, curvature)`` at arc lengths ``s`` in one pass.
 
@@ -744,10 +762,21 @@ class Path:
         >>> p = Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[0, 0], [1, 1], [2, 0]])
         >>> p.point([0.0, p.length]).round(12).tolist(), round(p.length, 9)
         ([[0.0, 0.0], [2.0, 0.0]], 2.295587149)
-        """
-        from .nurbs import nurbs_piece
 
-        return cls((nurbs_piece(degree, knots, control_points, weights),))
+        A NURBS whose control points lie in order on the segment between its ends is that
+        segment (VDA 5050 3.0 gives straight edges as two control points): a line.
+
+        >>> Path.from_nurbs(1, [0, 0, 1, 1], [[0, 0], [3, 4]]).straight_between(0.0, 5.0)
+        True
+        """
+        from .nurbs import nurbs_piece, straight_chord
+
+        piece = nurbs_piece(degree, knots, control_points, weights)
+        chord = straight_chord(np.asarray(control_points, dtype=np.float64))
+        if chord is not None:  # the same points, in the same order: exactly a line
+            start, heading, length = chord
+            return cls.from_segments([Line(length)], start=start, heading=heading)
+        return cls((piece,))
 
     @classmethod
     def from_linestring(cls, ls: LineString, kind: str = "g2", *,

@@ -153,6 +153,15 @@ class Piece:
         """``(point, heading, curvature)`` at once (pieces share work where they can)."""
         return self.point(u), self.heading(u), self.curvature(u)
 
+    @property
+    def straight(self) -> bool:
+        """Whether the curvature is exactly 0 along the whole piece (a line).
+
+        ``False`` unless the piece's own formula says so (a spline or NURBS piece that
+        happens to be straight is not recognised).
+        """
+        return False
+
     def reversed(self, swap_direction: bool = False) -> Piece:
         """The piece travelled from its end to its start.
 
@@ -597,6 +606,11 @@ class ReversedPiece(Piece):
         """``d(-κ(L - u))/du = κ'(L - u)`` [1/m²]."""
         return self.piece.curvature_rate(self._mirror(u))
 
+    @property
+    def straight(self) -> bool:
+        """Whether the underlying piece is a line."""
+        return self.piece.straight
+
     def reversed(self, swap_direction: bool = False) -> Piece:
         """The original piece when reversed the same way; otherwise a nested reversal."""
         if swap_direction == self.swap_direction:
@@ -621,6 +635,11 @@ class SubPiece(Piece):
     def direction(self) -> int:  # type: ignore[override]
         """Direction of travel of the underlying piece."""
         return self.piece.direction
+
+    @property
+    def straight(self) -> bool:
+        """Whether the underlying piece is a line."""
+        return self.piece.straight
 
     def _shift(self, u: FloatArray) -> FloatArray:
         out: FloatArray = self.lo + np.clip(np.asarray(u, dtype=np.float64), 0.0,

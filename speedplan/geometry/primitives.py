@@ -238,6 +238,11 @@ class ClothoidPiece(Piece):
         """The sharpness ``(k1 - k0) / length`` [1/m²], constant along the piece."""
         return np.full(np.shape(u), (self.k1 - self.k0) / self.length)
 
+    @property
+    def straight(self) -> bool:
+        """Whether the piece is a line (``k0 = k1 = 0``)."""
+        return self.k0 == 0.0 and self.k1 == 0.0
+
     def _integrate(self, a: FloatArray, b: FloatArray) -> FloatArray:
         """Displacements from ``a`` to ``b`` (direction of travel included)."""
         width = (b - a)[:, None] * self.direction

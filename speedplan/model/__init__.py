@@ -11,7 +11,10 @@ Modules, one job each:
 * `leg_grid` — the grid of one leg, as the request asks for it (user, default, no-jerk);
 * `rows` — node bounds, boundary envelopes, lateral-jerk rows and the speed caps they imply;
 * `standstill` — jerk rows next to a standstill;
-* `legs` — the data of a model: `Leg`, `ForcedLeg`, `Rest`, `TimeLawSpec`, `Model`, and
+* `straight` — straight legs with a constant speed bound: their exact minimum-time motion in
+  closed form (no grid);
+* `legs` — the data of a model: `Leg`, `ForcedLeg`, `StraightLeg`, `Rest`, `TimeLawSpec`,
+  `Model`, and
   `explain_infeasible`, which restates a leg's infeasibility in physical terms;
 * `build` — `build_model`: request -> `Model`. The problems are solved by
   `speedplan.strategy`; nothing here calls a solver.
@@ -20,8 +23,8 @@ This layer imports ``core``, ``geometry`` and the data of ``solve`` (`speedplan.
 """
 
 from .build import build_model, rest_points
-from .legs import ForcedLeg, Leg, Model, Rest, TimeLawSpec
+from .legs import ForcedLeg, Leg, Model, Rest, StraightLeg, TimeLawSpec
 from .request import STANDSTILL_MODES, PlanRequest
 
-__all__ = ["STANDSTILL_MODES", "ForcedLeg", "Leg", "Model", "PlanRequest", "Rest", "TimeLawSpec",
-           "build_model", "rest_points"]
+__all__ = ["STANDSTILL_MODES", "ForcedLeg", "Leg", "Model", "PlanRequest", "Rest", "StraightLeg",
+           "TimeLawSpec", "build_model", "rest_points"]

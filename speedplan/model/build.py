@@ -4,8 +4,10 @@
 [`DiscreteProblem`][speedplan.DiscreteProblem]. A request is split into *legs* at every point
 where the vehicle must be at rest: where a boundary state forces a stop on the way (a
 decelerating start whose speed falls exactly to zero: the motion to that point is forced, a
-`ForcedLeg`), and — with the route and cusp support — at cusps and stops. Each `Leg` gets its
-grid (`speedplan.model.leg_grid`), its node bounds, envelopes and lateral rows
+`ForcedLeg`), and — with the route and cusp support — at cusps and stops. A straight stretch
+with a constant speed bound between states at zero acceleration is a `StraightLeg`: its
+minimum-time motion is known in closed form (`speedplan.model.straight`). Every other `Leg`
+gets its grid (`speedplan.model.leg_grid`), its node bounds, envelopes and lateral rows
 (`speedplan.model.rows`) and is planned on its own by `speedplan.strategy`. This layer builds
 data and calls no solver.
 """
@@ -24,7 +26,7 @@ from ..solve.problem import MAX_RAMP_STEPS, DiscreteProblem, ramp_steps
 from .boundary import STATE_JERK_ROUNDING, check_reachable_states, turnaround_speed
 from .grid import MIN_NODES
 from .leg_grid import default_grid, grid_anchors, leg_grid
-from .legs import ForcedLeg, Leg, Model, Rest, TimeLawSpec
+from .legs import ForcedLeg, Leg, Model, Rest, StraightLeg, TimeLawSpec
 from .request import STATE_ROUNDING, PlanRequest, within_limit
 from .rows import (
     Envelopes,
@@ -35,9 +37,10 @@ from .rows import (
     node_bounds,
 )
 from .standstill import calibrate_standstill_rows
+from .straight import constant_bound, straight_applies, straight_motion
 
 __all__ = ["FORCED_NODES", "TOUCH_TIME", "TOUCH_ZERO", "build_leg", "build_model",
-           "leg_on_grid", "rest_points"]
+           "leg_on_grid", "rest_points", "straight_leg"]
 
 #: A decelerating boundary state whose speed falls to within this fraction of its own speed
 #: (``v - a²/(2 j)``) of zero comes to rest on the way: the gain of passing through at that
@@ -99,7 +102,7 @@ def build_model(request: PlanRequest) -> Model:
     request = _end_speeds(request, bound, length)
     rests = rest_points(request)
     cuts = [0.0, *(r.s for r in rests), length]
-    legs: list[Leg | ForcedLeg] = []
+    legs: list[Leg | ForcedLeg | StraightLeg] = []
     for j in range(len(cuts) - 1):
         first, last = j == 0, j == len(cuts) - 2
         legs += _stretch_legs(
@@ -113,7 +116,7 @@ def build_model(request: PlanRequest) -> Model:
 
 def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
                   start: tuple[float, float], end: tuple[float, float], rest_before: Rest | None,
-                  rest_after: Rest | None) -> list[Leg | ForcedLeg]:
+                  rest_after: Rest | None) -> list[Leg | ForcedLeg | StraightLeg]:
     """The legs of the stretch ``[lo, hi]`` between two cuts (the path's ends or rests)."""
     lim = request.limits
     (v0, a0), (vf, af) = start, end
@@ -132,7 +135,7 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
                 f"between s={lo:.6g} m and s={hi:.6g} m ({ends}, where the vehicle must be at "
                 f"rest): {exc}", constraint=exc.constraint,
                 s=None if exc.s is None else lo + exc.s) from exc
-    legs: list[Leg | ForcedLeg] = []
+    legs: list[Leg | ForcedLeg | StraightLeg] = []
     j_state = request.moving_state_jerk
     # A state read off a plan's final stop (it needs the rounding jerk) lies on the stop's
     # curve to the law's rounding, a few 1e-5: it touches zero within a few times that, and
@@ -163,7 +166,8 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
     if tail is not None:
         inner_hi, vf, af = hi - tail.length, 0.0, 0.0
     if inner_hi - inner_lo > 1e-12 * length:
-        legs.append(build_leg(request, bound, inner_lo, inner_hi, v0, a0, vf, af))
+        legs.append(straight_leg(request, bound, inner_lo, inner_hi, v0, a0, vf, af)
+                    or build_leg(request, bound, inner_lo, inner_hi, v0, a0, vf, af))
     elif head is not None and tail is not None:
         raise InfeasibleError(
             "the path is too short: both boundary states force a stop and the two stops "
@@ -171,6 +175,26 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
     if tail is not None:
         legs.append(_shifted(tail, hi - tail.length))
     return legs
+
+
+def straight_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0: float,
+                 a0: float, vf: float, af: float) -> StraightLeg | None:
+    """The stretch ``[lo, hi]`` as a `StraightLeg` (its motion in closed form), or ``None``.
+
+    ``None`` where the closed form does not apply (`straight_applies`, `constant_bound`)
+    or no double-S move joins the states (`straight_motion`): the leg is then built on a grid.
+    """
+    if not straight_applies(request, lo, hi, a0, af):
+        return None
+    top = constant_bound(bound, lo, hi)
+    if top is None:
+        return None
+    lim = request.limits
+    motion = straight_motion(hi - lo, v0, vf, float(np.sqrt(top)), lim.a_max, lim.a_decel,
+                             lim.j_max)
+    if motion is None:
+        return None
+    return StraightLeg(start=lo, length=hi - lo, v0=v0, a0=a0, vf=vf, af=af, motion=motion)
 
 
 def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0: float,

@@ -1,8 +1,9 @@
 """What a model is made of: legs between standstills, their time-law options, the rests.
 
 Pure data: `speedplan.model.build` fills them from a request, `speedplan.strategy` solves each
-`Leg`'s problem, and `explain_infeasible` restates a discrete infeasibility of a leg's problem
-in speeds and metres along the path.
+`Leg`'s problem (a `ForcedLeg` or a `StraightLeg` carries its motion already), and
+`explain_infeasible` restates a discrete infeasibility of a leg's problem in speeds and metres
+along the path.
 """
 
 from __future__ import annotations
@@ -18,8 +19,10 @@ from ..core.options import Backend, Refine, RestReason
 from ..geometry import SpeedBound
 from ..solve.problem import DiscreteProblem
 from .request import PlanRequest
+from .straight import JerkPhases
 
-__all__ = ["ForcedLeg", "Leg", "Model", "Rest", "TimeLawSpec", "explain_infeasible"]
+__all__ = ["ForcedLeg", "Leg", "Model", "Rest", "StraightLeg", "TimeLawSpec",
+           "explain_infeasible"]
 
 @dataclass(frozen=True)
 class TimeLawSpec:
@@ -123,6 +126,23 @@ class ForcedLeg(_Ends):
 
 
 @dataclass(frozen=True)
+class StraightLeg(_Ends):
+    """A straight leg planned in closed form: its minimum-time motion is known exactly.
+
+    A straight stretch with a constant speed bound between states at zero acceleration
+    (`speedplan.model.straight`); ``start``, ``length`` and the boundary states are those of
+    `Leg`.
+
+    Attributes
+    ----------
+    motion : JerkPhases
+        The minimum-time motion (positions from the leg's start).
+    """
+
+    motion: JerkPhases
+
+
+@dataclass(frozen=True)
 class Model:
     """A request modelled as legs between standstills.
 
@@ -132,7 +152,7 @@ class Model:
         What was asked.
     bound : SpeedBound
         ``s -> mu+(s)`` [m²/s²] along the whole path.
-    legs : tuple of Leg or ForcedLeg
+    legs : tuple of Leg, ForcedLeg or StraightLeg
         In order; consecutive legs meet at rest.
     rests : tuple of Rest
         The points inside the path where the vehicle stops, in order.
@@ -140,7 +160,7 @@ class Model:
 
     request: PlanRequest
     bound: SpeedBound
-    legs: tuple[Leg | ForcedLeg, ...] = field(default_factory=tuple)
+    legs: tuple[Leg | ForcedLeg | StraightLeg, ...] = field(default_factory=tuple)
     rests: tuple[Rest, ...] = ()
 
 

@@ -16,7 +16,6 @@ from ..core.numerics import wrap_angle
 from ..core.options import JsonObject
 from ..geometry import Path
 from ..geometry.corners import CUSP_ANGLE, g2_chain
-from ..geometry.primitives import ClothoidPiece
 from . import _checks
 from ._checks import integer, string
 from .elements import THETA_TOLERANCE, RouteEdge, RouteNode
@@ -37,11 +36,7 @@ def _heading_change(incoming: Path, outgoing: Path) -> float:
 
 def _is_straight(path: Path) -> bool:
     """Whether ``path`` is one straight piece driven forward (an edge between node positions)."""
-    if len(path.pieces) != 1:
-        return False
-    piece = path.pieces[0]
-    return isinstance(piece, ClothoidPiece) and piece.k0 == 0.0 and piece.k1 == 0.0 \
-        and piece.direction == 1
+    return len(path.pieces) == 1 and path.pieces[0].straight and path.pieces[0].direction == 1
 
 
 def _turn(before: RouteEdge, after: RouteEdge) -> float:

@@ -58,7 +58,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -66,7 +66,56 @@ from ..core.checks import FloatArray, IntArray
 from ..core.errors import InvalidInputError
 from ._law_numpy import backend
 
-__all__ = ["STANDSTILL_EXPONENT", "Extreme", "LawChain", "PieceExtremes", "TimeLaw"]
+__all__ = ["STANDSTILL_EXPONENT", "Extreme", "LawChain", "PieceExtremes", "SpeedLaw", "TimeLaw"]
+
+class SpeedLaw(Protocol):
+    """What a profile and its checks use of a leg's law: `TimeLaw`, or a motion known in time.
+
+    Nodes ``s`` [m] with their ``w`` [m²/s²] and ``node_times`` [s]; pieces between ``knots``
+    with exact extremes (`TimeLaw.extremes`); kinematics at arc lengths; times and states.
+    """
+
+    @property
+    def s(self) -> FloatArray:
+        """Arc length of the nodes [m]."""
+
+    @property
+    def w(self) -> FloatArray:
+        """Squared speed at the nodes [m²/s²]."""
+
+    @property
+    def knots(self) -> FloatArray:
+        """Ends of the pieces [m]."""
+
+    @property
+    def node_times(self) -> FloatArray:
+        """Times at the nodes [s]."""
+
+    @property
+    def length(self) -> float:
+        """Path length covered [m]."""
+
+    @property
+    def duration(self) -> float:
+        """Total travel time [s]."""
+
+    def extremes(self) -> PieceExtremes:
+        """Exact extremes of ``w``, ``a`` and the jerk over each piece."""
+
+    def kinematics(self, q: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``w, v, a, jerk`` at arc lengths ``q``."""
+
+    def _kinematics(self, j: IntArray, dx: FloatArray, dr: FloatArray
+                    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``w, v, a, jerk`` on pieces ``j`` at offsets ``dx`` (from the left), ``dr``."""
+
+    def time_at(self, q: FloatArray) -> FloatArray:
+        """Time at arc lengths ``q`` [s]."""
+
+    def state_at(self, t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray,
+                                                FloatArray]:
+        """``s, w, v, a, jerk`` at times ``t``."""
+
 
 #: Exponent ``p`` of ``u = w^p`` on standstill regions: ``w ∝ s^{4/3}`` makes ``u`` linear.
 STANDSTILL_EXPONENT = 0.75
@@ -740,7 +789,7 @@ class LawChain:
     (2.0, [1.0])
     """
 
-    laws: tuple[TimeLaw, ...]
+    laws: tuple[SpeedLaw, ...]
     offsets: FloatArray
 
     @cached_property

@@ -19,7 +19,7 @@ from ..core.forward import Forwarded
 from ..core.limits import Limits
 from ..solve.solution import STATUSES as SOLUTION_STATUSES
 from ..solve.solution import DiscreteSolution
-from .law import LawChain, TimeLaw
+from .law import LawChain, SpeedLaw, TimeLaw
 from .trajectory import Trajectory
 from .verify import LegCheck, Verification, bound_breakpoints, check_law, curvature_rate
 
@@ -59,8 +59,8 @@ class LegResult:
         The leg's grid, from 0 [m].
     solution : DiscreteSolution
         Its discrete solve (a forced leg has ``backend == "forced"``).
-    law : TimeLaw
-        Its continuous law.
+    law : SpeedLaw
+        Its continuous law (a `TimeLaw`, or a `MotionLaw` for a motion known in closed form).
     check : LegCheck or None
         Its verification.
     """
@@ -68,7 +68,7 @@ class LegResult:
     start: float
     s: FloatArray
     solution: DiscreteSolution
-    law: TimeLaw
+    law: SpeedLaw
     check: LegCheck | None = None
 
 

@@ -26,7 +26,7 @@ from ..core.forward import Forwarded
 from ..core.limits import Limits
 from ..geometry import Path, SpeedBound
 from ..geometry.bounds import bound_breakpoints
-from .law import PieceExtremes, TimeLaw
+from .law import PieceExtremes, SpeedLaw
 
 __all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "LimitCheck",
            "Verification", "bound_breakpoints", "check_law", "curvature_rate"]
@@ -301,7 +301,7 @@ class _Samples:
     break_pieces: IntArray  # the piece(s) each breakpoint counts for
 
 
-def _law_samples(law: TimeLaw, top: FloatArray, local: FloatArray) -> _Samples:
+def _law_samples(law: SpeedLaw, top: FloatArray, local: FloatArray) -> _Samples:
     """The law at its samples, and where they lie (see `_Samples`).
 
     Each piece's `SAMPLES_PER_PIECE` points, its speed maximum ``top``, and the
@@ -418,7 +418,7 @@ def _piece_checks(ex: PieceExtremes, knots: FloatArray, offset: float, limits: L
     return out
 
 
-def check_law(law: TimeLaw, offset: float, path: Path,
+def check_law(law: SpeedLaw, offset: float, path: Path,
               bound: Callable[[FloatArray], FloatArray], limits: Limits,
               breaks: FloatArray | None = None) -> LegCheck:
     """Check the law of one leg that covers ``[offset, offset + law.length]`` of ``path``.

@@ -135,13 +135,14 @@ def test_stdin_path_and_stdout_trajectory(root):
 
 
 def test_strict_exits_5_on_any_verify_failure(tmp_path):
-    # 27 km with 0.2 um jerk phases, below the finest step a grid resolves: the jerk at the
-    # ends exceeds its tolerance (the trust fuzz's case; plan() flags it).
+    # 27 km with 0.2 um jerk phases, below the finest step a grid resolves: planned on the
+    # relaxation's grid (a named backend), the jerk at the ends exceeds its tolerance (the
+    # trust fuzz's case; plan() flags it).
     f = tmp_path / "line.json"
     f.write_text(json.dumps({"segments": [{"type": "line", "length": 27373.408073555755}]}))
     limits = ["--v-max", "12.217721761422338", "--a-max", "0.05420259524615834",
               "--a-lat-max", "1", "--j-max", "11.189576218503156"]
-    res = run("plan", str(f), *limits, "--strict")
+    res = run("plan", str(f), *limits, "--backend", "banded", "--strict")
     assert res.returncode == 5, res.stderr
     # "(--strict): jerk ..." today; "status limits_exceeded; jerk ..." once the planner
     # reports that status itself: either way exit 5 and the limit named.

@@ -41,6 +41,10 @@ G2_4M_LIMITS = sp.Limits(v_max=16.418898422873855, a_max=0.11059941918961164,
 def test_a_plan_records_which_attempt_answered():
     profile = sp.plan(STRAIGHT, LGV)
     assert [(a.name, a.leg, a.outcome) for a in profile.attempts] == [
+        ("model", None, "answered"), ("closed_form", 0, "answered")]
+    assert all(a.name in strategy.ATTEMPTS for a in profile.attempts)
+    profile = sp.plan(STRAIGHT, LGV, backend="banded")
+    assert [(a.name, a.leg, a.outcome) for a in profile.attempts] == [
         ("model", None, "answered"), ("default_grid", 0, "answered")]
     assert all(a.name in strategy.ATTEMPTS for a in profile.attempts)
     assert all(a.seconds >= 0.0 for a in profile.attempts)

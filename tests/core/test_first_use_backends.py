@@ -47,8 +47,10 @@ def cold(monkeypatch):
 def _cases():
     yield "warehouse_loop", read_path(ROOT / "paths" / "warehouse_loop.json"), LGV, {}
     yield "u_turn", read_path(ROOT / "paths" / "u_turn.json"), LGV, {}
+    # On a grid of the caller's: a straight move between rests is otherwise planned in
+    # closed form, with no relaxation.
     yield "straight", sp.Path.from_segments([Line(27.337)]), sp.Limits(
-        v_max=1.0903, a_max=0.3025, a_lat_max=1.0, j_max=1.9522), {}
+        v_max=1.0903, a_max=0.3025, a_lat_max=1.0, j_max=1.9522), {"ds": 0.01}
     yield "moving start", sp.Path.from_segments([Line(12.0)]), LGV, {"v0": 1.2, "a0": -0.3}
 
 
@@ -92,7 +94,8 @@ def test_a_fresh_environment_answers_at_once_then_with_the_compiled_kernel(tmp_p
     code = ("import time, speedplan as sp; from speedplan.geometry import Line\n"
             "from speedplan.core.jit import FAMILIES\n"
             "lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)\n"
-            "t = time.perf_counter(); p = sp.plan(sp.Path.from_segments([Line(20.0)]), lim)\n"
+            "corner = sp.Path.from_waypoints([[0, 0], [20, 0], [20, 10]])\n"
+            "t = time.perf_counter(); p = sp.plan(corner, lim)\n"
             "print(p.solution.backend, time.perf_counter() - t, repr(p.duration))\n"
             "b = FAMILIES['relaxation'].background\n"
             "b is not None and b.wait()\n")

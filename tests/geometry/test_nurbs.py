@@ -314,3 +314,31 @@ def test_cells_whose_curvature_interpolant_fails_evaluate_the_curve(monkeypatch)
     object.__setattr__(piece, "_kappa_coef", wrong)
     object.__setattr__(piece, "_kappa_ok", np.zeros_like(piece._kappa_ok))
     np.testing.assert_array_equal(p.curvature(s), direct)
+
+
+@pytest.mark.parametrize(("ctrl", "w"), [
+    ([[1, 2], [4, 6]], [1, 1]),  # VDA 5050 3.0's straight edge: two control points
+    ([[1, 2], [1.3, 2.4], [2.5, 4], [4, 6]], [1, 0.4, 2.5, 1]),  # more, uneven, rational
+])
+def test_a_nurbs_along_its_chord_is_that_line(ctrl, w):
+    ctrl, w = np.array(ctrl, dtype=float), np.array(w, dtype=float)
+    k = ctrl.shape[0] - 1
+    knots = np.concatenate((np.zeros(k + 1), np.ones(k + 1)))
+    p = Path.from_nurbs(k, knots, ctrl, w)
+    assert p.straight_between(0.0, p.length) and p.length == pytest.approx(5.0, rel=1e-15)
+    # Every point of the curve (independent de Boor) lies on the path, in order.
+    x = np.linspace(0.0, 1.0, 41)
+    pts = np.array([nurbs_point(k, knots, ctrl, w, xi) for xi in x])
+    along = np.hypot(*(pts - ctrl[0]).T)
+    assert np.all(np.diff(along) >= -1e-12)
+    np.testing.assert_allclose(p.point(along), pts, atol=1e-12)
+    assert float(np.abs(p.curvature(np.linspace(0, p.length, 9))).max()) == 0.0
+
+
+def test_control_points_off_the_chord_or_out_of_order_are_not_a_line():
+    from speedplan.geometry.nurbs import straight_chord
+
+    assert straight_chord(np.array([[0.0, 0.0], [6.0, 0.0], [4.0, 0.0]])) is None
+    assert straight_chord(np.array([[0.0, 0.0], [2.0, 1e-6], [4.0, 0.0]])) is None
+    p = Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[0, 0], [2, 1e-6], [4, 0]])
+    assert not p.straight_between(0.0, p.length)

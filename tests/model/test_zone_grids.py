@@ -91,7 +91,7 @@ def test_user_grids_and_no_jerk_grids_are_never_coarsened() -> None:
     free = Limits(v_max=2.6, a_max=0.406, a_lat_max=1.0, j_max=np.inf)
     no_jerk = build_model(PlanRequest.create(path, free, zones=[zone]))
     assert coarser_leg(no_jerk.request, no_jerk.legs[0], 0.5) is None
-    model = build_model(PlanRequest.create(path, LIM))
+    model = build_model(PlanRequest.create(path, LIM, zones=[zone]))
     coarsest = coarser_leg(model.request, model.legs[0], 1e-9)
     assert coarsest is not None and coarsest.problem.n <= MIN_NODES + 2
     assert coarser_leg(model.request, coarsest, 0.5) is None

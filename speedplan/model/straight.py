@@ -1,0 +1,204 @@
+"""Straight legs: the exact minimum-time motion in closed form, without a grid or a solver.
+
+On a straight stretch (every piece a line) whose speed bound is one constant ``v_top``, the
+curvature terms vanish (no lateral acceleration, lateral jerk or yaw rate) and planning is the
+1-D time-optimal move under ``v <= v_top``, ``-a_decel <= a <= a_max``, ``|jerk| <= j_max``,
+``v >= 0``. Between states at zero acceleration — at rest, or cruising — its optimum
+accelerates from ``v0`` to a peak speed ``vp`` with the time-optimal speed change (jerk ``+j``,
+hold ``a_max``, jerk ``-j``: `speedplan.model.boundary.transition`), cruises at ``vp``, and
+brakes to ``vf`` likewise: the double-S move (`straight_motion`).
+
+**The peak.** Such a speed change over ``dv`` lasts ``T(dv) = dv/a + a/j`` (``2 sqrt(dv/j)``
+when ``a`` is not reached) and, its speed being symmetric in time, covers ``(v_lo + v_hi) T /
+2``. With ``D(vp)`` the distance of both changes and a cruise over the rest, the time is
+``T_up + T_down + (L - D) / vp`` and its derivative in ``vp`` is
+``Σ (dv T'(dv) - T(dv)) / (2 vp) - (L - D) / vp²``, negative since ``dv T' - T`` is ``-a/j``
+(or ``-sqrt(dv/j)``): the higher the peak, the shorter the move. So ``vp`` is ``v_top`` when
+both changes fit in ``L`` (with a cruise), else the root of ``D(vp) = L`` (monotone: a
+bracketed root). The ends' rest phases come out exactly — jerk phases of microseconds on a
+kilometre move included, which no grid resolves.
+
+If even ``vp = max(v0, vf)`` does not fit (a slow start that would have to dip towards rest
+to reach a faster end in time), there is no double-S move and `straight_motion`
+returns ``None``: the leg is then planned on a grid like any other.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..core.checks import FloatArray
+from ..geometry import SpeedBound, bound_breakpoints
+from .boundary import transition
+from .request import PlanRequest
+
+__all__ = ["JerkPhases", "constant_bound", "straight_applies", "straight_motion"]
+
+
+@dataclass(frozen=True, eq=False)
+class JerkPhases:
+    """A 1-D motion made of constant-jerk phases, given at the phases' boundaries.
+
+    Attributes
+    ----------
+    t : ndarray
+        Times of the boundaries [s], from 0, shape ``(m + 1,)``.
+    s : ndarray
+        Positions there [m], from 0.
+    v, a : ndarray
+        Speed [m/s] and acceleration [m/s²] there.
+    jerk : ndarray
+        Jerk of each phase [m/s³], shape ``(m,)``.
+    """
+
+    t: FloatArray
+    s: FloatArray
+    v: FloatArray
+    a: FloatArray
+    jerk: FloatArray
+
+    @property
+    def duration(self) -> float:
+        """Total time [s]."""
+        return float(self.t[-1])
+
+    @property
+    def length(self) -> float:
+        """Distance covered [m]."""
+        return float(self.s[-1])
+
+
+def _change_time(dv: float, acc: float, j_max: float) -> float:
+    """Duration of the time-optimal speed change by ``dv >= 0`` from and to ``a = 0``."""
+    if dv * j_max <= acc * acc:
+        return 2.0 * float(np.sqrt(dv / j_max))
+    return dv / acc + acc / j_max
+
+
+def _changes_distance(vp: float, v0: float, vf: float, a_max: float, a_decel: float,
+                      j_max: float) -> float:
+    """Distance of the speed changes ``v0 -> vp -> vf`` (each symmetric in time)."""
+    return (0.5 * (v0 + vp) * _change_time(vp - v0, a_max, j_max)
+            + 0.5 * (vp + vf) * _change_time(vp - vf, a_decel, j_max))
+
+
+def _rising(v_lo: float, v_hi: float, j_max: float, acc: float
+            ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Boundaries ``(t, d, v, a)`` and jerks of the time-optimal rise ``v_lo -> v_hi``.
+
+    ``d`` from 0 at the start; phases of zero duration are dropped, the end state is set
+    exactly (``v_hi``, ``a = 0``).
+    """
+    phases = [p for p in transition(v_lo, 0.0, v_hi, 0.0, j_max, acc, acc) if p.duration > 0]
+    m = len(phases)
+    t, d, v, a = np.zeros(m + 1), np.zeros(m + 1), np.zeros(m + 1), np.zeros(m + 1)
+    jerk = np.array([p.jerk for p in phases], dtype=np.float64)
+    v[0] = v_lo
+    for k, p in enumerate(phases):
+        dt = p.duration
+        t[k + 1] = t[k] + dt
+        d[k + 1] = d[k] + dt * (v[k] + dt * (0.5 * a[k] + dt * p.jerk / 6.0))
+        v[k + 1] = v[k] + dt * (a[k] + 0.5 * dt * p.jerk)
+        a[k + 1] = a[k] + dt * p.jerk
+    v[-1], a[-1] = v_hi, 0.0
+    return t, d, v, a, jerk
+
+
+def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: float,
+                    a_decel: float, j_max: float) -> JerkPhases | None:
+    """The minimum-time double-S move over ``length`` from ``(v0, 0)`` to ``(vf, 0)``.
+
+    Parameters
+    ----------
+    length : float
+        Distance [m], > 0.
+    v0, vf : float
+        Speeds at the start and the end [m/s], at zero acceleration, ``<= v_top``.
+    v_top : float
+        Speed limit over the whole stretch [m/s].
+    a_max, a_decel, j_max : float
+        Acceleration, braking [m/s²] and jerk [m/s³] limits (finite).
+
+    Returns
+    -------
+    JerkPhases or None
+        The motion (see the module notes for why it is the optimum), or ``None`` when no
+        double-S move joins the states within ``length``.
+
+    Examples
+    --------
+    30 m from rest to rest with ``v_max = 2``, ``a_max = 1``, ``j_max = 0.5``: 4 s to reach
+    2 m/s (jerk phases of 2 s, no constant acceleration), 11 s of cruise, 4 s to stop.
+
+    >>> m = straight_motion(30.0, 0.0, 0.0, 2.0, 1.0, 1.0, 0.5)
+    >>> round(m.duration, 12), m.jerk.tolist()
+    (19.0, [0.5, -0.5, 0.0, -0.5, 0.5])
+    """
+    if not (length > 0 and v_top > 0 and np.isfinite(j_max)):
+        return None
+    low = max(v0, vf)
+    if low > v_top or _changes_distance(low, v0, vf, a_max, a_decel, j_max) > length:
+        return None
+    if _changes_distance(v_top, v0, vf, a_max, a_decel, j_max) <= length:
+        vp = v_top
+    else:
+        vp = brentq(lambda x: _changes_distance(x, v0, vf, a_max, a_decel, j_max) - length,
+                    low, v_top, xtol=1e-15 * v_top, rtol=4 * np.finfo(float).eps)
+    for _ in range(60):
+        t_up, d_up, v_up, a_up, j_up = _rising(v0, vp, j_max, a_max)
+        # The braking, time reversed, is a rise from vf: its positions counted from the end
+        # keep full precision next to the final stop.
+        t_dn, d_dn, v_dn, a_dn, j_dn = _rising(vf, vp, j_max, a_decel)
+        gap = length - d_dn[-1] - d_up[-1]
+        if gap >= 0.0 or vp <= low:
+            break
+        # The changes overlap by a rounding (a speed change of a few ulps computed from a
+        # difference of speeds): a hair lower peak leaves a cruise of a rounding instead, so
+        # that the positions of both changes meet without a jump.
+        vp = max(low, vp - (vp - low) * 2.0 ** (_ - 50))
+    s_dn = length - d_dn[::-1]
+    cruise = max(gap, 0.0) / vp
+    starts = [t_up, t_up[-1] + cruise + (t_dn[-1] - t_dn[::-1])]
+    pos = [d_up, s_dn]
+    speed, acc, jerk = [v_up, v_dn[::-1]], [a_up, -a_dn[::-1]], [j_up, j_dn[::-1]]
+    if cruise > 0:
+        jerk.insert(1, np.zeros(1))
+    else:  # the two changes meet: one boundary between them
+        starts[1], pos[1], speed[1], acc[1] = (x[1:] for x in (starts[1], pos[1], speed[1],
+                                                               acc[1]))
+    return JerkPhases(t=np.concatenate(starts), s=np.concatenate(pos),
+                      v=np.concatenate(speed), a=np.concatenate(acc),
+                      jerk=np.concatenate(jerk))
+
+
+def constant_bound(bound: SpeedBound, lo: float, hi: float) -> float | None:
+    """The speed bound's value [m²/s²] if it is one constant over ``[lo, hi]``, else ``None``.
+
+    Evaluated at the ends, at every breakpoint inside (piece joins, zone entries and exits,
+    ``v_limit`` knots, span ends: `bound_breakpoints`) and between consecutive ones; on a
+    straight stretch the bound is piecewise constant or linear between breakpoints, so equal
+    values there mean a constant bound.
+    """
+    breaks = bound_breakpoints(bound.path, bound)
+    inner = breaks[(breaks > lo) & (breaks < hi)]
+    knots = np.concatenate(([lo], inner, [hi]))
+    probes = np.concatenate((knots, 0.5 * (knots[:-1] + knots[1:])))
+    w = np.asarray(bound(probes), dtype=np.float64)
+    top = float(w[0])
+    return top if top > 0 and np.isfinite(top) and bool(np.all(w == top)) else None
+
+
+def straight_applies(request: PlanRequest, lo: float, hi: float, a0: float, af: float) -> bool:
+    """Whether the stretch ``[lo, hi]`` of ``request`` is planned in closed form.
+
+    A straight stretch, states at zero acceleration, jerk-limited with the smooth
+    standstill, on the default grid (``n`` and ``ds`` not given: a given grid is the caller's)
+    with ``backend="auto"`` (a named backend asks for the relaxation). The speed bound is
+    checked separately (`constant_bound`).
+    """
+    return (request.jerk_limited and request.smooth_standstill and a0 == 0.0 and af == 0.0
+            and request.n is None and request.ds is None and request.backend == "auto"
+            and request.path.straight_between(lo, hi))

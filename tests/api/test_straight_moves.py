@@ -1,0 +1,154 @@
+"""Straight legs planned in closed form: ruckig's optimum exactly, and a trajectory within limits.
+
+The oracle is ruckig (the exact 1-D time-optimal motion, forward only) and the finite
+differences of the sampled trajectory (`oracles.measure`), never the library's own checks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from oracles import measure, ruckig_duration, ruckig_move
+
+import speedplan as sp
+from speedplan.geometry import Line, Path, SpeedZone
+
+
+def _line(length: float) -> Path:
+    return Path.from_waypoints([[0.0, 0.0], [length, 0.0]], kind="polyline")
+
+
+def _answered(profile: sp.SpeedProfile) -> list[str]:
+    return [a.name for a in profile.attempts if a.outcome == "answered"]
+
+
+def _exact(profile: sp.SpeedProfile, samples: int = 6_000) -> None:
+    """The sampled trajectory meets every limit to rounding (no tolerance needed)."""
+    m = measure(profile, samples=samples)
+    assert m.speed <= 1 + 1e-9, m
+    assert max(m.accel, m.decel) <= 1 + 1e-9 + m.accel_rounding, m
+    assert m.jerk <= 1 + 1e-9 + m.jerk_rounding, m
+
+
+#: Rest-to-rest moves that the grid planned with a final jerk phase shorter than its finest
+#: step and flagged ``limits_exceeded`` (jerk 1.07x and 6.8x), and one whose phases last
+#: microseconds on 16.5 km.
+FLAGGED_ON_A_GRID = [
+    (260.7535089142938, dict(v_max=1.5796976971681844, a_max=0.05146119099882472,
+                             j_max=27.003482118818823, a_decel=0.04355096774371088)),
+    (16499.670214826176, dict(v_max=8.402299315275519, a_max=0.060097267955824187,
+                              j_max=77.08902572383232, a_decel=0.13848130909662754)),
+]
+
+
+@pytest.mark.parametrize(("length", "limits"), FLAGGED_ON_A_GRID)
+def test_moves_with_unresolvable_jerk_phases_are_planned_exactly(length, limits):
+    lim = sp.Limits(a_lat_max=1.0, **limits)
+    prof = sp.plan(_line(length), lim)
+    assert prof.status == "optimal" and not prof.limits_exceeded
+    assert _answered(prof) == ["model", "closed_form"]
+    assert prof.duration == pytest.approx(ruckig_duration(length, lim), rel=1e-12)
+    _exact(prof, samples=30_000)
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(log_length=st.floats(-3.0, 5.0), log_v=st.floats(np.log10(0.05), np.log10(30.0)),
+       log_a=st.floats(np.log10(0.05), np.log10(5.0)),
+       log_d=st.floats(np.log10(0.05), np.log10(5.0)),
+       log_j=st.floats(np.log10(0.02), np.log10(50.0)),
+       f0=st.one_of(st.just(0.0), st.floats(0.0, 1.0)),
+       ff=st.one_of(st.just(0.0), st.floats(0.0, 1.0)))
+def test_moves_between_cruise_states_take_ruckigs_optimum(log_length, log_v, log_a, log_d,
+                                                          log_j, f0, ff):
+    length = 10.0**log_length
+    lim = sp.Limits(v_max=10.0**log_v, a_max=10.0**log_a, a_decel=10.0**log_d,
+                    a_lat_max=1.0, j_max=10.0**log_j)
+    v0, vf = f0 * lim.v_max, ff * lim.v_max
+    answer = ruckig_move(length, lim, v0=v0, vf=vf)
+    try:
+        prof = sp.plan(_line(length), lim, v0=v0, vf=vf)
+    except sp.InfeasibleError:
+        assert answer.duration is None  # a refusal only where no forward motion exists
+        return
+    except sp.InvalidInputError:
+        return  # outside the documented ranges (e.g. below the shortest path)
+    assert prof.status == "optimal"
+    closed = "closed_form" in _answered(prof)
+    if closed:
+        _exact(prof)
+    if answer.duration is not None:
+        if closed:
+            assert prof.duration == pytest.approx(answer.duration, rel=1e-9, abs=1e-12)
+        else:  # planned on a grid: never faster than the optimum
+            assert prof.duration >= answer.duration * (1 - 1e-4)
+
+
+def test_a_straight_path_with_a_cusp_is_two_closed_form_legs():
+    path = Path.from_segments([Line(5.0), Line(3.0, reverse=True)])
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    prof = sp.plan(path, lim)
+    assert [a.name for a in prof.attempts if a.outcome == "answered"] == [
+        "model", "closed_form", "closed_form"]
+    expected = ruckig_duration(5.0, lim) + ruckig_duration(3.0, lim)
+    assert prof.duration == pytest.approx(expected, rel=1e-12)
+    _exact(prof)
+
+
+def test_a_zone_over_the_whole_line_caps_the_closed_form():
+    zone = SpeedZone([(-1, -1), (11, -1), (11, 1), (-1, 1)], v_max=0.5)
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    prof = sp.plan(_line(10.0), lim, zones=[zone])
+    assert "closed_form" in _answered(prof)
+    capped = sp.Limits(v_max=0.5, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    assert prof.duration == pytest.approx(ruckig_duration(10.0, capped), rel=1e-12)
+    assert float(np.max(prof.sample(0.01).v)) <= 0.5 * (1 + 1e-12)
+
+
+@pytest.mark.parametrize("kwargs", [
+    {"zones": [SpeedZone([(4, -1), (6, -1), (6, 1), (4, 1)], v_max=0.5)]},  # bound varies
+    {"n": 400},  # the caller's grid
+    {"backend": "banded"},  # a named relaxation backend
+    {"v0": 1.0, "a0": 0.2},  # a moving state with an acceleration
+    {"standstill": "free"},  # the paper's model
+])
+def test_the_closed_form_applies_only_where_it_is_the_requested_model(kwargs):
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    prof = sp.plan(_line(10.0), lim, **kwargs)
+    assert "closed_form" not in [a.name for a in prof.attempts]
+    assert prof.status in ("optimal", "refined")
+
+
+def test_a_curved_path_is_not_planned_in_closed_form():
+    path = Path.from_waypoints([[0, 0], [10, 0], [10, 10]])
+    prof = sp.plan(path, sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5))
+    assert "closed_form" not in [a.name for a in prof.attempts]
+
+
+def test_a_start_that_must_dip_to_reach_a_fast_end_is_planned_on_a_grid():
+    # From 0.1 m/s to 2 m/s at rest acceleration over 2.88 m: the direct speed-up needs
+    # 2.895 m; braking to rest first and starting again needs less, so the double-S move
+    # does not exist and the grid plans the dip.
+    lim = sp.Limits(v_max=3.0, a_max=10.0, a_lat_max=1.0, j_max=1.0)
+    answer = ruckig_move(2.88, lim, v0=0.1, vf=2.0)
+    try:
+        prof = sp.plan(_line(2.88), lim, v0=0.1, vf=2.0)
+    except sp.InfeasibleError:
+        assert answer.duration is None
+        return
+    assert "closed_form" not in _answered(prof)
+    assert answer.duration is not None
+    assert prof.duration >= answer.duration * (1 - 1e-4)
+
+
+def test_a_cruise_state_read_off_a_straight_plan_replans_to_the_same_arrival():
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    path = _line(30.0)
+    prof = sp.plan(path, lim)
+    state = prof.at([9.5])
+    assert float(state.a[0]) == 0.0  # cruising
+    s = float(state.s[0])
+    rest = sp.plan(path.sub(s), lim, v0=float(state.v[0]))
+    assert "closed_form" in _answered(rest)
+    assert 9.5 + rest.duration == pytest.approx(prof.duration, rel=1e-12)
