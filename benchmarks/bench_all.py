@@ -576,17 +576,13 @@ def section_straight(repeats: int, count: int) -> None:
               f"max {1e3 * rest[-1]:.2f} ms")
     length, lim = SLOW_STRAIGHT
     path = sp.Path.from_segments([Line(length)])
-    prof = sp.plan(path, lim)
-    t = median_time(lambda: sp.plan(path, lim), repeats)
-    stages: dict[str, list[float]] = defaultdict(list)
-    from speedplan.model import build as build_mod  # adaptive_grid as plan() calls it
-
-    with _timed(build_mod, "adaptive_grid", stages):
-        sp.plan(path, lim)
-    t_grid = sum(stages["adaptive_grid"])
-    print(f"{length} m rest to rest (v_max={lim.v_max}, a_max={lim.a_max}, j_max={lim.j_max})"
-          f": {1e3 * t:.1f} ms on {prof.s.size} nodes (grid {1e3 * t_grid:.1f} ms), "
-          f"T = {prof.duration:.9f} s, ruckig {ruckig_move(length, lim).duration:.9f} s")
+    for label, kw in (("closed form", {}), ("default grid, banded backend", {"backend": "banded"})):
+        prof = sp.plan(path, lim, **kw)
+        t = median_time(lambda k=kw: sp.plan(path, lim, **k), repeats)
+        answered = [a.name for a in prof.attempts if a.outcome == "answered"][-1]
+        print(f"{length} m rest to rest (v_max={lim.v_max}, a_max={lim.a_max}, j_max="
+              f"{lim.j_max}), {label}: {1e3 * t:.2f} ms ({answered}, {prof.s.size} nodes), "
+              f"T = {prof.duration:.9f} s, ruckig {ruckig_move(length, lim).duration:.9f} s")
     route = sp.Route.from_vda5050(thirty_edge_order())
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -174,7 +174,8 @@ def _warm() -> None:
     compile_families()  # as `speedplan compile`: no plan runs while a kernel compiles
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        sp.plan(_straight(sp, 5.0), sp.Limits(2.0, 1.0, 1.0, 0.5))  # compile the kernels
+        sp.plan(sp.Path.from_waypoints([[0, 0], [5, 0], [5, 3]]),  # load the kernels
+                sp.Limits(2.0, 1.0, 1.0, 0.5))
 
 
 def run(jobs: list[Job], time_limit: float | None, cap: float | None) -> list[dict[str, Any]]:

@@ -476,11 +476,12 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
             raise record.timeout()
         worst = ", ".join(f"{k} {r:.3f}× at s={check.where.get(k, float('nan')):.4g} m"
                           for k, r in check.violations.items())
+        rounds = sum(e.name == "local_refinement" for e in record.entries)
         warnings.warn(
             f"the planned trajectory exceeds limits beyond tolerance ({worst} of the limit) "
-            f"even after {MAX_REFINEMENTS} local refinements; status 'limits_exceeded' — see "
-            "profile.verification and profile.attempts, or plan with a finer grid (n or ds)",
-            LimitWarning, stacklevel=4,
+            f"after {rounds} local refinement{'s' * (rounds != 1)} of the grid; status "
+            "'limits_exceeded' — see profile.verification and profile.attempts, or plan with "
+            "a finer grid (n or ds)", LimitWarning, stacklevel=4,
         )
     # The bound's memo (every position evaluated while planning) stays with the plan, not
     # with the profile a caller keeps.

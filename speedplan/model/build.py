@@ -5,11 +5,11 @@
 where the vehicle must be at rest: where a boundary state forces a stop on the way (a
 decelerating start whose speed falls exactly to zero: the motion to that point is forced, a
 `ForcedLeg`), and — with the route and cusp support — at cusps and stops. A straight stretch
-with a constant speed bound between states at zero acceleration is a `StraightLeg`: its
-minimum-time motion is known in closed form (`speedplan.model.straight`). Every other `Leg`
-gets its grid (`speedplan.model.leg_grid`), its node bounds, envelopes and lateral rows
-(`speedplan.model.rows`) and is planned on its own by `speedplan.strategy`. This layer builds
-data and calls no solver.
+with a constant speed bound whose states a motion with one speed peak joins is a
+`StraightLeg`: its minimum-time motion is known in closed form (`speedplan.model.straight`).
+Every other `Leg` gets its grid (`speedplan.model.leg_grid`), its node bounds, envelopes and
+lateral rows (`speedplan.model.rows`) and is planned on its own by `speedplan.strategy`. This
+layer builds data and calls no solver.
 """
 
 from __future__ import annotations
@@ -144,6 +144,14 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
     touch = max(TOUCH_ZERO, 4.0 * STATE_JERK_ROUNDING) if rounded else TOUCH_ZERO
     past = 5.0 * STATE_JERK_ROUNDING if rounded else STATE_ROUNDING
     touching = {"touch": touch, "least_duration": length / lim.v_max}
+    # In closed form a speed dip next to rest is exact: only a state on a stop's curve (to
+    # rounding) stops on the way; the dips a grid could not resolve are passed.
+    if request.jerk_limited and not any(
+            _forced_stop(v, a, j_state, end=end, touch=touch, least_duration=0.0)
+            for v, a, end in ((v0, a0, False), (vf, af, True))):
+        whole = straight_leg(request, bound, lo, hi, v0, a0, vf, af)
+        if whole is not None:
+            return [whole]
     head = _forced_stop(v0, a0, j_state, end=False, **touching) if request.jerk_limited else None
     tail = _forced_stop(vf, af, j_state, end=True, **touching) if request.jerk_limited else None
     inner_lo, inner_hi = lo, hi
@@ -160,6 +168,12 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
             # spans the stretch.
             forced = replace(forced, length=length, s=forced.s * (length / forced.length))
             head, tail = (forced, None) if forced.v0 > 0 else (None, forced)
+    # A forced stop shorter than a rounding of the stretch (a state a few ulps from rest)
+    # is no motion: the state is rest.
+    if head is not None and head.length <= 1e-12 * length:
+        head, v0, a0 = None, 0.0, 0.0
+    if tail is not None and tail.length <= 1e-12 * length:
+        tail, vf, af = None, 0.0, 0.0
     if head is not None:
         legs.append(_shifted(head, lo))
         inner_lo, v0, a0 = lo + head.length, 0.0, 0.0
@@ -184,14 +198,16 @@ def straight_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, 
     ``None`` where the closed form does not apply (`straight_applies`, `constant_bound`)
     or no double-S move joins the states (`straight_motion`): the leg is then built on a grid.
     """
-    if not straight_applies(request, lo, hi, a0, af):
+    if not straight_applies(request, lo, hi):
         return None
     top = constant_bound(bound, lo, hi)
     if top is None:
         return None
     lim = request.limits
+    # The jerk a marginal boundary state may use (a state read off a plan lies on the
+    # boundary of what j_max reaches, to rounding), as on a grid: over the whole leg.
     motion = straight_motion(hi - lo, v0, vf, float(np.sqrt(top)), lim.a_max, lim.a_decel,
-                             lim.j_max)
+                             request.moving_state_jerk, a0=a0, af=af)
     if motion is None:
         return None
     return StraightLeg(start=lo, length=hi - lo, v0=v0, a0=a0, vf=vf, af=af, motion=motion)

@@ -129,9 +129,9 @@ class ForcedLeg(_Ends):
 class StraightLeg(_Ends):
     """A straight leg planned in closed form: its minimum-time motion is known exactly.
 
-    A straight stretch with a constant speed bound between states at zero acceleration
-    (`speedplan.model.straight`); ``start``, ``length`` and the boundary states are those of
-    `Leg`.
+    A straight stretch with a constant speed bound whose boundary states a motion with one
+    speed peak joins (`speedplan.model.straight`); ``start``, ``length`` and the boundary
+    states are those of `Leg`.
 
     Attributes
     ----------

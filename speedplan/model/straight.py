@@ -3,24 +3,32 @@
 On a straight stretch (every piece a line) whose speed bound is one constant ``v_top``, the
 curvature terms vanish (no lateral acceleration, lateral jerk or yaw rate) and planning is the
 1-D time-optimal move under ``v <= v_top``, ``-a_decel <= a <= a_max``, ``|jerk| <= j_max``,
-``v >= 0``. Between states at zero acceleration — at rest, or cruising — its optimum
-accelerates from ``v0`` to a peak speed ``vp`` with the time-optimal speed change (jerk ``+j``,
-hold ``a_max``, jerk ``-j``: `speedplan.model.boundary.transition`), cruises at ``vp``, and
-brakes to ``vf`` likewise: the double-S move (`straight_motion`).
+``v >= 0``. Its optimum rises from the start state ``(v0, a0)`` to a peak ``(vp, 0)`` with the
+time-optimal change of speed and acceleration (jerk ramp to a peak acceleration, hold it at
+``a_max`` if it would exceed it, ramp back to 0: `speedplan.model.boundary.transition`),
+cruises at ``vp``, and falls to the end state ``(vf, af)`` likewise: the double-S move, seven
+constant-jerk phases at most (`straight_motion`).
 
-**The peak.** Such a speed change over ``dv`` lasts ``T(dv) = dv/a + a/j`` (``2 sqrt(dv/j)``
-when ``a`` is not reached) and, its speed being symmetric in time, covers ``(v_lo + v_hi) T /
-2``. With ``D(vp)`` the distance of both changes and a cruise over the rest, the time is
-``T_up + T_down + (L - D) / vp`` and its derivative in ``vp`` is
-``Σ (dv T'(dv) - T(dv)) / (2 vp) - (L - D) / vp²``, negative since ``dv T' - T`` is ``-a/j``
-(or ``-sqrt(dv/j)``): the higher the peak, the shorter the move. So ``vp`` is ``v_top`` when
-both changes fit in ``L`` (with a cruise), else the root of ``D(vp) = L`` (monotone: a
-bracketed root). The ends' rest phases come out exactly — jerk phases of microseconds on a
-kilometre move included, which no grid resolves.
+**The peak.** The peak must be at least the speed each state turns around at
+(``v + a|a|/(2 j)``: a start's acceleration brought to 0, an end's traced back to 0). With
+``D(vp)`` the distance of both changes and a cruise over the rest, the time is
+``T_1 + T_2 + (L - D) / vp``; each change's time less its distance over ``vp`` falls as the
+peak rises (a higher target raises the speed all along the change), and so does the cruise's
+``(L - D) / vp``: the higher the peak, the shorter the move. So ``vp`` is ``v_top`` when both
+changes fit in ``L`` (with a cruise), else the root of ``D(vp) = L`` (bracketed, monotone).
+Between states at zero acceleration the changes are symmetric in time: a change over ``dv``
+lasts ``dv/a + a/j`` (``2 sqrt(dv/j)`` when ``a`` is not reached) and covers its mean speed
+times that. The ends' phases come out exactly — jerk phases of microseconds on a kilometre
+move included, which no grid resolves.
 
-If even ``vp = max(v0, vf)`` does not fit (a slow start that would have to dip towards rest
-to reach a faster end in time), there is no double-S move and `straight_motion`
-returns ``None``: the leg is then planned on a grid like any other.
+**Where it is the optimum.** The time-optimal 1-D motion has at most seven constant-jerk
+phases (Berscheid & Kröger, *Jerk-limited real-time trajectory generation with arbitrary
+target states*, 2021); those that rise to one speed peak and fall from it are this family.
+The others — a motion that never has a peak (still accelerating on arrival past any peak),
+or one that must dip towards rest to arrive faster — have no member here: if even the lowest
+admissible peak does not fit in ``L``, `straight_motion` returns ``None`` and the leg is
+planned on a grid like any other. ``tests/api/test_straight_moves.py`` holds every motion of
+this family against ruckig's optimum over decades of scale, boundary states included.
 """
 
 from __future__ import annotations
@@ -32,7 +40,7 @@ from scipy.optimize import brentq
 
 from ..core.checks import FloatArray
 from ..geometry import SpeedBound, bound_breakpoints
-from .boundary import transition
+from .boundary import run_phases, transition, turnaround_speed
 from .request import PlanRequest
 
 __all__ = ["JerkPhases", "constant_bound", "straight_applies", "straight_motion"]
@@ -80,23 +88,29 @@ def _change_time(dv: float, acc: float, j_max: float) -> float:
 
 def _changes_distance(vp: float, v0: float, vf: float, a_max: float, a_decel: float,
                       j_max: float) -> float:
-    """Distance of the speed changes ``v0 -> vp -> vf`` (each symmetric in time)."""
+    """Distance of the speed changes ``v0 -> vp -> vf`` at zero acceleration (symmetric)."""
     return (0.5 * (v0 + vp) * _change_time(vp - v0, a_max, j_max)
             + 0.5 * (vp + vf) * _change_time(vp - vf, a_decel, j_max))
 
 
-def _rising(v_lo: float, v_hi: float, j_max: float, acc: float
+def _rise_distance(v: float, a: float, vp: float, j_max: float, acc: float, dec: float
+                   ) -> float:
+    """Distance of the time-optimal change from ``(v, a)`` to ``(vp, 0)``."""
+    return run_phases(v, a, transition(v, a, vp, 0.0, j_max, acc, dec))[0]
+
+
+def _rising(v0: float, a0: float, v_hi: float, j_max: float, acc: float, dec: float
             ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Boundaries ``(t, d, v, a)`` and jerks of the time-optimal rise ``v_lo -> v_hi``.
+    """Boundaries ``(t, d, v, a)`` and jerks of the time-optimal change ``(v0, a0) -> (v_hi, 0)``.
 
     ``d`` from 0 at the start; phases of zero duration are dropped, the end state is set
     exactly (``v_hi``, ``a = 0``).
     """
-    phases = [p for p in transition(v_lo, 0.0, v_hi, 0.0, j_max, acc, acc) if p.duration > 0]
+    phases = [p for p in transition(v0, a0, v_hi, 0.0, j_max, acc, dec) if p.duration > 0]
     m = len(phases)
     t, d, v, a = np.zeros(m + 1), np.zeros(m + 1), np.zeros(m + 1), np.zeros(m + 1)
     jerk = np.array([p.jerk for p in phases], dtype=np.float64)
-    v[0] = v_lo
+    v[0], a[0] = v0, a0
     for k, p in enumerate(phases):
         dt = p.duration
         t[k + 1] = t[k] + dt
@@ -108,25 +122,29 @@ def _rising(v_lo: float, v_hi: float, j_max: float, acc: float
 
 
 def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: float,
-                    a_decel: float, j_max: float) -> JerkPhases | None:
-    """The minimum-time double-S move over ``length`` from ``(v0, 0)`` to ``(vf, 0)``.
+                    a_decel: float, j_max: float, *, a0: float = 0.0,
+                    af: float = 0.0) -> JerkPhases | None:
+    """The minimum-time double-S move over ``length`` from ``(v0, a0)`` to ``(vf, af)``.
 
     Parameters
     ----------
     length : float
         Distance [m], > 0.
     v0, vf : float
-        Speeds at the start and the end [m/s], at zero acceleration, ``<= v_top``.
+        Speeds at the start and the end [m/s], ``<= v_top``.
     v_top : float
         Speed limit over the whole stretch [m/s].
     a_max, a_decel, j_max : float
         Acceleration, braking [m/s²] and jerk [m/s³] limits (finite).
+    a0, af : float
+        Accelerations at the start and the end [m/s²], within ``[-a_decel, a_max]``.
 
     Returns
     -------
     JerkPhases or None
-        The motion (see the module notes for why it is the optimum), or ``None`` when no
-        double-S move joins the states within ``length``.
+        The motion (see the module notes for when it is the optimum), or ``None`` when no
+        motion that rises to one speed peak joins the states within ``length`` and
+        ``v_top`` (the states then need a grid, or no motion joins them).
 
     Examples
     --------
@@ -139,26 +157,34 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
     """
     if not (length > 0 and v_top > 0 and np.isfinite(j_max)):
         return None
-    low = max(v0, vf)
-    if low > v_top or _changes_distance(low, v0, vf, a_max, a_decel, j_max) > length:
+    turns = (turnaround_speed(v0, a0, j_max), turnaround_speed(vf, -af, j_max))
+    low = max(turns)
+    if min(turns) < 0 or low > v_top:
         return None
-    if _changes_distance(v_top, v0, vf, a_max, a_decel, j_max) <= length:
-        vp = v_top
+    if a0 == 0.0 and af == 0.0:
+        def distance(vp: float) -> float:
+            return _changes_distance(vp, v0, vf, a_max, a_decel, j_max)
     else:
-        vp = brentq(lambda x: _changes_distance(x, v0, vf, a_max, a_decel, j_max) - length,
-                    low, v_top, xtol=1e-15 * v_top, rtol=4 * np.finfo(float).eps)
-    for _ in range(60):
-        t_up, d_up, v_up, a_up, j_up = _rising(v0, vp, j_max, a_max)
-        # The braking, time reversed, is a rise from vf: its positions counted from the end
-        # keep full precision next to the final stop.
-        t_dn, d_dn, v_dn, a_dn, j_dn = _rising(vf, vp, j_max, a_decel)
+        def distance(vp: float) -> float:
+            return (_rise_distance(v0, a0, vp, j_max, a_max, a_decel)
+                    + _rise_distance(vf, -af, vp, j_max, a_decel, a_max))
+    if distance(low) > length:
+        return None
+    vp = v_top if distance(v_top) <= length else brentq(
+        lambda x: distance(x) - length, low, v_top, xtol=1e-15 * v_top,
+        rtol=4 * np.finfo(float).eps)
+    for k in range(60):
+        t_up, d_up, v_up, a_up, j_up = _rising(v0, a0, vp, j_max, a_max, a_decel)
+        # The fall, time reversed, is a rise from (vf, -af): its positions counted from the
+        # end keep full precision next to a final stop.
+        t_dn, d_dn, v_dn, a_dn, j_dn = _rising(vf, -af, vp, j_max, a_decel, a_max)
         gap = length - d_dn[-1] - d_up[-1]
         if gap >= 0.0 or vp <= low:
             break
-        # The changes overlap by a rounding (a speed change of a few ulps computed from a
+        # The changes overlap by a rounding (a change of a few ulps of speed computed from a
         # difference of speeds): a hair lower peak leaves a cruise of a rounding instead, so
         # that the positions of both changes meet without a jump.
-        vp = max(low, vp - (vp - low) * 2.0 ** (_ - 50))
+        vp = max(low, vp - (vp - low) * 2.0 ** (k - 50))
     s_dn = length - d_dn[::-1]
     cruise = max(gap, 0.0) / vp
     starts = [t_up, t_up[-1] + cruise + (t_dn[-1] - t_dn[::-1])]
@@ -191,14 +217,14 @@ def constant_bound(bound: SpeedBound, lo: float, hi: float) -> float | None:
     return top if top > 0 and np.isfinite(top) and bool(np.all(w == top)) else None
 
 
-def straight_applies(request: PlanRequest, lo: float, hi: float, a0: float, af: float) -> bool:
+def straight_applies(request: PlanRequest, lo: float, hi: float) -> bool:
     """Whether the stretch ``[lo, hi]`` of ``request`` is planned in closed form.
 
-    A straight stretch, states at zero acceleration, jerk-limited with the smooth
-    standstill, on the default grid (``n`` and ``ds`` not given: a given grid is the caller's)
-    with ``backend="auto"`` (a named backend asks for the relaxation). The speed bound is
-    checked separately (`constant_bound`).
+    A straight stretch, jerk-limited with the smooth standstill, on the default grid (``n``
+    and ``ds`` not given: a given grid is the caller's) with ``backend="auto"`` (a named
+    backend asks for the relaxation). The speed bound is checked separately
+    (`constant_bound`), and whether a double-S move joins the states (`straight_motion`).
     """
-    return (request.jerk_limited and request.smooth_standstill and a0 == 0.0 and af == 0.0
+    return (request.jerk_limited and request.smooth_standstill
             and request.n is None and request.ds is None and request.backend == "auto"
             and request.path.straight_between(lo, hi))

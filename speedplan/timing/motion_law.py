@@ -135,7 +135,7 @@ class MotionLaw:
         d = tau * (v0 + tau * (0.5 * a0 + tau * jerk / 6.0))
         s = np.where(left, p.s[j] + d, p.s[j + 1] - d)
         v = np.maximum(v0 + tau * (a0 + 0.5 * tau * jerk), 0.0)
-        return s, v * v, v, sgn * (a0 + tau * jerk), jerk
+        return s, v * v, v, sgn * (a0 + tau * jerk) + 0.0, jerk  # + 0.0: no -0.0
 
     def position_at(self, t: FloatArray) -> FloatArray:
         """Arc length ``s(t)`` at times ``t`` [m]."""
@@ -167,7 +167,7 @@ class MotionLaw:
         v, a, _ = self._end(j, left)
         jerk = p.jerk[j]
         width = p.t[j + 1] - p.t[j]
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(all="ignore"):  # a subnormal speed overflows: the bracket decides
             guess = np.where(v > 0, d / v, np.where(a > 0, np.sqrt(2.0 * d / a),
                                                     np.cbrt(6.0 * d / jerk)))
         tau = np.clip(np.where(np.isfinite(guess), guess, 0.5 * width), 0.0, width)
@@ -177,7 +177,7 @@ class MotionLaw:
             lo = np.where(f <= 0.0, tau, lo)
             hi = np.where(f >= 0.0, tau, hi)
             slope = v + tau * (a + 0.5 * tau * jerk)
-            with np.errstate(divide="ignore", invalid="ignore"):
+            with np.errstate(all="ignore"):
                 newton = tau - f / slope
             inside = (slope > 0) & (newton >= lo) & (newton <= hi)
             step = np.where(inside, newton, 0.5 * (lo + hi))
@@ -195,7 +195,7 @@ class MotionLaw:
         v0, a0, sgn = self._end(jb, left)
         jerk = self._pieces.jerk[jb]
         v = np.maximum(v0 + tau * (a0 + 0.5 * tau * jerk), 0.0)
-        return v * v, v, sgn * (a0 + tau * jerk), jerk
+        return v * v, v, sgn * (a0 + tau * jerk) + 0.0, jerk
 
     def _locate(self, q: FloatArray) -> IntArray:
         x = self._pieces.s
@@ -227,7 +227,7 @@ class MotionLaw:
         """
         p = self._pieces
         width = np.diff(p.t)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(all="ignore"):
             vertex = np.where(p.jerk != 0.0, -p.a[:-1] / p.jerk, -1.0)
         inside = (vertex > 0.0) & (vertex < width)
         tv = np.where(inside, vertex, 0.0)

@@ -51,7 +51,8 @@ def _cases():
     # closed form, with no relaxation.
     yield "straight", sp.Path.from_segments([Line(27.337)]), sp.Limits(
         v_max=1.0903, a_max=0.3025, a_lat_max=1.0, j_max=1.9522), {"ds": 0.01}
-    yield "moving start", sp.Path.from_segments([Line(12.0)]), LGV, {"v0": 1.2, "a0": -0.3}
+    yield "moving start", sp.Path.from_segments([Line(12.0)]), LGV, {"v0": 1.2, "a0": -0.3,
+                                                                    "ds": 0.005}
 
 
 CASES = list(_cases())
