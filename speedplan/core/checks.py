@@ -69,12 +69,14 @@ def as_array(
         )
     if length is not None and arr.shape[0] != length:
         raise InvalidInputError(f"`{name}` must have length {length}; got {arr.shape[0]}")
+    if np.isfinite(arr).all():  # one pass in the common case; the culprit named otherwise
+        return arr
     if np.isnan(arr).any():
         raise InvalidInputError(f"`{name}` contains NaN; pass finite numbers")
     if allow_inf:
         if np.isneginf(arr).any():
             raise InvalidInputError(f"`{name}` contains -inf; pass finite numbers or +inf")
-    elif not np.isfinite(arr).all():
+    else:
         raise InvalidInputError(f"`{name}` contains inf; pass finite numbers")
     return arr
 

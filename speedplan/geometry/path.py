@@ -157,12 +157,15 @@ class Path:
         q = as_array("s", s)
         L = self.length
         tol = S_TOLERANCE * L
-        if q.size and (q.min() < -tol or q.max() > L + tol):
-            bad = q[(q < -tol) | (q > L + tol)][0]
-            raise InvalidInputError(
-                f"`s` must lie in [0, length] = [0, {L:.9g}] m; got {bad!r}"
-            )
-        q = np.clip(q, 0.0, L)
+        if q.size:
+            lo, hi = q.min(), q.max()
+            if lo < -tol or hi > L + tol:
+                bad = q[(q < -tol) | (q > L + tol)][0]
+                raise InvalidInputError(
+                    f"`s` must lie in [0, length] = [0, {L:.9g}] m; got {bad!r}"
+                )
+            if lo < 0.0 or hi > L:  # within the tolerance: clipped (else already inside)
+                q = np.clip(q, 0.0, L)
         idx = np.clip(np.searchsorted(self.offsets, q, side="right") - 1, 0, len(self.pieces) - 1)
         return q, idx
 

@@ -70,7 +70,10 @@ def test_plans_with_and_without_the_memo_are_bitwise_equal(name, limits, monkeyp
         np.testing.assert_array_equal(a.s, b.s)
         np.testing.assert_array_equal(a.solution.w, b.solution.w)
     assert with_memo.verification == without.verification
-    assert evaluated < calls["n"]
+    if math.isfinite(limits.j_max):
+        assert evaluated < calls["n"]
+    else:  # the law's check reads the bound the model sampled: no position comes back
+        assert evaluated <= calls["n"]
     # The profile a caller keeps does not carry the plan's memo.
     assert with_memo.speed_bound.memo is None
 
