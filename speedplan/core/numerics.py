@@ -94,7 +94,7 @@ def cell_points(s: FloatArray, per_cell: int = CELL_POINTS) -> FloatArray:
     out = np.empty(per_cell * (n - 1) + 1)
     out[:n] = s
     rows = out[n:].reshape(per_cell - 1, n - 1)
-    np.multiply((np.arange(1, per_cell) / per_cell)[:, None], np.diff(s), out=rows)
+    np.multiply((np.arange(1, per_cell) / per_cell)[:, None], s[1:] - s[:-1], out=rows)
     rows += s[:-1]
     return out
 

@@ -400,6 +400,9 @@ class CellSamples:
         ``cell_points(s)`` [m].
     curvature, bound : ndarray
         The path's curvature [1/m] and the bound [m²/s²] at the points.
+    extra, extra_curvature, extra_bound : ndarray
+        Further positions [m] (the bound's breakpoints, `bound_breakpoints`) and the same
+        two quantities there; empty by default.
 
     Examples
     --------
@@ -418,13 +421,19 @@ class CellSamples:
     points: FloatArray
     curvature: FloatArray
     bound: FloatArray
+    extra: FloatArray = field(default_factory=lambda: np.zeros(0))
+    extra_curvature: FloatArray = field(default_factory=lambda: np.zeros(0))
+    extra_bound: FloatArray = field(default_factory=lambda: np.zeros(0))
 
     @classmethod
-    def of(cls, bound: SpeedBound, s: FloatArray) -> CellSamples:
-        """The samples of ``bound`` on the grid ``s``: every point evaluated."""
+    def of(cls, bound: SpeedBound, s: FloatArray, extra: FloatArray | None = None
+           ) -> CellSamples:
+        """The samples of ``bound`` on the grid ``s`` (and at ``extra``), all evaluated."""
         points = cell_points(s)
-        kappa, w = bound.evaluate(points)
-        return cls(s, bound.offset, points, kappa, w)
+        more = np.zeros(0) if extra is None else extra
+        kappa, w = bound.evaluate(np.concatenate((points, more)))
+        m = points.size
+        return cls(s, bound.offset, points, kappa[:m], w[:m], more, kappa[m:], w[m:])
 
     def on_grid(self, bound: SpeedBound, s: FloatArray) -> CellSamples:
         """The samples of ``bound`` on the grid ``s``, evaluated only where ``self`` lacks them.
@@ -444,18 +453,23 @@ class CellSamples:
         kept = same[:-1] & same[1:] & (at[1:] == at[:-1] + 1)
         new_nodes, new_cells = np.flatnonzero(~same), np.flatnonzero(~kept)
         nodes, inner = cell_rows(points)
-        fresh = bound.evaluate(np.concatenate((nodes[new_nodes], inner[:, new_cells].ravel())))
-        out = []
-        for own, values in zip((self.curvature, self.bound), fresh, strict=True):
-            val = np.empty(points.size)
-            val_nodes, val_inner = cell_rows(val)
-            own_nodes, own_inner = cell_rows(own)
-            val_nodes[same] = own_nodes[at[same]]
-            val_nodes[new_nodes] = values[:new_nodes.size]
-            val_inner[:, kept] = own_inner[:, at[:-1][kept]]
-            val_inner[:, new_cells] = values[new_nodes.size:].reshape(CELL_POINTS - 1, -1)
-            out.append(val)
-        return CellSamples(s, self.offset, points, out[0], out[1])
+        kappa, w = bound.evaluate(np.concatenate((nodes[new_nodes],
+                                                  inner[:, new_cells].ravel())))
+        # Where each point's value is, in ``self``'s values followed by the fresh ones (both
+        # in the order of `cell_points`): one gather per quantity.
+        m, n_old = self.points.size, old.size
+        fresh_node = m + np.cumsum(~same) - 1
+        fresh_cell = m + new_nodes.size + np.cumsum(~kept) - 1
+        index = np.empty(points.size, dtype=np.intp)
+        idx_nodes, idx_inner = cell_rows(index)
+        idx_nodes[:] = np.where(same, at, fresh_node)
+        base = np.where(kept, n_old + at[:-1], fresh_cell)
+        stride = np.where(kept, n_old - 1, new_cells.size)
+        np.multiply(np.arange(CELL_POINTS - 1)[:, None], stride, out=idx_inner)
+        idx_inner += base
+        out = [np.concatenate((own, fresh))[index]
+               for own, fresh in ((self.curvature, kappa), (self.bound, w))]
+        return replace(self, s=s, points=points, curvature=out[0], bound=out[1])
 
 
 def _check_v_limit(v_limit: VLimit) -> tuple[FloatArray, FloatArray]:

@@ -278,7 +278,7 @@ def _end_speeds(request: PlanRequest, bound: SpeedBound, length: float) -> PlanR
     A speed above the bound by at most `STATE_ROUNDING` is
     taken at the bound (a state read off a plan: the time law's rounding).
     """
-    ends = np.sqrt(bound(np.array([0.0, length])))
+    ends = np.sqrt(bound.evaluate(np.array([0.0, length]))[1])
     v0, vf = (within_limit(name, v, float(b), "m/s", f"the speed bound at s={where:.6g} m "
                            "(v_max, lateral acceleration, a zone or v_limit)")
               for name, v, b, where in (("v0", request.v0, ends[0], 0.0),

@@ -18,8 +18,8 @@ from .boundary import turnaround_speed
 from .grid import (
     MAX_DEFAULT_NODES,
     adaptive_grid,
+    dips_between,
     graded_ends,
-    hidden_dips,
     rest_phase_length,
     subdivided_grid,
     top_speed,
@@ -81,9 +81,17 @@ def no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: flo
     """
     lim = request.limits
     s = uniform_grid(length, n=NO_JERK_NODES)
-    s = _cut_out_dips(s, hidden_dips(s, bound_breakpoints(request.path, bound), bound,
-                                     cells=True))
-    samples = CellSamples.of(bound, s)
+    breaks = bound_breakpoints(request.path, bound)
+    breaks = breaks[breaks <= length]
+    samples = CellSamples.of(bound, s, extra=breaks)  # the law's check reads the breakpoints too
+    inside = (breaks > s[0]) & (breaks < s[-1])
+    if inside.any():  # hidden_dips, from the values just evaluated
+        k = np.clip(np.searchsorted(s, breaks[inside]), 1, s.size - 1)
+        dips = dips_between(s, breaks[inside], samples.extra_bound[inside],
+                            samples.bound[k - 1], samples.bound[k], cells=True)
+        if dips.size:
+            s = _cut_out_dips(s, dips)
+            samples = samples.on_grid(bound, s)
     for _ in range(NO_JERK_REFINEMENTS):
         if s.size > MAX_DEFAULT_NODES:
             break
@@ -92,7 +100,7 @@ def no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: flo
         w_max = nodes.copy()
         w_max[0], w_max[-1] = max(w_max[0], v0 * v0), max(w_max[-1], vf * vf)
         m = s.size
-        h = np.diff(s)  # the exact no-jerk optimum on this grid (speedplan.solve.nojerk)
+        h = s[1:] - s[:-1]  # the exact no-jerk optimum on this grid (speedplan.solve.nojerk)
         w = largest_under_rates(w_max, np.full(m - 1, lim.A) * h,
                                 np.full(m - 1, lim.A_decel) * h)
         lossy = (w >= nodes * (1.0 - 1e-9)) & (nodes < (1.0 - NO_JERK_BOUND_LOSS) * own)

@@ -510,10 +510,14 @@ def check_linear_law(law: TimeLaw, offset: float, path: Path,
             and (samples.s is s or np.array_equal(samples.s, s))):
         points, kappa, wb = samples.points, samples.curvature, samples.bound
     else:
+        samples = None
         points = cell_points(s)
         kappa, wb = _path_values(offset + points, path, bound)
-    kappa_b, wb_b = _path_values(offset + local, path, bound)
-    dw, h = np.diff(w), np.diff(s)
+    if samples is not None and np.array_equal(samples.extra, local):
+        kappa_b, wb_b = samples.extra_curvature, samples.extra_bound
+    else:
+        kappa_b, wb_b = _path_values(offset + local, path, bound)
+    dw, h = w[1:] - w[:-1], s[1:] - s[:-1]
     w_pts = np.empty(points.size)  # w on the chords, in the order of cell_points
     w_nodes, w_inner = cell_rows(w_pts)
     w_nodes[:] = w
