@@ -200,13 +200,15 @@ def _bounds(
     zone_list: list[SpeedZone], v_limit: VLimit | None, span_list: Sequence[SpanLimit] = (),
 ) -> FloatArray:
     """`speed_bounds` at ``q`` once the path's curvature there is known."""
-    w = np.full(q.shape, limits.v_max**2)
     kappa = np.abs(curvature)
-    with np.errstate(divide="ignore"):
-        if np.isfinite(limits.a_lat_max):
-            w = np.minimum(w, np.where(kappa > 0, limits.a_lat_max / kappa, np.inf))
-        if np.isfinite(limits.yaw_rate_max):  # |κ| v <= ω
-            w = np.minimum(w, np.where(kappa > 0, (limits.yaw_rate_max / kappa) ** 2, np.inf))
+    curved = kappa > 0  # elsewhere (0 or NaN) no lateral term
+    w = np.full(q.shape, limits.v_max**2)
+    if np.isfinite(limits.a_lat_max):
+        lateral = np.divide(limits.a_lat_max, kappa, out=np.full(q.shape, np.inf), where=curved)
+        np.minimum(w, lateral, out=w)
+    if np.isfinite(limits.yaw_rate_max):  # |κ| v <= ω
+        yaw = np.divide(limits.yaw_rate_max, kappa, out=np.full(q.shape, np.inf), where=curved)
+        np.minimum(w, yaw * yaw, out=w)
     if zone_list:
         xy = path.point(q)
         for zone in zone_list:

@@ -298,6 +298,10 @@ class Path:
         """``attr`` of each piece at the points located on it (``q``, ``idx``: `_locate`)."""
         flat, fidx = q.ravel(), idx.ravel()
         trailing = (2,) if attr == "point" else ()
+        if len(self.pieces) == 1:  # no grouping (a NURBS edge, a spline)
+            one = np.asarray(getattr(self.pieces[0], attr)(flat - self.offsets[0]),
+                             dtype=np.float64)
+            return one.reshape(q.shape + trailing)
         out = np.empty(flat.shape + trailing)
         # Group by piece with one stable sort (a mask per piece is O(pieces x points)).
         order = np.argsort(fidx, kind="stable")

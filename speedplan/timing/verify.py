@@ -531,7 +531,10 @@ def check_linear_law(law: TimeLaw, offset: float, path: Path,
     lateral = (k_abs * w_pts, k_abs_b * w_b)
     yaw2 = (k_abs * lateral[0], k_abs_b * lateral[1])
     accel = 0.5 * (dw / h)  # constant on each cell, both its pieces
-    k_v, k_lat, k_yaw = (_first_peak(x, points) for x in (speed2, lateral, yaw2))
+    # Where a limit is not set only the maximum is reported: any of its points will do.
+    k_v, k_lat, k_yaw = (_first_peak(x, points, locate) for x, locate in (
+        (speed2, True), (lateral, np.isfinite(limits.a_lat_max)),
+        (yaw2, np.isfinite(limits.yaw_rate_max))))
     if k_v is None or k_lat is None or k_yaw is None or not np.isfinite(accel).all():
         return None
     first = float(offset + points[0])
@@ -564,12 +567,12 @@ def check_linear_law(law: TimeLaw, offset: float, path: Path,
     return LegCheck(check, excess, knots)
 
 
-def _first_peak(parts: tuple[FloatArray, FloatArray], points: FloatArray
-                ) -> tuple[int, int] | None:
+def _first_peak(parts: tuple[FloatArray, FloatArray], points: FloatArray,
+                locate: bool = True) -> tuple[int, int] | None:
     """Where the largest value lies: ``(0, i)`` at ``points[i]``, ``(1, i)`` at breakpoint ``i``.
 
     Among equal values the first along the path, points before breakpoints (the order of
-    `check_pieces`). ``None`` if a value is not finite.
+    `check_pieces`); any of them unless ``locate``. ``None`` if a value is not finite.
     """
     main, brk = parts
     top = main.max()
@@ -578,6 +581,8 @@ def _first_peak(parts: tuple[FloatArray, FloatArray], points: FloatArray
         return None
     if top_b > top:
         return 1, int(np.argmax(brk))
+    if not locate:
+        return 0, int(np.argmax(main))
     # The first tie of each row of `cell_points` (each in the cells' order), then the first
     # of these along the path.
     at = main == top
