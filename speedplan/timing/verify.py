@@ -15,6 +15,7 @@ The quantities come from `speedplan.core.kinematics`, with ``κ'`` the path's ex
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 
@@ -177,6 +178,8 @@ class Verification:
         else:
             records = {c.name: c for c in checks}
         object.__setattr__(self, "checks", records)
+        # Read after every check of a plan: computed once (the records are immutable).
+        object.__setattr__(self, "_ok", not any(c.exceeded for c in records.values()))
 
     # Shorthands for entries of ``maxima``, documented in the class docstring.
     max_speed = Forwarded[float]("maxima", key="speed")
@@ -213,7 +216,7 @@ class Verification:
     @property
     def ok(self) -> bool:
         """Whether every ratio is within its tolerance."""
-        return not any(c.exceeded for c in self.checks.values())
+        return bool(self.__dict__["_ok"])
 
     def summary(self) -> str:
         """One line per limit: realised ratio, tolerance and where.
@@ -575,9 +578,9 @@ def _first_peak(parts: tuple[FloatArray, FloatArray], points: FloatArray,
     `check_pieces`); any of them unless ``locate``. ``None`` if a value is not finite.
     """
     main, brk = parts
-    top = main.max()
-    top_b = brk.max() if brk.size else -np.inf
-    if not (np.isfinite(top) and (np.isfinite(top_b) or top_b == -np.inf)):
+    top = float(main.max())
+    top_b = float(brk.max()) if brk.size else -math.inf
+    if not (math.isfinite(top) and (math.isfinite(top_b) or top_b == -math.inf)):
         return None
     if top_b > top:
         return 1, int(np.argmax(brk))
