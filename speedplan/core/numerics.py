@@ -5,7 +5,7 @@ Quadrature rules, angle wrapping, the points inside the cells of a grid.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -70,6 +70,8 @@ def wrap_heading(theta: Any) -> FloatArray:
     return out
 
 
+_Scalar = TypeVar("_Scalar", bound=np.generic)
+
 #: Points per grid cell at which the speed bound is evaluated: the model's node bounds (the
 #: bound's minimum over each cell) and the check of a law without jerk limit.
 CELL_POINTS = 8
@@ -99,8 +101,8 @@ def cell_points(s: FloatArray, per_cell: int = CELL_POINTS) -> FloatArray:
     return out
 
 
-def cell_rows(values: npt.NDArray[Any], per_cell: int = CELL_POINTS
-              ) -> tuple[npt.NDArray[Any], npt.NDArray[Any]]:
+def cell_rows(values: npt.NDArray[_Scalar], per_cell: int = CELL_POINTS
+              ) -> tuple[npt.NDArray[_Scalar], npt.NDArray[_Scalar]]:
     """``values`` at the `cell_points` of a grid as ``(nodes, inner)``.
 
     Shapes ``(n,)`` and ``(per_cell - 1, n - 1)``; views, not copies: ``inner[k - 1, i]`` is

@@ -413,7 +413,7 @@ class CellSamples:
     >>> from speedplan.geometry import Arc, CellSamples, Line, Path, SpeedBound
     >>> p = Path.from_segments([Line(2.0), Arc(radius=2.0, angle=1.0)])
     >>> bound = SpeedBound(p, Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
-    >>> smp = CellSamples.of(bound, np.array([0.0, 2.0, 4.0]))
+    >>> smp = CellSamples.of(bound, np.array([0.0, 1.0, 4.0]))
     >>> smp.points.size, smp.bound[:3].tolist()  # the nodes first (see cell_points)
     (17, [4.0, 4.0, 2.0])
     """
