@@ -24,7 +24,11 @@ Prints, in order:
    (``solve_problem(problem, refine="never", backend="auto")``), and
    ``profile_from_waypoints`` on the route.
 3. ``plan(j_max=inf)`` against TOPP-RA's ``compute_trajectory`` (toppra, 1-DOF path ``q = s``
-   with the same speed bound per node and the same grid: the same discrete problem).
+   with the same speed bound per node and the same grid: the same discrete problem) and
+   copp-py's TOPP2-RA (``copp2_time``), ours and copp's alternating over ``--rounds``;
+   *bound*: one evaluation of the curvature and the speed bound at the 8 points per cell of
+   the plan's grid (`cell_points`), which every plan needs for its node bounds and its check.
+   With ``--baseline TREE`` also the speedplan in TREE (a worker process), alternating.
 4. copp-py's jerk-limited TOPP3 (``topp3_socp``) on the same grids, when it is installed.
 5. ``import speedplan`` (subprocess, median of ``--import-runs``) and the first ``plan()`` in
    a fresh process with an empty numba cache (``NUMBA_CACHE_DIR`` in a temporary directory).
@@ -286,9 +290,79 @@ def copp2_time(s: np.ndarray, w_max: np.ndarray, lim: sp.Limits,
     return median_time(run, repeats), duration
 
 
-def section_toppra(repeats: int) -> None:
+def nojerk_cases() -> list[tuple[str, sp.Path, sp.Limits, dict[str, Any]]]:
+    """Section 3's cases: those of `cases` but the braking start, without a jerk limit."""
+    return [(name, path, sp.Limits(v_max=lim.v_max, a_max=lim.a_max, a_lat_max=lim.a_lat_max,
+                                   j_max=math.inf), kw)
+            for name, path, lim, kw in cases()[:-1]]
+
+
+class Baseline:
+    """``plan(j_max=inf)`` timed in a worker process that imports speedplan from ``tree``.
+
+    The worker is this script (``--nojerk-worker``) with ``PYTHONPATH=tree``: it answers a
+    line ``case repeats`` with the median time of that many calls of section 3's case and its
+    duration, so that section 3 times the two versions alternately, in one run.
+    """
+
+    def __init__(self, tree: str) -> None:
+        env = {**os.environ, "PYTHONPATH": os.path.abspath(tree)}
+        self.proc = subprocess.Popen([sys.executable, __file__, "--nojerk-worker"], env=env,
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.where = self._ask("where")
+
+    def _ask(self, line: str) -> str:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(line + "\n")
+        self.proc.stdin.flush()
+        return self.proc.stdout.readline().strip()
+
+    def time(self, case: int, repeats: int) -> tuple[float, float]:
+        """Median time [s] of ``repeats`` plans of case ``case``, and the plan's duration."""
+        t, duration = self._ask(f"{case} {repeats}").split()
+        return float(t), float(duration)
+
+    def close(self) -> None:
+        self._ask("quit")
+        self.proc.wait()
+
+
+def nojerk_worker() -> None:
+    """The loop of `Baseline`'s worker process."""
+    work = nojerk_cases()
+    for line in sys.stdin:
+        if line.strip() == "where":
+            print(os.path.dirname(sp.__file__), flush=True)
+            continue
+        if line.strip() == "quit":
+            print("bye", flush=True)
+            return
+        case, repeats = (int(x) for x in line.split())
+        _, path, lim, kw = work[case]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            duration = sp.plan(path, lim, **kw).duration
+            t = median_time(lambda p=path, li=lim, k=kw: sp.plan(p, li, **k), repeats)
+        print(f"{t!r} {duration!r}", flush=True)
+
+
+def bound_time(path: sp.Path, lim: sp.Limits, kw: dict[str, Any], s: np.ndarray,
+               repeats: int) -> float:
+    """One evaluation of the curvature and the speed bound at the `cell_points` of ``s``.
+
+    What every no-jerk plan computes at least once on its final grid: its node bounds and
+    its check both need them.
+    """
+    from speedplan.core.numerics import cell_points
+    from speedplan.geometry import SpeedBound
+
+    points = cell_points(s)
+    return median_time(lambda: SpeedBound(path, lim, kw.get("zones")).evaluate(points), repeats)
+
+
+def section_toppra(repeats: int, rounds: int = 1, baseline: str | None = None) -> None:
     print(f"\n== 3. plan(j_max=inf) against TOPP-RA compute_trajectory and copp-py TOPP2-RA "
-          f"(whole calls), medians of {repeats} ==")
+          f"(whole calls), medians of {repeats} calls, then of {rounds} alternating rounds ==")
     try:
         import copp_py  # noqa: F401
         have_copp = True
@@ -296,21 +370,44 @@ def section_toppra(repeats: int) -> None:
         have_copp = False
         print("copp-py is not installed (pip install copp-py, or the bench extra): its "
               "columns are skipped")
-    print(f"{'case':<22} {'n':>5} {'ours [ms]':>10} {'toppra [ms]':>12} {'ratio':>7}"
-          f" {'copp2 [ms]':>11} {'ratio':>7} {'T ours':>9} {'T toppra':>9} {'T copp2':>9}")
-    for name, path, lim, kw in cases()[:-1]:
-        nojerk = sp.Limits(v_max=lim.v_max, a_max=lim.a_max, a_lat_max=lim.a_lat_max,
-                           j_max=math.inf)
-        prof, t_ours, p = plan_and_problem(path, nojerk, kw, repeats)
+    before = Baseline(baseline) if baseline else None
+    if before is not None:
+        print(f"before: speedplan from {before.where}")
+    print(f"{'case':<22} {'n':>5} {'ours [ms]':>10}"
+          + (f" {'before [ms]':>11} {'speed-up':>8}" if before else "")
+          + f" {'bound [ms]':>10} {'toppra [ms]':>12} {'ratio':>7}"
+          f" {'copp2 [ms]':>11} {'ratio':>7} {'T ours':>9}"
+          + (f" {'T before':>9}" if before else "") + f" {'T toppra':>9} {'T copp2':>9}")
+    for i, (name, path, nojerk, kw) in enumerate(nojerk_cases()):
+        prof, _, p = plan_and_problem(path, nojerk, kw, 1)
         if p is None:
             print(f"{name:<22} skipped: several legs")
             continue
-        t_ta, dur_ta = toppra_time(p.s, p.w_max, lim.a_max, repeats)
-        t_c2, dur_c2 = copp2_time(p.s, p.w_max, nojerk, repeats) if have_copp else (
-            math.nan, math.nan)
-        print(f"{name:<22} {p.n:>5} {1e3 * t_ours:>10.2f} {1e3 * t_ta:>12.2f}"
-              f" {t_ta / t_ours:>7.1f} {1e3 * t_c2:>11.2f} {t_c2 / t_ours:>7.2f}"
-              f" {prof.duration:>9.3f} {dur_ta:>9.3f} {dur_c2:>9.3f}")
+        ours, old, copp = [], [], []
+        dur_old = dur_c2 = math.nan
+        for _ in range(rounds):  # the versions alternate: the load they see is alike
+            ours.append(plan_and_problem(path, nojerk, kw, repeats)[1])
+            if before is not None:
+                t_old, dur_old = before.time(i, repeats)
+                old.append(t_old)
+            if have_copp:
+                t_c2, dur_c2 = copp2_time(p.s, p.w_max, nojerk, repeats)
+                copp.append(t_c2)
+        t_ours = statistics.median(ours)
+        t_c2 = statistics.median(copp) if copp else math.nan
+        t_bound = bound_time(path, nojerk, kw, p.s, repeats)
+        t_ta, dur_ta = toppra_time(p.s, p.w_max, nojerk.a_max, repeats)
+        line = f"{name:<22} {p.n:>5} {1e3 * t_ours:>10.2f}"
+        if before is not None:
+            t_old = statistics.median(old)
+            line += f" {1e3 * t_old:>11.2f} {t_old / t_ours:>8.2f}"
+        line += (f" {1e3 * t_bound:>10.2f} {1e3 * t_ta:>12.2f} {t_ta / t_ours:>7.1f}"
+                 f" {1e3 * t_c2:>11.2f} {t_c2 / t_ours:>7.2f} {prof.duration:>9.3f}")
+        if before is not None:
+            line += f" {dur_old:>9.3f}"
+        print(line + f" {dur_ta:>9.3f} {dur_c2:>9.3f}")
+    if before is not None:
+        before.close()
 
 
 # --- 4. copp-py ------------------------------------------------------------------------------
@@ -624,7 +721,14 @@ def main(argv: list[str] | None = None) -> None:
                     help="section 5: plans per process in the cold-start runs")
     ap.add_argument("--only", nargs="+", type=int, choices=range(1, 9),
                     help="run only these sections")
+    ap.add_argument("--baseline", metavar="TREE",
+                    help="section 3: also time plan() of the speedplan in TREE (a checkout's "
+                         "root), alternating with this one in --rounds rounds")
+    ap.add_argument("--nojerk-worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.nojerk_worker:
+        nojerk_worker()
+        return
     repeats = 3 if args.quick else args.repeats
     sizes = [1000, 10000] if args.quick else [10000, 100000]
     only = set(args.only or range(1, 9))
@@ -636,7 +740,7 @@ def main(argv: list[str] | None = None) -> None:
     if 2 in only:
         section_overhead(repeats)
     if 3 in only:
-        section_toppra(repeats)
+        section_toppra(repeats, 1 if args.quick else args.rounds, args.baseline)
     if 4 in only:
         section_copp(repeats)
     if 5 in only:

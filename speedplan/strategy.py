@@ -421,7 +421,8 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
     """
     profile = SpeedProfile(path=request.path, limits=request.limits, legs=tuple(legs),
                            speed_bound=model.bound, request=request)
-    leg_checks = [profile.check_leg(i) for i in range(len(legs))]
+    leg_checks = [profile.check_leg(i, leg.samples if isinstance(leg, Leg) else None)
+                  for i, leg in enumerate(model.legs)]
     stuck: set[int] = set()  # legs whose refined law did not arrive: retrying repeats it
     for _ in range(MAX_REFINEMENTS):
         if all(c.verification.ok for c in leg_checks):

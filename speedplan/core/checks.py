@@ -6,6 +6,7 @@ argument, shows the offending value and says what to do.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from typing import Any, TypeVar
 
@@ -69,12 +70,14 @@ def as_array(
         )
     if length is not None and arr.shape[0] != length:
         raise InvalidInputError(f"`{name}` must have length {length}; got {arr.shape[0]}")
+    if np.isfinite(arr).all():  # one pass in the common case; the culprit named otherwise
+        return arr
     if np.isnan(arr).any():
         raise InvalidInputError(f"`{name}` contains NaN; pass finite numbers")
     if allow_inf:
         if np.isneginf(arr).any():
             raise InvalidInputError(f"`{name}` contains -inf; pass finite numbers or +inf")
-    elif not np.isfinite(arr).all():
+    else:
         raise InvalidInputError(f"`{name}` contains inf; pass finite numbers")
     return arr
 
@@ -90,8 +93,10 @@ def as_scalar(
     """Return ``value`` as a float after checking sign and finiteness."""
     if isinstance(value, bool):
         raise InvalidInputError(f"`{name}` must be a number; got {shown(value)}")
-    arr = as_array(name, value, ndim=0, allow_inf=allow_inf)
-    x = float(arr)
+    if type(value) is float and math.isfinite(value):  # the common case, without an array
+        x = value
+    else:
+        x = float(as_array(name, value, ndim=0, allow_inf=allow_inf))
     if positive and not x > 0:
         raise InvalidInputError(f"`{name}` must be > 0; got {x!r}")
     if nonnegative and not x >= 0:

@@ -1,15 +1,19 @@
-"""Numerics shared by the layers, one definition each: quadrature rules, angle wrapping."""
+"""Numerics shared by the layers, one definition each.
+
+Quadrature rules, angle wrapping, the points inside the cells of a grid.
+"""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
+import numpy.typing as npt
 
 from .checks import FloatArray
 
-__all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "SHORT_NODES", "SHORT_WEIGHTS", "gauss_legendre",
-           "wrap_angle", "wrap_heading"]
+__all__ = ["CELL_POINTS", "GAUSS_NODES", "GAUSS_WEIGHTS", "SHORT_NODES", "SHORT_WEIGHTS",
+           "cell_points", "cell_rows", "gauss_legendre", "wrap_angle", "wrap_heading"]
 
 
 def gauss_legendre(points: int) -> tuple[np.ndarray, np.ndarray]:
@@ -64,3 +68,52 @@ def wrap_heading(theta: Any) -> FloatArray:
     # Rounding can bring a wrapped value up to π itself.
     out: FloatArray = np.where(wrapped >= np.pi, -np.pi, wrapped)
     return out
+
+
+_Scalar = TypeVar("_Scalar", bound=np.generic)
+
+#: Points per grid cell at which the speed bound is evaluated: the model's node bounds (the
+#: bound's minimum over each cell) and the check of a law without jerk limit.
+CELL_POINTS = 8
+
+
+def cell_points(s: FloatArray, per_cell: int = CELL_POINTS) -> FloatArray:
+    """``per_cell`` equally spaced points of every cell of the grid ``s``, nodes first.
+
+    The nodes ``s`` (every cell's first point, and the grid's end), then for each
+    ``k = 1 .. per_cell - 1`` the ``k``-th point ``s_i + h_i k / per_cell`` of every cell
+    ``i`` (``h = diff(s)``): ``per_cell (n - 1) + 1`` points, each row of ``n - 1`` in the
+    cells' order (`cell_rows` views them so). A cell's points depend only on its own two
+    nodes: a grid that keeps a cell keeps its points to the last bit.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> cell_points(np.array([0.0, 1.0, 3.0]), 4).tolist()
+    [0.0, 1.0, 3.0, 0.25, 1.5, 0.5, 2.0, 0.75, 2.5]
+    """
+    n = s.size
+    out = np.empty(per_cell * (n - 1) + 1)
+    out[:n] = s
+    rows = out[n:].reshape(per_cell - 1, n - 1)
+    np.multiply((np.arange(1, per_cell) / per_cell)[:, None], s[1:] - s[:-1], out=rows)
+    rows += s[:-1]
+    return out
+
+
+def cell_rows(values: npt.NDArray[_Scalar], per_cell: int = CELL_POINTS
+              ) -> tuple[npt.NDArray[_Scalar], npt.NDArray[_Scalar]]:
+    """``values`` at the `cell_points` of a grid as ``(nodes, inner)``.
+
+    Shapes ``(n,)`` and ``(per_cell - 1, n - 1)``; views, not copies: ``inner[k - 1, i]`` is
+    the value at the ``k``-th point of cell ``i``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> nodes, inner = cell_rows(cell_points(np.array([0.0, 1.0, 3.0]), 4), 4)
+    >>> nodes.tolist(), inner[:, 1].tolist()
+    ([0.0, 1.0, 3.0], [1.5, 2.0, 2.5])
+    """
+    n = (values.size - 1) // per_cell + 1
+    return values[:n], values[n:].reshape(per_cell - 1, n - 1)

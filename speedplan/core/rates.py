@@ -26,14 +26,18 @@ def cumulative(step: FloatArray) -> FloatArray:
     >>> cumulative(np.array([1.0, 2.0, 3.0])).tolist()
     [0.0, 1.0, 3.0, 6.0]
     """
-    out: FloatArray = np.concatenate(([0.0], np.cumsum(step)))
+    out: FloatArray = np.empty(step.size + 1)
+    out[0] = 0.0
+    np.cumsum(step, out=out[1:])
     return out
 
 
 def _forward(bound: FloatArray, up: FloatArray) -> FloatArray:
     c = cumulative(up)
-    out: FloatArray = c + np.minimum.accumulate(bound - c)
-    return np.minimum(out, bound)
+    out: FloatArray = bound - c
+    np.minimum.accumulate(out, out=out)
+    out += c
+    return np.minimum(out, bound, out=out)
 
 
 def largest_under_rates(bound: FloatArray, up: FloatArray, down: FloatArray) -> FloatArray:

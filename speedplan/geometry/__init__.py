@@ -16,12 +16,13 @@ Modules, one job each:
 * `nurbs` — NURBS (VDA 5050 ``trajectory``);
 * `bounds` — [`speed_bounds`][speedplan.speed_bounds] ``mu+(s)``, `SpeedBound`,
   [`SpeedZone`][speedplan.SpeedZone], [`SpanLimit`][speedplan.SpanLimit], `zone_intervals`,
-  `bound_breakpoints`.
+  `bound_breakpoints`, `CellSamples`.
 
-This layer imports only ``errors``, ``_checks`` and ``limits``.
+This layer imports only from `speedplan.core`.
 """
 
 from .bounds import (
+    CellSamples,
     SpanLimit,
     SpeedBound,
     SpeedZone,
@@ -33,6 +34,7 @@ from .path import Arc, Clothoid, Line, Path, PathSamples
 
 __all__ = [
     "Arc",
+    "CellSamples",
     "Clothoid",
     "Line",
     "Path",

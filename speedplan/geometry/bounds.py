@@ -13,10 +13,12 @@ from numpy.typing import ArrayLike
 from ..core.checks import FloatArray, as_array, as_scalar, instances
 from ..core.errors import InvalidInputError
 from ..core.limits import Limits
+from ..core.numerics import CELL_POINTS, cell_points, cell_rows
 from ..core.options import VLimit
 from .path import Path
 
-__all__ = ["ZONE_RESCAN", "SpanLimit", "SpeedBound", "SpeedZone", "bound_breakpoints",
+__all__ = ["ZONE_RESCAN", "CellSamples", "SpanLimit", "SpeedBound", "SpeedZone",
+           "bound_breakpoints",
            "check_spans", "check_zones", "speed_bounds", "zone_intervals"]
 
 
@@ -198,13 +200,15 @@ def _bounds(
     zone_list: list[SpeedZone], v_limit: VLimit | None, span_list: Sequence[SpanLimit] = (),
 ) -> FloatArray:
     """`speed_bounds` at ``q`` once the path's curvature there is known."""
-    w = np.full(q.shape, limits.v_max**2)
     kappa = np.abs(curvature)
-    with np.errstate(divide="ignore"):
-        if np.isfinite(limits.a_lat_max):
-            w = np.minimum(w, np.where(kappa > 0, limits.a_lat_max / kappa, np.inf))
-        if np.isfinite(limits.yaw_rate_max):  # |κ| v <= ω
-            w = np.minimum(w, np.where(kappa > 0, (limits.yaw_rate_max / kappa) ** 2, np.inf))
+    curved = kappa > 0  # elsewhere (0 or NaN) no lateral term
+    w = np.full(q.shape, limits.v_max**2)
+    if np.isfinite(limits.a_lat_max):
+        lateral = np.divide(limits.a_lat_max, kappa, out=np.full(q.shape, np.inf), where=curved)
+        np.minimum(w, lateral, out=w)
+    if np.isfinite(limits.yaw_rate_max):  # |κ| v <= ω
+        yaw = np.divide(limits.yaw_rate_max, kappa, out=np.full(q.shape, np.inf), where=curved)
+        np.minimum(w, yaw * yaw, out=w)
     if zone_list:
         xy = path.point(q)
         for zone in zone_list:
@@ -301,6 +305,14 @@ class SpeedBound:
             return kappa, self._given(q, kappa)
         return self.memo.lookup(q, self._fresh)
 
+    def evaluate(self, s: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The path's curvature [1/m] and the bound [m²/s²] at arc lengths ``s`` [m], computed.
+
+        `curvature_and_bound` without its memo and its check of ``s`` (callers that evaluate
+        every position once, such as `CellSamples`).
+        """
+        return self._fresh(np.asarray(s, dtype=np.float64) + self.offset)
+
     def _fresh(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
         kappa = np.asarray(self.path.curvature(q), dtype=np.float64)
         return kappa, self._given(q, kappa)
@@ -368,6 +380,98 @@ class BoundMemo:
 
     def __reduce__(self) -> tuple[type[BoundMemo], tuple[()]]:
         return (BoundMemo, ())
+
+
+@dataclass(frozen=True, eq=False)
+class CellSamples:
+    """A speed bound and the path's curvature at the `cell_points` of a grid.
+
+    What a plan without jerk limit evaluates once and reads twice: its model takes the node
+    bounds from it (the bound's minimum over each cell, `speedplan.model.rows.node_minima`)
+    and its check reads the speed bound, lateral acceleration and yaw rate of the law at the
+    same points (`speedplan.timing.verify.check_law`).
+
+    Attributes
+    ----------
+    s : ndarray
+        The grid [m], in the bound's own arc length (from its offset).
+    offset : float
+        The bound's offset on the path [m] (`SpeedBound.offset`): the points lie at
+        ``offset + points`` of the path.
+    points : ndarray
+        ``cell_points(s)`` [m].
+    curvature, bound : ndarray
+        The path's curvature [1/m] and the bound [m²/s²] at the points.
+    extra, extra_curvature, extra_bound : ndarray
+        Further positions [m] (the bound's breakpoints, `bound_breakpoints`) and the same
+        two quantities there; empty by default.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan import Limits
+    >>> from speedplan.geometry import Arc, CellSamples, Line, Path, SpeedBound
+    >>> p = Path.from_segments([Line(2.0), Arc(radius=2.0, angle=1.0)])
+    >>> bound = SpeedBound(p, Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    >>> smp = CellSamples.of(bound, np.array([0.0, 1.0, 4.0]))
+    >>> smp.points.size, smp.bound[:3].tolist()  # the nodes first (see cell_points)
+    (17, [4.0, 4.0, 2.0])
+    """
+
+    s: FloatArray
+    offset: float
+    points: FloatArray
+    curvature: FloatArray
+    bound: FloatArray
+    extra: FloatArray = field(default_factory=lambda: np.zeros(0))
+    extra_curvature: FloatArray = field(default_factory=lambda: np.zeros(0))
+    extra_bound: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+    @classmethod
+    def of(cls, bound: SpeedBound, s: FloatArray, extra: FloatArray | None = None
+           ) -> CellSamples:
+        """The samples of ``bound`` on the grid ``s`` (and at ``extra``), all evaluated."""
+        points = cell_points(s)
+        more = np.zeros(0) if extra is None else extra
+        kappa, w = bound.evaluate(np.concatenate((points, more)))
+        m = points.size
+        return cls(s, bound.offset, points, kappa[:m], w[:m], more, kappa[m:], w[m:])
+
+    def on_grid(self, bound: SpeedBound, s: FloatArray) -> CellSamples:
+        """The samples of ``bound`` on the grid ``s``, evaluated only where ``self`` lacks them.
+
+        A node of ``s`` that is a node of ``self.s``, and a cell of ``s`` between two
+        consecutive nodes of ``self.s``, have the same points to the last bit
+        (`cell_points`): their values are taken from ``self``. ``bound`` must be the one
+        ``self`` sampled.
+        """
+        if bound.offset != self.offset:
+            raise InvalidInputError(
+                f"`bound` is read from offset {bound.offset!r}; the samples from {self.offset!r}")
+        old = self.s
+        points = cell_points(s)
+        at = np.minimum(np.searchsorted(old, s), old.size - 1)
+        same = old[at] == s
+        kept = same[:-1] & same[1:] & (at[1:] == at[:-1] + 1)
+        new_nodes, new_cells = np.flatnonzero(~same), np.flatnonzero(~kept)
+        nodes, inner = cell_rows(points)
+        kappa, w = bound.evaluate(np.concatenate((nodes[new_nodes],
+                                                  inner[:, new_cells].ravel())))
+        # Where each point's value is, in ``self``'s values followed by the fresh ones (both
+        # in the order of `cell_points`): one gather per quantity.
+        m, n_old = self.points.size, old.size
+        fresh_node = m + np.cumsum(~same) - 1
+        fresh_cell = m + new_nodes.size + np.cumsum(~kept) - 1
+        index = np.empty(points.size, dtype=np.intp)
+        idx_nodes, idx_inner = cell_rows(index)
+        idx_nodes[:] = np.where(same, at, fresh_node)
+        base = np.where(kept, n_old + at[:-1], fresh_cell)
+        stride = np.where(kept, n_old - 1, new_cells.size)
+        np.multiply(np.arange(CELL_POINTS - 1)[:, None], stride, out=idx_inner)
+        idx_inner += base
+        out = [np.concatenate((own, fresh))[index]
+               for own, fresh in ((self.curvature, kappa), (self.bound, w))]
+        return replace(self, s=s, points=points, curvature=out[0], bound=out[1])
 
 
 def _check_v_limit(v_limit: VLimit) -> tuple[FloatArray, FloatArray]:

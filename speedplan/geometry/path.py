@@ -157,12 +157,15 @@ class Path:
         q = as_array("s", s)
         L = self.length
         tol = S_TOLERANCE * L
-        if q.size and (q.min() < -tol or q.max() > L + tol):
-            bad = q[(q < -tol) | (q > L + tol)][0]
-            raise InvalidInputError(
-                f"`s` must lie in [0, length] = [0, {L:.9g}] m; got {bad!r}"
-            )
-        q = np.clip(q, 0.0, L)
+        if q.size:
+            lo, hi = q.min(), q.max()
+            if lo < -tol or hi > L + tol:
+                bad = q[(q < -tol) | (q > L + tol)][0]
+                raise InvalidInputError(
+                    f"`s` must lie in [0, length] = [0, {L:.9g}] m; got {bad!r}"
+                )
+            if lo < 0.0 or hi > L:  # within the tolerance: clipped (else already inside)
+                q = np.clip(q, 0.0, L)
         idx = np.clip(np.searchsorted(self.offsets, q, side="right") - 1, 0, len(self.pieces) - 1)
         return q, idx
 
@@ -295,6 +298,10 @@ class Path:
         """``attr`` of each piece at the points located on it (``q``, ``idx``: `_locate`)."""
         flat, fidx = q.ravel(), idx.ravel()
         trailing = (2,) if attr == "point" else ()
+        if len(self.pieces) == 1:  # no grouping (a NURBS edge, a spline)
+            one = np.asarray(getattr(self.pieces[0], attr)(flat - self.offsets[0]),
+                             dtype=np.float64)
+            return one.reshape(q.shape + trailing)
         out = np.empty(flat.shape + trailing)
         # Group by piece with one stable sort (a mask per piece is O(pieces x points)).
         order = np.argsort(fidx, kind="stable")

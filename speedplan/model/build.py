@@ -21,11 +21,11 @@ import numpy as np
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
 from ..core.options import RestReason
-from ..geometry import SpeedBound
+from ..geometry import CellSamples, SpeedBound
 from ..solve.problem import MAX_RAMP_STEPS, DiscreteProblem, ramp_steps
 from .boundary import STATE_JERK_ROUNDING, check_reachable_states, turnaround_speed
 from .grid import MIN_NODES
-from .leg_grid import default_grid, grid_anchors, leg_grid
+from .leg_grid import default_grid, grid_anchors, leg_grid, no_jerk_grid
 from .legs import ForcedLeg, Leg, Model, Rest, StraightLeg, TimeLawSpec
 from .request import STATE_ROUNDING, PlanRequest, within_limit
 from .rows import (
@@ -35,6 +35,7 @@ from .rows import (
     lateral_jerk_rows,
     lateral_speed_caps,
     node_bounds,
+    node_minima,
 )
 from .standstill import calibrate_standstill_rows
 from .straight import constant_bound, straight_applies, straight_motion
@@ -218,6 +219,9 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
     """The discrete problem of the stretch ``[lo, hi]`` of the request's path."""
     leg_bound = bound if (lo == 0.0 and hi == float(request.path.length)) else _sub_bound(
         request, bound, lo, hi)
+    if request.n is None and request.ds is None and not request.jerk_limited:
+        samples = no_jerk_grid(request, leg_bound, hi - lo, v0, vf)  # the bound comes with it
+        return leg_on_grid(request, leg_bound, samples.s, lo, v0, a0, vf, af, samples=samples)
     s = leg_grid(request, leg_bound, lo, hi, v0, a0, vf, af)
     if request.n is None and request.ds is None and request.jerk_limited:
         leg = leg_on_grid(request, leg_bound, s, lo, v0, a0, vf, af)
@@ -232,12 +236,24 @@ def build_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0:
 
 
 def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: float, v0: float,
-                a0: float, vf: float, af: float) -> Leg:
-    """The leg's discrete problem on the grid ``s`` (from 0 to the leg's length)."""
+                a0: float, vf: float, af: float, samples: CellSamples | None = None) -> Leg:
+    """The leg's discrete problem on the grid ``s`` (from 0 to the leg's length).
+
+    A leg whose law is linear in ``w`` (no jerk nor lateral-jerk limit) keeps the bound at the
+    grid's `cell_points` (``samples``, evaluated here unless given for ``s``): its node
+    bounds come from them, and its law's check reads them (`Leg.samples`).
+    """
     lim = request.limits
     length = float(s[-1])
     env = Envelopes.of(request, v0, a0, vf, af, length)
-    w_max = env.cap(s, node_bounds(bound, s))
+    linear = not (request.jerk_limited or np.isfinite(lim.j_lat_max))
+    if linear:
+        if samples is None or samples.s is not s:
+            samples = CellSamples.of(bound, s)
+        w_max = env.cap(s, node_minima(samples.bound))
+    else:
+        samples = None
+        w_max = env.cap(s, node_bounds(bound, s))
     w_max[0] = max(w_max[0], v0 * v0)
     w_max[-1] = max(w_max[-1], vf * vf)
     if (w_max[1:-1] <= 0).any():
@@ -278,11 +294,12 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
         accel_start=a0 if v0 > 0 and request.jerk_limited else None,
         accel_end=af if vf > 0 and request.jerk_limited else None,
         # Without jerk (and lateral-jerk) rows nothing bounds the law's bend: on the chords.
-        linear=not (request.jerk_limited or np.isfinite(lim.j_lat_max)),
+        linear=linear,
     )
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
-               backend=request.backend, anchors=grid_anchors(request, lo, lo + length))
+               backend=request.backend, anchors=grid_anchors(request, lo, lo + length),
+               samples=samples)
 
 
 def _zero_cause(bound: SpeedBound) -> str:
@@ -301,7 +318,7 @@ def _end_speeds(request: PlanRequest, bound: SpeedBound, length: float) -> PlanR
     A speed above the bound by at most `STATE_ROUNDING` is
     taken at the bound (a state read off a plan: the time law's rounding).
     """
-    ends = np.sqrt(bound(np.array([0.0, length])))
+    ends = np.sqrt(bound.evaluate(np.array([0.0, length]))[1])
     v0, vf = (within_limit(name, v, float(b), "m/s", f"the speed bound at s={where:.6g} m "
                            "(v_max, lateral acceleration, a zone or v_limit)")
               for name, v, b, where in (("v0", request.v0, ends[0], 0.0),

@@ -57,6 +57,7 @@ __all__ = [
     "PAD_CELLS",
     "TOP_SPEED_PROBES",
     "adaptive_grid",
+    "dips_between",
     "graded_ends",
     "graded_steps",
     "hidden_dips",
@@ -577,10 +578,20 @@ def hidden_dips(sf: FloatArray, breaks: FloatArray,
     if breaks.size == 0:
         return breaks
     k = np.clip(np.searchsorted(sf, breaks), 1, sf.size - 1)
-    wb = w_bound(np.concatenate((breaks, sf[k - 1], sf[k])))
-    at, left, right = np.split(wb, 3)
+    at, left, right = np.split(w_bound(np.concatenate((breaks, sf[k - 1], sf[k]))), 3)
+    return dips_between(sf, breaks, at, left, right, cells=cells)
+
+
+def dips_between(sf: FloatArray, breaks: FloatArray, at: FloatArray, left: FloatArray,
+                 right: FloatArray, cells: bool = False) -> FloatArray:
+    """`hidden_dips` from the bound's values at the breakpoints and their scan points.
+
+    ``at``: the bound at the ``breaks`` (all inside ``(sf[0], sf[-1])``); ``left`` and
+    ``right``: at the scan points before and after each.
+    """
     dip = at < HIDDEN_DIP * np.minimum(left, right)
-    if cells:
+    if cells and dip.any():
+        k = np.searchsorted(sf, breaks)
         dip = np.isin(k, k[dip])
     out: FloatArray = breaks[dip]
     return out
@@ -674,13 +685,20 @@ def subdivided_grid(s: FloatArray, cells: np.ndarray, parts: int = 4) -> FloatAr
     >>> g.size, bool(np.isin(s, g).all()), float(np.diff(g).min())
     (20, True, 0.5)
     """
-    m = s.size - 1
-    split = np.zeros(m, dtype=bool)
-    for k in np.flatnonzero(cells):
-        split[max(k - PAD_CELLS, 0):min(k + PAD_CELLS + 1, m)] = True
+    # Each flagged cell and PAD_CELLS on each side: a window sum over the flags.
+    window = np.convolve(cells.astype(np.intp), np.ones(2 * PAD_CELLS + 1, dtype=np.intp))
+    split = window[PAD_CELLS:PAD_CELLS + cells.size] > 0
     lo = s[:-1][split]
     width = np.diff(s)[split]
-    inner = (lo[:, None] + width[:, None] * (np.arange(1, parts) / parts)[None, :]).ravel()
-    grid = np.unique(np.concatenate((s, inner)))  # sorted; a cell of a few ulps adds none
-    grid_size("n", grid.size)
+    inner = lo[:, None] + width[:, None] * (np.arange(1, parts) / parts)[None, :]
+    # Each cell's nodes in place: its first node, then its inner points where split.
+    grid_size("n", s.size + inner.size)
+    start = np.empty(s.size, dtype=np.intp)
+    start[0] = 0
+    np.cumsum(np.where(split, parts, 1), out=start[1:])
+    grid = np.empty(s.size + inner.size)
+    grid[start] = s
+    grid[(start[:-1][split][:, None] + np.arange(1, parts)[None, :]).ravel()] = inner.ravel()
+    if not (grid[1:] > grid[:-1]).all():  # a cell of a few ulps: its points coincide
+        grid = np.unique(grid)
     return grid

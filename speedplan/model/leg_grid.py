@@ -13,20 +13,20 @@ import numpy as np
 from ..core.checks import FloatArray
 from ..core.errors import InvalidInputError
 from ..core.rates import largest_under_rates
-from ..geometry import SpeedBound, bound_breakpoints
+from ..geometry import CellSamples, SpeedBound, bound_breakpoints
 from .boundary import turnaround_speed
 from .grid import (
     MAX_DEFAULT_NODES,
     adaptive_grid,
+    dips_between,
     graded_ends,
-    hidden_dips,
     rest_phase_length,
     subdivided_grid,
     top_speed,
     uniform_grid,
 )
 from .request import PlanRequest
-from .rows import Envelopes, node_bounds
+from .rows import Envelopes, node_minima
 
 __all__ = ["NO_JERK_BOUND_LOSS", "NO_JERK_NODES", "NO_JERK_REFINEMENTS", "default_grid",
            "grid_anchors", "leg_grid", "no_jerk_grid"]
@@ -65,32 +65,42 @@ def default_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: flo
 
 
 def no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: float,
-                  vf: float) -> FloatArray:
-    """`NO_JERK_NODES` uniform nodes, refined where the node bounds cost time.
+                  vf: float) -> CellSamples:
+    """`NO_JERK_NODES` uniform nodes, refined where the node bounds cost time; with the bound.
 
     Where the bound falls steeply (a corner's clothoid, a zone's edge) the node bound, the
     minimum over both adjacent cells, lies well below the bound at the node; where the no-jerk
     optimum rides it, those cells and their neighbours are cut in four
     (`subdivided_grid`; the no-jerk law is linear in ``w`` per cell and needs
     no smoothness of the steps). Every other cell is kept to the last bit, so the bound
-    already evaluated inside it is looked up, not evaluated again
-    (`memoised`). The O(n) pass makes each round cheap;
-    on the serpentine of ``benchmarks/bench_all.py`` one round takes the duration from 3.9 %
-    to 1.0 % above the exact optimum.
+    already evaluated inside it is kept, not evaluated again: the grid comes with the bound
+    and the curvature at its `cell_points` (`CellSamples`), from which the leg takes its
+    node bounds (`leg_on_grid`) and its law's check reads the bound. The O(n) pass makes each
+    round cheap; on the serpentine of ``benchmarks/bench_all.py`` one round takes the duration
+    from 3.9 % to 1.0 % above the exact optimum.
     """
     lim = request.limits
     s = uniform_grid(length, n=NO_JERK_NODES)
-    s = _cut_out_dips(s, hidden_dips(s, bound_breakpoints(request.path, bound), bound,
-                                     cells=True))
+    breaks = bound_breakpoints(request.path, bound)
+    breaks = breaks[breaks <= length]
+    samples = CellSamples.of(bound, s, extra=breaks)  # the law's check reads the breakpoints too
+    inside = (breaks > s[0]) & (breaks < s[-1])
+    if inside.any():  # hidden_dips, from the values just evaluated
+        k = np.clip(np.searchsorted(s, breaks[inside]), 1, s.size - 1)
+        dips = dips_between(s, breaks[inside], samples.extra_bound[inside],
+                            samples.bound[k - 1], samples.bound[k], cells=True)
+        if dips.size:
+            s = _cut_out_dips(s, dips)
+            samples = samples.on_grid(bound, s)
     for _ in range(NO_JERK_REFINEMENTS):
         if s.size > MAX_DEFAULT_NODES:
             break
-        nodes = node_bounds(bound, s)
-        own = np.asarray(bound(s), dtype=np.float64)
+        nodes = node_minima(samples.bound)
+        own = samples.bound[:s.size]  # the bound at the nodes themselves (cell_points)
         w_max = nodes.copy()
         w_max[0], w_max[-1] = max(w_max[0], v0 * v0), max(w_max[-1], vf * vf)
         m = s.size
-        h = np.diff(s)  # the exact no-jerk optimum on this grid (speedplan.solve.nojerk)
+        h = s[1:] - s[:-1]  # the exact no-jerk optimum on this grid (speedplan.solve.nojerk)
         w = largest_under_rates(w_max, np.full(m - 1, lim.A) * h,
                                 np.full(m - 1, lim.A_decel) * h)
         lossy = (w >= nodes * (1.0 - 1e-9)) & (nodes < (1.0 - NO_JERK_BOUND_LOSS) * own)
@@ -101,7 +111,8 @@ def no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: flo
         cells[np.clip(idx - 1, 0, m - 2)] = True
         cells[np.clip(idx, 0, m - 2)] = True
         s = subdivided_grid(s, cells, parts=4)
-    return s
+        samples = samples.on_grid(bound, s)
+    return samples
 
 
 def _cut_out_dips(s: FloatArray, edges: FloatArray) -> FloatArray:
@@ -228,4 +239,4 @@ def leg_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: float, 
         return s
     if request.jerk_limited:
         return default_grid(request, leg_bound, lo, hi, v0, a0, vf, af)
-    return no_jerk_grid(request, leg_bound, length, v0, vf)
+    return no_jerk_grid(request, leg_bound, length, v0, vf).s

@@ -16,7 +16,7 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
 from ..core.limits import Limits
 from ..core.options import Backend, Refine, RestReason
-from ..geometry import SpeedBound
+from ..geometry import CellSamples, SpeedBound
 from ..solve.problem import DiscreteProblem
 from .request import PlanRequest
 from .straight import JerkPhases
@@ -99,6 +99,10 @@ class Leg(_Ends):
     anchors : ndarray
         Positions on the leg [m] its grids keep as nodes (joins of path pieces where the
         curvature rate jumps, with a lateral-jerk limit); empty when none.
+    samples : CellSamples or None
+        For a law linear in ``w`` (``time_law.linear``): the bound and the curvature at the
+        `cell_points` of the grid, which gave the node bounds and which the law's check
+        reads again; ``None`` otherwise.
     """
 
     bound: SpeedBound
@@ -108,6 +112,7 @@ class Leg(_Ends):
     refine: Refine = "auto"
     backend: Backend = "auto"
     anchors: FloatArray = field(default_factory=lambda: np.zeros(0))
+    samples: CellSamples | None = None
 
 
 @dataclass(frozen=True)

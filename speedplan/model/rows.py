@@ -18,13 +18,14 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
 from ..core.kinematics import lateral_rate_weights
 from ..core.limits import Limits
+from ..core.numerics import CELL_POINTS, cell_points, cell_rows
 from ..geometry import Path
 from ..solve.problem import StencilRows
 from .boundary import fastest_w, jerk_motion_w
 from .request import PlanRequest
 
 __all__ = ["Envelopes", "NodeCurvature", "check_floor", "curvature_at_nodes",
-           "lateral_jerk_rows", "lateral_speed_caps", "node_bounds"]
+           "lateral_jerk_rows", "lateral_speed_caps", "node_bounds", "node_minima"]
 
 #: ``κ``, and ``κ'`` after and before each interior node of a leg's grid.
 NodeCurvature = tuple[FloatArray, FloatArray, FloatArray]
@@ -40,7 +41,7 @@ CAP_MARGIN = 1e-9
 
 
 def node_bounds(bound: Callable[[FloatArray], FloatArray], s: FloatArray,
-                per_interval: int = 8) -> FloatArray:
+                per_interval: int = CELL_POINTS) -> FloatArray:
     """Bound at each node: the minimum of ``bound`` over its two adjacent intervals.
 
     The discrete problem sees the bound only at nodes; taking the minimum over the neighbouring
@@ -48,17 +49,29 @@ def node_bounds(bound: Callable[[FloatArray], FloatArray], s: FloatArray,
     entry, a curvature peak) at an ``O(h)`` cost where the bound is smooth. Interpolated
     linearly (the law without a jerk limit) ``w`` stays under the larger node value of each
     cell, so under the bound; the jerk-limited law bends away from the chords only by its
-    curvature, ``O(j h²)`` (`speedplan.timing.law`).
+    curvature, ``O(j h²)`` (`speedplan.timing.law`). The bound is evaluated once, at
+    `cell_points` (every node among them); `node_minima` takes the minima.
     """
-    frac = np.arange(per_interval) / per_interval
-    # Every node once (the start of its interval, and the end of the grid), then the points
-    # inside each interval: one call to the bound.
-    sub = np.append((s[:-1, None] + np.diff(s)[:, None] * frac[None, :]).ravel(), s[-1])
-    sub[::per_interval] = s
-    val = np.asarray(bound(sub), dtype=np.float64)
-    w = val[::per_interval].copy()
-    interval_min = np.minimum(val[:-1].reshape(-1, per_interval).min(axis=1), w[1:])
-    w[:-1] = np.minimum(w[:-1], interval_min)
+    return node_minima(np.asarray(bound(cell_points(s, per_interval)), dtype=np.float64),
+                       per_interval)
+
+
+def node_minima(values: FloatArray, per_interval: int = CELL_POINTS) -> FloatArray:
+    """`node_bounds` from the bound's ``values`` at the grid's `cell_points`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan.core.numerics import cell_points
+    >>> points = cell_points(np.array([0.0, 1.0, 2.0]), 4)  # a dip inside the second cell
+    >>> node_minima(np.where(points == 1.5, 1.0, 4.0), per_interval=4).tolist()
+    [4.0, 1.0, 1.0]
+    """
+    nodes, inner = cell_rows(values, per_interval)
+    interval_min = np.minimum(inner.min(axis=0), nodes[:-1])
+    np.minimum(interval_min, nodes[1:], out=interval_min)  # each cell with both its ends
+    w = nodes.copy()
+    w[:-1] = np.minimum(w[:-1], interval_min)  # each node and both its cells
     w[1:] = np.minimum(w[1:], interval_min)
     return w
 

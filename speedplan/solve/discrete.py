@@ -143,19 +143,15 @@ def solve_problem(
     t_start = time.perf_counter()
     refine = check_option("refine", refine, REFINE_MODES)
     backend = check_option("backend", backend, BACKENDS)
+    if not (problem.has_jerk or problem.has_grip):
+        return _passed(problem, t_start)
     check_reachable(problem)
     if problem.has_grip and backend == "banded":
         raise InvalidInputError(
             "`backend`='banded' holds no friction-ellipse rows (Limits grip='ellipse'); use "
             "backend='auto' or 'clarabel'")
-    if not (problem.has_jerk or problem.has_grip) or problem.n < 3:
-        w = max_feasible_w(problem)
-        obj = problem.travel_time(w)
-        return DiscreteSolution(
-            w=w, objective=obj, lower_bound=obj, gap=0.0, exact=True, exact_a_priori=True,
-            jerk_violation=0.0, refined=False, status="optimal",
-            solve_time=time.perf_counter() - t_start, backend="pass",
-        )
+    if problem.n < 3:
+        return _passed(problem, t_start)
 
     check_grid_resolvable(problem)  # before any solver spends a minute on it
     positive_feasible_w(problem)  # before scaling: its error names s in the problem's units
@@ -190,6 +186,24 @@ def solve_problem(
         backend=relaxed.info.backend,
         relaxation=relaxed.info,
         refinement=refinement,
+    )
+
+
+def _passed(problem: DiscreteProblem, t_start: float) -> DiscreteSolution:
+    """The exact optimum without jerk rows (the O(n) pass), its boundary values checked.
+
+    The pass meets ``w_start`` and ``w_end`` exactly when they are reachable (see
+    `max_feasible_w`); only when it does not does `check_reachable` run, to raise the
+    error that names the constraint and where (or pass, for values within its tolerance).
+    """
+    w = max_feasible_w(problem)
+    if problem.has_lower_bounds or not (w[0] == problem.w_start and w[-1] == problem.w_end):
+        check_reachable(problem)
+    obj = problem.travel_time(w)
+    return DiscreteSolution(
+        w=w, objective=obj, lower_bound=obj, gap=0.0, exact=True, exact_a_priori=True,
+        jerk_violation=0.0, refined=False, status="optimal",
+        solve_time=time.perf_counter() - t_start, backend="pass",
     )
 
 

@@ -36,7 +36,8 @@ def max_feasible_w(problem: DiscreteProblem, *, pin_ends: bool = True) -> FloatA
     if pin_ends:
         bound[0] = min(bound[0], problem.w_start)
         bound[-1] = min(bound[-1], problem.w_end)
-    return largest_under_rates(bound, problem.accel * problem.h, problem.decel * problem.h)
+    h = problem.h
+    return largest_under_rates(bound, problem.accel * h, problem.decel * h)
 
 
 def positive_feasible_w(problem: DiscreteProblem) -> FloatArray:

@@ -120,7 +120,9 @@ class DiscreteProblem:
     @property
     def h(self) -> FloatArray:
         """Steps ``h_i = s_{i+1} - s_i``, shape (n-1,)."""
-        return np.diff(self.s)
+        s = self.s
+        out: FloatArray = s[1:] - s[:-1]  # np.diff, without its overhead
+        return out
 
     @property
     def tau(self) -> FloatArray:

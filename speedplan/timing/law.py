@@ -394,10 +394,11 @@ class TimeLaw:
         s, n = self.s, self.s.size
         w = np.maximum(self.w, 0.0)
         x = np.empty(2 * n - 1)
-        x[0::2], x[1::2] = s, s[:-1] + 0.5 * np.diff(s)
+        h = s[1:] - s[:-1]
+        x[0::2], x[1::2] = s, s[:-1] + 0.5 * h
         y = np.empty(2 * n - 1)
         y[0::2], y[1::2] = w, 0.5 * (w[:-1] + w[1:])
-        slope = np.repeat(np.diff(w) / np.diff(s), 2)  # the cell's secant on both halves
+        slope = np.repeat((w[1:] - w[:-1]) / h, 2)  # the cell's secant on both halves
         m = x.size - 1
         return _Pieces(x=x, y=y, g=np.append(slope, slope[-1]), c=np.zeros(m),
                        is_u=np.zeros(m, dtype=bool), y_right=y[1:].copy(), g_right=slope)
@@ -540,7 +541,7 @@ class TimeLaw:
         if self.linear:  # ∫ ds / sqrt(w) with w linear: 2 Δx / (v_a + v_b), in closed form
             v = np.sqrt(p.y)
             with np.errstate(divide="ignore"):
-                seg = 2.0 * np.diff(x) / (v[:-1] + v[1:])
+                seg = 2.0 * (x[1:] - x[:-1]) / (v[:-1] + v[1:])
             return np.concatenate(([0.0], np.cumsum(seg)))
         j = np.arange(x.size - 1)
         right = (p.y_right <= 0.0) & (p.y[:-1] > 0.0)

@@ -24,7 +24,7 @@ from .trajectory import Trajectory
 from .verify import LegCheck, Verification, bound_breakpoints, check_law, curvature_rate
 
 if TYPE_CHECKING:
-    from ..geometry import Path
+    from ..geometry import CellSamples, Path
     from ..model import PlanRequest
     from ..model.legs import TimeLawSpec
 
@@ -301,11 +301,16 @@ class SpeedProfile:
         return Verification.merged([self.check_leg(i).verification
                                     for i in range(len(self.legs))])
 
-    def check_leg(self, i: int) -> LegCheck:
-        """The check of leg ``i`` (which of its law pieces exceed a tolerance)."""
+    def check_leg(self, i: int, samples: CellSamples | None = None) -> LegCheck:
+        """The check of leg ``i`` (which of its law pieces exceed a tolerance).
+
+        ``samples``: the speed bound at the `cell_points` of the leg's grid, as its model
+        evaluated them (`speedplan.model.Leg`), which the check of a law linear in ``w``
+        reads instead of evaluating the bound there again (see `check_law`).
+        """
         leg = self.legs[i]
         return check_law(leg.law, leg.start, self.path, self.speed_bound, self.limits,
-                         self._bound_breaks)
+                         self._bound_breaks, samples)
 
     @cached_property
     def _bound_breaks(self) -> FloatArray:

@@ -15,6 +15,7 @@ The quantities come from `speedplan.core.kinematics`, with ``κ'`` the path's ex
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 
@@ -24,12 +25,14 @@ from ..core import kinematics
 from ..core.checks import FloatArray, IntArray
 from ..core.forward import Forwarded
 from ..core.limits import Limits
-from ..geometry import Path, SpeedBound
+from ..core.numerics import CELL_POINTS, cell_points, cell_rows
+from ..geometry import CellSamples, Path, SpeedBound
 from ..geometry.bounds import bound_breakpoints
-from .law import PieceExtremes, SpeedLaw
+from .law import PieceExtremes, SpeedLaw, TimeLaw
 
 __all__ = ["LIMIT_NAMES", "SAMPLES_PER_PIECE", "TOLERANCES", "LegCheck", "LimitCheck",
-           "Verification", "bound_breakpoints", "check_law", "curvature_rate"]
+           "Verification", "bound_breakpoints", "check_law", "check_linear_law", "check_pieces",
+           "curvature_rate"]
 
 #: Points per law piece where path-dependent quantities are evaluated (ends included).
 SAMPLES_PER_PIECE = 5
@@ -175,6 +178,8 @@ class Verification:
         else:
             records = {c.name: c for c in checks}
         object.__setattr__(self, "checks", records)
+        # Read after every check of a plan: computed once (the records are immutable).
+        object.__setattr__(self, "_ok", not any(c.exceeded for c in records.values()))
 
     # Shorthands for entries of ``maxima``, documented in the class docstring.
     max_speed = Forwarded[float]("maxima", key="speed")
@@ -211,7 +216,7 @@ class Verification:
     @property
     def ok(self) -> bool:
         """Whether every ratio is within its tolerance."""
-        return not any(c.exceeded for c in self.checks.values())
+        return bool(self.__dict__["_ok"])
 
     def summary(self) -> str:
         """One line per limit: realised ratio, tolerance and where.
@@ -233,8 +238,11 @@ class Verification:
         """The worst of several verifications (legs of one profile).
 
         A quantity only some parts check (``"yaw_acc"`` of turns) is merged over those; it
-        counts as not set when every part has it and none sets it.
+        counts as not set when every part has it and none sets it. One part is its own worst.
         """
+        if len(parts) == 1 and tuple(parts[0].checks) == tuple(
+                k for k in LIMIT_NAMES if k in parts[0].checks):
+            return parts[0]
         out = []
         for k in LIMIT_NAMES:
             have = [p.checks[k] for p in parts if k in p.checks]
@@ -340,6 +348,16 @@ def _law_samples(law: SpeedLaw, top: FloatArray, local: FloatArray) -> _Samples:
                     break_pieces=extra_piece)
 
 
+def _path_values(spots: FloatArray, path: Path, bound: Callable[[FloatArray], FloatArray]
+                 ) -> tuple[FloatArray, FloatArray]:
+    """The path's curvature [1/m] and the speed bound [m²/s²] at path arc lengths ``spots``."""
+    if isinstance(bound, SpeedBound) and bound.path is path and bound.offset == 0.0:
+        # The curvature is the bound's own (remembered from the grid where it has a memo).
+        return bound.curvature_and_bound(spots)
+    return (np.asarray(path.curvature(spots), dtype=np.float64),
+            np.asarray(bound(spots), dtype=np.float64))
+
+
 def _sampled_loads(smp: _Samples, spot_glob: FloatArray, path: Path,
                    bound: Callable[[FloatArray], FloatArray], limits: Limits
                    ) -> dict[str, tuple[FloatArray, FloatArray, float]]:
@@ -348,12 +366,7 @@ def _sampled_loads(smp: _Samples, spot_glob: FloatArray, path: Path,
     ``load / limit`` is the ratio (``"speed"``'s load is already one), ``value`` the
     realised quantity; a quantity without a limit is one 0.
     """
-    if isinstance(bound, SpeedBound) and bound.path is path and bound.offset == 0.0:
-        # The curvature is the bound's own (remembered from the grid where it has a memo).
-        kappa_spot, wb_spot = bound.curvature_and_bound(spot_glob)
-    else:
-        kappa_spot = np.asarray(path.curvature(spot_glob), dtype=np.float64)
-        wb_spot = np.asarray(bound(spot_glob), dtype=np.float64)
+    kappa_spot, wb_spot = _path_values(spot_glob, path, bound)
     kappa = kappa_spot[smp.sample_spot]
     wb = wb_spot[smp.sample_spot]
     w, v, a = smp.w, smp.v, smp.a
@@ -420,18 +433,34 @@ def _piece_checks(ex: PieceExtremes, knots: FloatArray, offset: float, limits: L
 
 def check_law(law: SpeedLaw, offset: float, path: Path,
               bound: Callable[[FloatArray], FloatArray], limits: Limits,
-              breaks: FloatArray | None = None) -> LegCheck:
+              breaks: FloatArray | None = None, samples: CellSamples | None = None) -> LegCheck:
     """Check the law of one leg that covers ``[offset, offset + law.length]`` of ``path``.
 
     ``breaks``: arc lengths of ``path`` (`bound_breakpoints`, computed here when not
     given) where the path-dependent quantities are evaluated too, besides the samples.
+
+    A law linear in ``w`` (no jerk nor lateral-jerk limit, no friction ellipse) is checked
+    cell by cell (`check_linear_law`): the same points and the same verdicts, without the
+    pieces' machinery; ``samples`` (the bound at its grid's `cell_points`, read from
+    ``offset``, as the model evaluated it) spares evaluating the bound there again.
     """
-    ex = law.extremes()
-    knots = law.knots
     if breaks is None:
         breaks = bound_breakpoints(path, bound)
-    local = np.clip(breaks[(breaks >= offset) & (breaks <= offset + law.length)] - offset,
-                    0.0, law.length)
+    if (isinstance(law, TimeLaw) and law.linear and not limits.ellipse
+            and not np.isfinite(limits.j_lat_max)):
+        linear = check_linear_law(law, offset, path, bound, limits, breaks, samples)
+        if linear is not None:
+            return linear
+    return check_pieces(law, offset, path, bound, limits, breaks)
+
+
+def check_pieces(law: SpeedLaw, offset: float, path: Path,
+                 bound: Callable[[FloatArray], FloatArray], limits: Limits,
+                 breaks: FloatArray) -> LegCheck:
+    """`check_law` of any law: exact extremes of every piece, samples of every piece."""
+    ex = law.extremes()
+    knots = law.knots
+    local = _local_breaks(breaks, offset, law.length)
     # Each piece's speed maximum is the sixth sample of the piece.
     smp = _law_samples(law, ex.w.at, local)
     spot_glob = offset + smp.spots
@@ -439,12 +468,164 @@ def check_law(law: SpeedLaw, offset: float, path: Path,
     found = _sampled_checks(_sampled_loads(smp, spot_glob, path, bound, limits), smp,
                             spot_glob[smp.sample_spot], excess)
     found.update(_piece_checks(ex, knots, offset, limits, excess))
+    return LegCheck(_verification(found, limits), excess, knots)
+
+
+def _local_breaks(breaks: FloatArray, offset: float, length: float) -> FloatArray:
+    """The breakpoints inside ``[offset, offset + length]``, in the leg's arc length."""
+    out: FloatArray = np.clip(breaks[(breaks >= offset) & (breaks <= offset + length)] - offset,
+                              0.0, length)
+    return out
+
+
+def _verification(found: dict[str, tuple[float, float, float]], limits: Limits) -> Verification:
+    """The `Verification` of ``name: (maximum, ratio, where)``, in `LIMIT_NAMES` order."""
     limit_of = {"speed": limits.v_max, "accel": limits.a_max, "decel": limits.a_decel,
                 "lateral": limits.a_lat_max, "jerk": limits.j_max,
                 "yaw_rate": limits.yaw_rate_max, "lateral_jerk": limits.j_lat_max,
                 "grip": 1.0 if limits.ellipse else np.inf}
-    checks = [LimitCheck(name, ratio=found[name][1], maximum=found[name][0],
-                         limit=float(limit_of[name]), where_s=found[name][2],
-                         unset=not np.isfinite(limit_of[name]))
-              for name in LIMIT_NAMES if name in found]
-    return LegCheck(Verification(checks), excess, knots)
+    return Verification([LimitCheck(name, ratio=found[name][1], maximum=found[name][0],
+                                    limit=float(limit_of[name]), where_s=found[name][2],
+                                    unset=not np.isfinite(limit_of[name]))
+                         for name in LIMIT_NAMES if name in found])
+
+
+def check_linear_law(law: TimeLaw, offset: float, path: Path,
+                     bound: Callable[[FloatArray], FloatArray], limits: Limits,
+                     breaks: FloatArray, samples: CellSamples | None = None
+                     ) -> LegCheck | None:
+    """`check_law` of a law linear in ``w`` on every cell, from the nodes' ``w`` alone.
+
+    Without jerk nor lateral-jerk limit (and without the friction ellipse), on each cell
+    ``w`` is the chord and the acceleration ``(w_{k+1} - w_k) / (2 h_k)`` is constant: its
+    extremes are the cells' own, the jerk is 0. The speed bound, lateral acceleration and yaw
+    rate are evaluated where `check_pieces` evaluates them, at each piece's
+    `SAMPLES_PER_PIECE` points (two pieces per cell: the `cell_points`, nodes included,
+    where the speed maxima lie) and at the breakpoints; the maxima are found on ``w / mu+``
+    and ``κ² w``, whose square roots are taken at the peak only, and where they tie, the
+    first along the path is reported, as there. A piece is flagged for refinement when it
+    holds a point beyond a tolerance, as there. ``None`` where a value is not finite (a bound
+    of 0, a NaN): `check_pieces` reports it.
+    """
+    s, w = law.s, np.maximum(law.w, 0.0)
+    n = s.size
+    local = _local_breaks(breaks, offset, law.length)
+    if (samples is not None and samples.offset == offset
+            and (samples.s is s or np.array_equal(samples.s, s))):
+        points, kappa, wb = samples.points, samples.curvature, samples.bound
+    else:
+        samples = None
+        points = cell_points(s)
+        kappa, wb = _path_values(offset + points, path, bound)
+    if samples is not None and np.array_equal(samples.extra, local):
+        kappa_b, wb_b = samples.extra_curvature, samples.extra_bound
+    else:
+        kappa_b, wb_b = _path_values(offset + local, path, bound)
+    dw, h = w[1:] - w[:-1], s[1:] - s[:-1]
+    w_pts = np.empty(points.size)  # w on the chords, in the order of cell_points
+    w_nodes, w_inner = cell_rows(w_pts)
+    w_nodes[:] = w
+    np.multiply((np.arange(1, CELL_POINTS) / CELL_POINTS)[:, None], dw, out=w_inner)
+    w_inner += w[:-1]
+    cell = np.clip(np.searchsorted(s, local, side="right") - 1, 0, n - 2)
+    w_b = np.maximum(w[cell] + dw[cell] * ((local - s[cell]) / h[cell]), 0.0)
+    k_abs, k_abs_b = np.abs(kappa), np.abs(kappa_b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        speed2 = (w_pts / wb, w_b / wb_b)
+    lateral = (k_abs * w_pts, k_abs_b * w_b)
+    yaw2 = (k_abs * lateral[0], k_abs_b * lateral[1])
+    accel = 0.5 * (dw / h)  # constant on each cell, both its pieces
+    # Where a limit is not set only the maximum is reported: any of its points will do.
+    k_v, k_lat, k_yaw = (_first_peak(x, points, locate) for x, locate in (
+        (speed2, True), (lateral, np.isfinite(limits.a_lat_max)),
+        (yaw2, np.isfinite(limits.yaw_rate_max))))
+    if k_v is None or k_lat is None or k_yaw is None or not np.isfinite(accel).all():
+        return None
+    first = float(offset + points[0])
+    glob = (points, local)  # leg arc length: `offset` added where read
+    top_w = max(float(w_pts.max()), float(w_b.max()) if w_b.size else 0.0)
+    found = {"speed": (float(np.sqrt(top_w)),
+                       float(np.sqrt(_at((w_pts, w_b), k_v)) / np.sqrt(_at((wb, wb_b), k_v))),
+                       offset + _at(glob, k_v))}
+    for name, top, k, limit in (
+            ("lateral", _at(lateral, k_lat), k_lat, limits.a_lat_max),
+            ("yaw_rate", _at((k_abs, k_abs_b), k_yaw) * float(np.sqrt(_at((w_pts, w_b), k_yaw))),
+             k_yaw, limits.yaw_rate_max)):  # |κ| v where κ² w peaks
+        found[name] = ((top, top / limit, offset + _at(glob, k)) if np.isfinite(limit)
+                       else (top, 0.0, first))
+    for name in ("lateral_jerk", "grip"):  # not set for such a law: reported as 0
+        found[name] = (0.0, 0.0, first)
+    knots = law.knots
+    for name, per_cell, limit in (("accel", accel, limits.a_max),
+                                  ("decel", -accel, limits.a_decel),
+                                  ("jerk", np.zeros(n - 1), limits.j_max)):
+        i = int(np.argmax(per_cell))
+        top = float(per_cell[i])
+        found[name] = (max(top, 0.0), max(top / limit, 0.0) if np.isfinite(limit) else 0.0,
+                       float(offset + 0.5 * (knots[2 * i] + knots[2 * i + 1])))
+    check = _verification(found, limits)
+    excess = np.zeros(knots.size - 1, dtype=bool)
+    if not check.ok:
+        _flag_linear(excess, knots, local, accel, limits,
+                     (np.sqrt(speed2[0]), np.sqrt(speed2[1])), lateral, yaw2)
+    return LegCheck(check, excess, knots)
+
+
+def _first_peak(parts: tuple[FloatArray, FloatArray], points: FloatArray,
+                locate: bool = True) -> tuple[int, int] | None:
+    """Where the largest value lies: ``(0, i)`` at ``points[i]``, ``(1, i)`` at breakpoint ``i``.
+
+    Among equal values the first along the path, points before breakpoints (the order of
+    `check_pieces`); any of them unless ``locate``. ``None`` if a value is not finite.
+    """
+    main, brk = parts
+    top = float(main.max())
+    top_b = float(brk.max()) if brk.size else -math.inf
+    if not (math.isfinite(top) and (math.isfinite(top_b) or top_b == -math.inf)):
+        return None
+    if top_b > top:
+        return 1, int(np.argmax(brk))
+    if not locate:
+        return 0, int(np.argmax(main))
+    # The first tie of each row of `cell_points` (each in the cells' order), then the first
+    # of these along the path.
+    at = main == top
+    nodes, inner = cell_rows(at)
+    n = nodes.size
+    first = np.concatenate(([np.argmax(nodes)], n + np.arange(inner.shape[0]) * (n - 1)
+                            + np.argmax(inner, axis=1)))
+    first = first[at[first]]
+    return 0, int(first[np.argmin(points[first])])
+
+
+def _at(parts: tuple[FloatArray, FloatArray], where: tuple[int, int]) -> float:
+    return float(parts[where[0]][where[1]])
+
+
+def _flag_linear(excess: np.ndarray, knots: FloatArray, local: FloatArray, accel: FloatArray,
+                 limits: Limits, speed: tuple[FloatArray, FloatArray],
+                 lateral: tuple[FloatArray, FloatArray], yaw2: tuple[FloatArray, FloatArray]
+                 ) -> None:
+    """Flag (in place) the pieces of a linear law holding a point beyond a tolerance."""
+    over, over_b = (speed[0] > 1.0 + TOLERANCES["speed"], speed[1] > 1.0 + TOLERANCES["speed"])
+    for name, (load, load_b), limit in (("lateral", lateral, limits.a_lat_max),
+                                        ("yaw_rate", yaw2, limits.yaw_rate_max)):
+        if np.isfinite(limit):
+            if name == "yaw_rate":  # |κ| v from κ² w
+                load, load_b = np.sqrt(load), np.sqrt(load_b)
+            over |= load / limit > 1.0 + TOLERANCES[name]
+            over_b |= load_b / limit > 1.0 + TOLERANCES[name]
+    nodes, inner = cell_rows(over)
+    half = CELL_POINTS // 2  # the cell's middle point ends its first piece, starts its second
+    excess[0::2] = nodes[:-1] | inner[:half].any(axis=0)
+    excess[1::2] = inner[half - 1:].any(axis=0) | nodes[1:]
+    for name, per_cell, limit in (("accel", accel, limits.a_max), ("decel", -accel,
+                                                                   limits.a_decel)):
+        if np.isfinite(limit):
+            cell = per_cell > limit * (1.0 + TOLERANCES[name])
+            excess[0::2] |= cell
+            excess[1::2] |= cell
+    m = knots.size - 1  # each breakpoint counts for the piece(s) it lies in
+    for side in ("right", "left"):
+        piece = np.clip(np.searchsorted(knots, local, side=side) - 1, 0, m - 1)
+        excess[piece[over_b]] = True

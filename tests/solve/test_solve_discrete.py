@@ -256,6 +256,28 @@ def test_unreachable_boundary_is_infeasible_with_location():
         solve_discrete(np.full(10, 1.0), 1.0, 1.0, w_start=2.0)
 
 
+@pytest.mark.parametrize("J", [1.0, np.inf])
+def test_unreachable_boundaries_name_the_constraint_with_and_without_jerk_rows(J):
+    # Without jerk rows the pass answers alone; it must refuse the same boundary values.
+    w_max = np.full(50, 4.0)
+    w_max[10] = 0.1
+    with pytest.raises(InfeasibleError, match="brake") as info:
+        solve_discrete(w_max, 0.05, J, w_start=4.0)
+    assert info.value.constraint == "decel" and info.value.s == 10.0
+    with pytest.raises(InfeasibleError, match="accelerate") as info:
+        solve_discrete(w_max, 0.05, J, w_end=4.0)
+    assert info.value.constraint == "accel" and info.value.s == 10.0
+    with pytest.raises(InfeasibleError, match="w_start") as info:
+        solve_discrete(np.full(10, 1.0), 1.0, J, w_start=2.0)
+    assert info.value.constraint == "w_start"
+    with pytest.raises(InfeasibleError, match="w_end") as info:
+        solve_discrete(np.full(10, 1.0), 1.0, J, w_end=2.0)
+    assert info.value.constraint == "w_end"
+    # Within the tolerance of the check, a boundary value just beyond reach is accepted.
+    ok = solve_discrete(np.full(10, 1.0), 1.0, J, w_start=1.0 + 1e-12)
+    assert ok.w[0] == pytest.approx(1.0, abs=1e-11)
+
+
 @pytest.mark.parametrize("backend", ["banded", "clarabel"])
 @pytest.mark.parametrize("h", [1e-3, 0.5, 40.0])
 def test_forced_standstill_is_infeasible_at_its_own_position(h, backend):
