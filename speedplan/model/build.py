@@ -19,16 +19,17 @@ import numpy as np
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
 from ..core.options import RestReason
-from ..geometry import SpeedBound
+from ..geometry import SpeedBound, bound_breakpoints
 from ..solve.problem import MAX_RAMP_STEPS, DiscreteProblem, ramp_steps
 from .boundary import STATE_JERK_ROUNDING, check_reachable_states, turnaround_speed
 from .grid import MIN_NODES
-from .leg_grid import default_grid, grid_anchors, leg_grid
+from .leg_grid import default_grid, grid_anchors, kink_anchors, leg_grid
 from .legs import ForcedLeg, Leg, Model, Rest, TimeLawSpec
 from .request import STATE_ROUNDING, PlanRequest, within_limit
 from .rows import (
     Envelopes,
     check_floor,
+    chord_node_bounds,
     curvature_at_nodes,
     lateral_jerk_rows,
     lateral_speed_caps,
@@ -197,7 +198,9 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     lim = request.limits
     length = float(s[-1])
     env = Envelopes.of(request, v0, a0, vf, af, length)
-    w_max = env.cap(s, node_bounds(bound, s))
+    smooth_law = request.jerk_limited or np.isfinite(lim.j_lat_max)
+    w_max = env.cap(s, chord_node_bounds(bound, s, bound_breakpoints(request.path, bound))
+                    if smooth_law else node_bounds(bound, s))
     w_max[0] = max(w_max[0], v0 * v0)
     w_max[-1] = max(w_max[-1], vf * vf)
     if (w_max[1:-1] <= 0).any():
@@ -238,11 +241,13 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
         accel_start=a0 if v0 > 0 and request.jerk_limited else None,
         accel_end=af if vf > 0 and request.jerk_limited else None,
         # Without jerk (and lateral-jerk) rows nothing bounds the law's bend: on the chords.
-        linear=not (request.jerk_limited or np.isfinite(lim.j_lat_max)),
+        linear=not smooth_law,
     )
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
-               backend=request.backend, anchors=grid_anchors(request, lo, lo + length))
+               backend=request.backend,
+               anchors=np.union1d(grid_anchors(request, lo, lo + length),
+                                  kink_anchors(request, bound, length)))
 
 
 def _zero_cause(bound: SpeedBound) -> str:

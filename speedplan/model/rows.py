@@ -63,6 +63,76 @@ def node_bounds(bound: Callable[[FloatArray], FloatArray], s: FloatArray,
     return w
 
 
+def chord_node_bounds(bound: Callable[[FloatArray], FloatArray], s: FloatArray,
+                      breakpoints: FloatArray | None = None,
+                      per_interval: int = 8) -> FloatArray:
+    """Bound at each node such that every cell's chord lies under the bound.
+
+    On each cell ``[s_i, s_{i+1}]`` the node bounds ``(B_i, B_{i+1})`` span a line under the
+    bound ``b``: a ``w`` under them and linear on the cell stays under ``b`` (to the sampling
+    of ``b``), as with the minimum over the cell (`node_bounds`). Of these lines the cell
+    takes the one that costs the least time to first order: a line under ``b`` maximising
+    ``B_i / b_i^{3/2} + B_{i+1} / b_{i+1}^{3/2}`` (the sensitivity of ``h / sqrt(w)``), which
+    is the lower convex hull of ``b`` over the cell at a point between its ends. Each node
+    takes the smaller of its two cells' values. Where ``b`` is smooth the bound is then lost
+    only where it is convex, by ``O(b'' h²)``; the minimum over the cells loses
+    ``O(|b'| h)`` wherever the bound falls. A kink or a step of the bound inside a cell (a
+    clothoid onto an arc, a zone's edge) still costs ``O(h)``: a node on it costs nothing
+    (`speedplan.model.leg_grid.bound_kinks`).
+
+    ``b`` is read at ``per_interval`` points per cell and at the ``breakpoints`` [m] of the
+    bound inside the cells, where it may kink, step or dip (`bound_breakpoints`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.linspace(0.0, 4.0, 5)
+    >>> falling = lambda q: 10.0 - np.asarray(q)  # linear: the chords lie on it
+    >>> chord_node_bounds(falling, s).tolist(), node_bounds(falling, s).tolist()
+    ([10.0, 9.0, 8.0, 7.0, 6.0], [9.0, 8.0, 7.0, 6.0, 6.0])
+    >>> step = lambda q: np.where(np.asarray(q) < 2.5, 4.0, 1.0)  # a step inside cell 2
+    >>> chord_node_bounds(step, s, breakpoints=np.array([2.5])).tolist()
+    [4.0, 4.0, 1.0, 1.0, 1.0]
+    """
+    m = s.size - 1
+    h = np.diff(s)
+    theta = np.tile(np.linspace(0.0, 1.0, per_interval + 1), (m, 1))
+    if breakpoints is not None and breakpoints.size:
+        brk = breakpoints[(breakpoints > s[0]) & (breakpoints < s[-1])]
+        k = np.clip(np.searchsorted(s, brk, side="right") - 1, 0, m - 1)
+        inside = (brk > s[k]) & (brk < s[k + 1])
+        brk, k = brk[inside], k[inside]
+        if brk.size:  # one more column per breakpoint of the busiest cell, the others at 1
+            rank = np.arange(brk.size) - np.searchsorted(k, k)
+            extra = np.ones((m, int(rank.max()) + 1))
+            extra[k, rank] = (brk - s[k]) / h[k]
+            theta = np.hstack((theta, extra))
+    b = np.asarray(bound((s[:-1, None] + h[:, None] * theta).ravel()),
+                   dtype=np.float64).reshape(theta.shape)
+    b[:, 0], b[:, per_interval] = bound(s[:-1]), bound(s[1:])  # the nodes exactly
+    b = np.where(theta == 1.0, b[:, [per_interval]], b)
+    weight = np.maximum(b[:, [0, per_interval]], 1e-300) ** -1.5
+    star = np.clip(weight[:, 1] / weight.sum(axis=1), 1e-6, 1.0 - 1e-6)[:, None]
+    i, j = np.triu_indices(theta.shape[1], 1)
+    ti, tj, bi, bj = theta[:, i], theta[:, j], b[:, i], b[:, j]
+    lo, hi = np.minimum(ti, tj), np.maximum(ti, tj)
+    spans = (lo <= star) & (star <= hi) & (hi > lo)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = (bj - bi) / (tj - ti)
+        at_star = np.where(spans, bi + slope * (star - ti), np.inf)
+    best = np.argmin(at_star, axis=1)
+    rows_ = np.arange(m)
+    slope = slope[rows_, best]
+    left = b[rows_, i[best]] - slope * theta[rows_, i[best]]
+    # The line through the hull's edge at `star` lies under every sample; rounding aside.
+    left = left - np.maximum((left[:, None] + slope[:, None] * theta - b).max(axis=1), 0.0)
+    right = left + slope
+    out = np.asarray(bound(s), dtype=np.float64)
+    out[:-1] = np.minimum(out[:-1], left)
+    out[1:] = np.minimum(out[1:], right)
+    return out
+
+
 @dataclass(frozen=True)
 class Envelopes:
     """Jerk-limited envelopes of the motions leaving the start state and reaching the end."""
