@@ -111,8 +111,10 @@ def chord_node_bounds(bound: Callable[[FloatArray], FloatArray], s: FloatArray,
                    dtype=np.float64).reshape(theta.shape)
     b[:, 0], b[:, per_interval] = bound(s[:-1]), bound(s[1:])  # the nodes exactly
     b = np.where(theta == 1.0, b[:, [per_interval]], b)
-    weight = np.maximum(b[:, [0, per_interval]], 1e-300) ** -1.5
-    star = np.clip(weight[:, 1] / weight.sum(axis=1), 1e-6, 1.0 - 1e-6)[:, None]
+    # The weights b^{-3/2} of the ends, as the share of the right one (bounds of 0 allowed).
+    ends = np.log(np.maximum(b[:, [0, per_interval]], 1e-300))
+    star = 1.0 / (1.0 + np.exp(np.clip(1.5 * (ends[:, 1] - ends[:, 0]), -50.0, 50.0)))
+    star = np.clip(star, 1e-6, 1.0 - 1e-6)[:, None]
     i, j = np.triu_indices(theta.shape[1], 1)
     ti, tj, bi, bj = theta[:, i], theta[:, j], b[:, i], b[:, j]
     lo, hi = np.minimum(ti, tj), np.maximum(ti, tj)
@@ -127,6 +129,10 @@ def chord_node_bounds(bound: Callable[[FloatArray], FloatArray], s: FloatArray,
     # The line through the hull's edge at `star` lies under every sample; rounding aside.
     left = left - np.maximum((left[:, None] + slope[:, None] * theta - b).max(axis=1), 0.0)
     right = left + slope
+    # A bound of 0 at a node is never left in finite time where it rises like s² (a v_limit
+    # knot at 0 m/s): no line from 0 lies under it. The cell is flat at 0, as the minimum.
+    zero = np.minimum(b[:, 0], b[:, per_interval]) <= 0.0
+    left, right = np.where(zero, 0.0, left), np.where(zero, 0.0, right)
     out = np.asarray(bound(s), dtype=np.float64)
     out[:-1] = np.minimum(out[:-1], left)
     out[1:] = np.minimum(out[1:], right)
