@@ -199,8 +199,9 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     length = float(s[-1])
     env = Envelopes.of(request, v0, a0, vf, af, length)
     smooth_law = request.jerk_limited or np.isfinite(lim.j_lat_max)
-    w_max = env.cap(s, chord_node_bounds(bound, s, bound_breakpoints(request.path, bound))
-                    if smooth_law else node_bounds(bound, s))
+    breaks = bound_breakpoints(request.path, bound) if smooth_law else None
+    w_max = env.cap(s, chord_node_bounds(bound, s, breaks) if smooth_law
+                    else node_bounds(bound, s))
     w_max[0] = max(w_max[0], v0 * v0)
     w_max[-1] = max(w_max[-1], vf * vf)
     if (w_max[1:-1] <= 0).any():
@@ -247,7 +248,7 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
                problem=problem, time_law=law, limits=lim, refine=request.refine,
                backend=request.backend,
                anchors=np.union1d(grid_anchors(request, lo, lo + length),
-                                  kink_anchors(request, bound, length)))
+                                  kink_anchors(request, bound, length, breaks)))
 
 
 def _zero_cause(bound: SpeedBound) -> str:

@@ -107,33 +107,41 @@ def chord_node_bounds(bound: Callable[[FloatArray], FloatArray], s: FloatArray,
             extra = np.ones((m, int(rank.max()) + 1))
             extra[k, rank] = (brk - s[k]) / h[k]
             theta = np.hstack((theta, extra))
-    b = np.asarray(bound((s[:-1, None] + h[:, None] * theta).ravel()),
-                   dtype=np.float64).reshape(theta.shape)
-    b[:, 0], b[:, per_interval] = bound(s[:-1]), bound(s[1:])  # the nodes exactly
-    b = np.where(theta == 1.0, b[:, [per_interval]], b)
+    # One call to the bound: the nodes, then the points inside the cells.
+    inside = np.ones(theta.shape, dtype=bool)
+    inside[:, [0, per_interval]] = False
+    inside &= theta < 1.0
+    points = (s[:-1, None] + h[:, None] * theta)[inside]
+    val = np.asarray(bound(np.concatenate((s, points))), dtype=np.float64)
+    at = val[:s.size]
+    b = np.where(theta >= 1.0, at[1:, None], at[:-1, None])
+    b[inside] = val[s.size:]
     # The weights b^{-3/2} of the ends, as the share of the right one (bounds of 0 allowed).
-    ends = np.log(np.maximum(b[:, [0, per_interval]], 1e-300))
-    star = 1.0 / (1.0 + np.exp(np.clip(1.5 * (ends[:, 1] - ends[:, 0]), -50.0, 50.0)))
-    star = np.clip(star, 1e-6, 1.0 - 1e-6)[:, None]
-    i, j = np.triu_indices(theta.shape[1], 1)
-    ti, tj, bi, bj = theta[:, i], theta[:, j], b[:, i], b[:, j]
-    lo, hi = np.minimum(ti, tj), np.maximum(ti, tj)
-    spans = (lo <= star) & (star <= hi) & (hi > lo)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope = (bj - bi) / (tj - ti)
-        at_star = np.where(spans, bi + slope * (star - ti), np.inf)
-    best = np.argmin(at_star, axis=1)
-    rows_ = np.arange(m)
-    slope = slope[rows_, best]
-    left = b[rows_, i[best]] - slope * theta[rows_, i[best]]
+    ends = np.log(np.maximum(at, 1e-300))
+    star = 1.0 / (1.0 + np.exp(np.clip(1.5 * (ends[1:] - ends[:-1]), -50.0, 50.0)))
+    star = np.clip(star, 1e-6, 1.0 - 1e-6)
+    # The lower convex hull at `star`: the least value there of a chord between two samples
+    # on either side of it.
+    best_val = np.full(m, np.inf)
+    slope, left = np.zeros(m), b[:, 0].copy()
+    for i, j in zip(*np.triu_indices(theta.shape[1], 1), strict=True):
+        ti, tj, bi, bj = theta[:, i], theta[:, j], b[:, i], b[:, j]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sl = (bj - bi) / (tj - ti)
+            value = bi + sl * (star - ti)
+        spans = (np.minimum(ti, tj) <= star) & (star <= np.maximum(ti, tj)) & (ti != tj)
+        better = spans & (value < best_val)
+        best_val = np.where(better, value, best_val)
+        slope = np.where(better, sl, slope)
+        left = np.where(better, bi - sl * ti, left)
     # The line through the hull's edge at `star` lies under every sample; rounding aside.
     left = left - np.maximum((left[:, None] + slope[:, None] * theta - b).max(axis=1), 0.0)
     right = left + slope
     # A bound of 0 at a node is never left in finite time where it rises like s² (a v_limit
     # knot at 0 m/s): no line from 0 lies under it. The cell is flat at 0, as the minimum.
-    zero = np.minimum(b[:, 0], b[:, per_interval]) <= 0.0
+    zero = np.minimum(at[:-1], at[1:]) <= 0.0
     left, right = np.where(zero, 0.0, left), np.where(zero, 0.0, right)
-    out = np.asarray(bound(s), dtype=np.float64)
+    out = at.copy()
     out[:-1] = np.minimum(out[:-1], left)
     out[1:] = np.minimum(out[1:], right)
     return out
