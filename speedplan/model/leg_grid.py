@@ -146,6 +146,16 @@ def bound_kinks(bound: SpeedBound, breaks: FloatArray, length: float) -> FloatAr
     There the chord of a cell with the point inside lies above the bound by ``O(h)``
     (`chord_node_bounds`); a node on it costs nothing. A concave kink (the bound leaving
     ``v_max²`` into a curve) or a join where the bound is smooth needs none.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan import Limits
+    >>> from speedplan.geometry import Arc, Clothoid, Line, Path, SpeedBound
+    >>> p = Path.from_segments([Line(5.0), Clothoid(2.0, 0.0, 0.5), Arc(radius=2.0, angle=1.0)])
+    >>> bound = SpeedBound(p, Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    >>> bound_kinks(bound, np.array([5.0, 7.0]), float(p.length)).tolist()  # the arc's start
+    [7.0]
     """
     breaks = breaks[(breaks > 0.0) & (breaks < length)]
     if breaks.size == 0:
