@@ -21,20 +21,20 @@ import numpy as np
 from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
 from ..core.options import RestReason
-from ..geometry import CellSamples, SpeedBound
+from ..geometry import CellSamples, SpeedBound, bound_breakpoints
 from ..solve.problem import MAX_RAMP_STEPS, DiscreteProblem, ramp_steps
 from .boundary import STATE_JERK_ROUNDING, check_reachable_states, turnaround_speed
 from .grid import MIN_NODES
-from .leg_grid import default_grid, grid_anchors, leg_grid, no_jerk_grid
+from .leg_grid import default_grid, grid_anchors, kink_anchors, leg_grid, no_jerk_grid
 from .legs import ForcedLeg, Leg, Model, Rest, StraightLeg, TimeLawSpec
 from .request import STATE_ROUNDING, PlanRequest, within_limit
 from .rows import (
     Envelopes,
     check_floor,
+    chord_node_bounds,
     curvature_at_nodes,
     lateral_jerk_rows,
     lateral_speed_caps,
-    node_bounds,
     node_minima,
 )
 from .standstill import calibrate_standstill_rows
@@ -247,13 +247,15 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     length = float(s[-1])
     env = Envelopes.of(request, v0, a0, vf, af, length)
     linear = not (request.jerk_limited or np.isfinite(lim.j_lat_max))
+    breaks = None
     if linear:
         if samples is None or samples.s is not s:
             samples = CellSamples.of(bound, s)
         w_max = env.cap(s, node_minima(samples.bound))
     else:
         samples = None
-        w_max = env.cap(s, node_bounds(bound, s))
+        breaks = bound_breakpoints(request.path, bound)
+        w_max = env.cap(s, chord_node_bounds(bound, s, breaks))
     w_max[0] = max(w_max[0], v0 * v0)
     w_max[-1] = max(w_max[-1], vf * vf)
     if (w_max[1:-1] <= 0).any():
@@ -298,7 +300,9 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     )
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
-               backend=request.backend, anchors=grid_anchors(request, lo, lo + length),
+               backend=request.backend,
+               anchors=np.union1d(grid_anchors(request, lo, lo + length),
+                                  kink_anchors(request, bound, length, breaks)),
                samples=samples)
 
 

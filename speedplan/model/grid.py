@@ -50,6 +50,7 @@ __all__ = [
     "END_ZONE",
     "GRADING",
     "HIDDEN_DIP",
+    "KINK_REFINE",
     "MAX_DEFAULT_NODES",
     "MIN_ANCHOR_NODES",
     "MIN_NODES",
@@ -88,11 +89,16 @@ MIN_RELATIVE_STEP = 1e-11
 #: Largest relative change between neighbouring steps where the speed may change.
 GRADING = 0.01
 #: Fewest nodes between two grid anchors (points that must be nodes, e.g. joins of path
-#: pieces where the curvature rate jumps): the steps on either side are scaled by at most
-#: ``1 ± 0.5 / MIN_ANCHOR_NODES`` (1 %), within the grading.
-MIN_ANCHOR_NODES = 50
+#: pieces where the curvature rate jumps, kinks of the speed bound): the count between two
+#: anchors is made an integer by a scale that is 1 at both and bends in between, which
+#: changes neighbouring steps by about ``3 / N²`` over ``N`` steps (0.5 % at 25), within the
+#: grading.
+MIN_ANCHOR_NODES = 25
 #: The default grid's steps leave this many times `MIN_ANCHOR_NODES` between two anchors.
 ANCHOR_ROOM = 1.5
+#: The default grid's steps between two kinks of the speed bound (nodes where it fits) are at
+#: most this many times finer than elsewhere to leave room for `MIN_ANCHOR_NODES`.
+KINK_REFINE = 4.0
 #: Largest relative change between neighbouring steps inside long constant-bound stretches.
 CRUISE_GRADING = 0.1
 #: Nodes per boundary transient of a user grid (``n`` or ``ds``): the first jerk phase from
@@ -266,10 +272,16 @@ def nodes_from_steps(s: FloatArray, h: FloatArray,
                 cuts.append(k)
     cuts.append(s.size - 1)
     factor = np.empty(ds.size)  # N is scaled by this on each cell: integer between cuts
-    for k0, k1 in itertools.pairwise(cuts):
+    if len(cuts) == 2:
+        factor[:] = max(int(np.ceil(cum_raw[-1] - 1e-9)), 1) / cum_raw[-1]
+    for k0, k1 in itertools.pairwise(cuts if len(cuts) > 2 else []):
+        # Between anchors the scale is 1 at both ends and bends in between (a parabola in the
+        # count): the steps change by ~3/N² per step over N steps, and not at the anchors.
         total = float(cum_raw[k1] - cum_raw[k0])
-        count = max(int(np.ceil(total - 1e-9)) if len(cuts) == 2 else round(total), 1)
-        factor[k0:k1] = count / total
+        u = (0.5 * (cum_raw[k0:k1] + cum_raw[k0 + 1:k1 + 1]) - cum_raw[k0]) / total
+        bump = 4.0 * u * (1.0 - u)
+        scale = (max(round(total), 1) - total) / float(np.sum(cell[k0:k1] * bump))
+        factor[k0:k1] = 1.0 + scale * bump
     if len(cuts) == 2 and factor[0] * cum_raw[-1] < 2.0 - 1e-9:  # at least three nodes
         factor[:] = 2.0 / cum_raw[-1]
     cell = cell * factor
@@ -335,6 +347,7 @@ def adaptive_grid(
     anchors: FloatArray | None = None,
     breakpoints: FloatArray | None = None,
     v_top: float | None = None,
+    nodes_at: FloatArray | None = None,
 ) -> FloatArray:
     """Smoothly graded grid with about ``per_phase`` nodes per jerk transition.
 
@@ -366,6 +379,11 @@ def adaptive_grid(
     v_top : float, optional
         The fastest speed the path's own bound allows (`top_speed`, without the
         boundary envelopes); the transitions are sized under ``min(v_max, v_top)``.
+    nodes_at : ndarray, optional
+        Positions [m] that should be nodes at a bounded cost (kinks and steps of the speed
+        bound, `speedplan.model.leg_grid.bound_kinks`): the steps between two of them leave
+        room for `MIN_ANCHOR_NODES` when that makes them at most `KINK_REFINE` times finer;
+        closer ones are nodes where they fit.
     """
     a = min(a_max, a_decel)
     v_max = v_max if v_top is None else min(v_max, v_top)
@@ -380,7 +398,11 @@ def adaptive_grid(
     inner_anchors = inner_anchors[(inner_anchors > 0.0) & (inner_anchors < length)]
     if inner_anchors.size:
         rule = replace(rule, anchors=np.concatenate(([0.0], np.sort(inner_anchors), [length])))
-    sf = _pre_grid(length, rule.floor, inner_anchors)
+    extra = np.zeros(0) if nodes_at is None else np.asarray(nodes_at, dtype=np.float64)
+    extra = extra[(extra > 0.0) & (extra < length)]
+    if extra.size:
+        rule = replace(rule, kinks=np.concatenate(([0.0], np.sort(extra), [length])))
+    sf = _pre_grid(length, rule.floor, np.union1d(inner_anchors, extra))
     if breakpoints is not None:
         sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
     sf, h, rate = _followed(sf, rule)
@@ -389,7 +411,7 @@ def adaptive_grid(
         # anchors then become nodes where they fit (a random comfort path of 21 pieces at the
         # cap: limits exceeded after three refinements with the room, verified after one
         # without it).
-        sf, h, rate = _followed(sf, replace(rule, anchors=None))
+        sf, h, rate = _followed(sf, replace(rule, anchors=None, kinks=None))
     # The first transitions next to each end (the max-jerk start from rest, a moving state's
     # first change of acceleration) keep their steps when the node cap binds: grown there,
     # the law's jerk at their end breaks its limit, and every finer grid tried after it costs
@@ -397,7 +419,8 @@ def adaptive_grid(
     zone = 2.0 * rule.floor if 2.0 * rule.floor <= END_ZONE * length else 0.0
     ends = (sf <= zone) | (sf >= length - zone)
     h = _capped(sf, h, rate, length, max_nodes, ends)
-    grid = nodes_from_steps(sf, h, inner_anchors if inner_anchors.size else None)
+    kept = np.union1d(inner_anchors, extra)
+    grid = nodes_from_steps(sf, h, kept if kept.size else None)
     grid_size("n", grid.size)
     return grid
 
@@ -420,6 +443,7 @@ class _StepRule:
     floor: float
     margin: float
     anchors: FloatArray | None = None  # sorted, with both ends: every anchor becomes a node
+    kinks: FloatArray | None = None  # sorted, with both ends: nodes at a bounded cost
 
     def scale(self, v: FloatArray) -> FloatArray:
         """``λ(v) = v min(t_j, sqrt(v / j))``: the length of a jerk transition at speed ``v``."""
@@ -450,6 +474,12 @@ class _StepRule:
                         self.anchors.size - 1)
             gap = self.anchors[k] - self.anchors[k - 1]
             h = np.minimum(h, gap / (ANCHOR_ROOM * MIN_ANCHOR_NODES))
+        if self.kinks is not None:
+            # The same room between the kinks of the bound, at most KINK_REFINE times finer:
+            # closer kinks are nodes where they fit.
+            k = np.clip(np.searchsorted(self.kinks, sf, side="right"), 1, self.kinks.size - 1)
+            gap = self.kinks[k] - self.kinks[k - 1]
+            h = np.minimum(h, np.maximum(gap / (ANCHOR_ROOM * MIN_ANCHOR_NODES), h / KINK_REFINE))
         rate: FloatArray = np.where(far, CRUISE_GRADING, GRADING)
         return graded_steps(sf, h, rate), rate
 

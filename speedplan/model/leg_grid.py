@@ -28,8 +28,9 @@ from .grid import (
 from .request import PlanRequest
 from .rows import Envelopes, node_minima
 
-__all__ = ["NO_JERK_BOUND_LOSS", "NO_JERK_NODES", "NO_JERK_REFINEMENTS", "default_grid",
-           "grid_anchors", "leg_grid", "no_jerk_grid"]
+__all__ = ["KINK_PROBE", "NO_JERK_BOUND_LOSS", "NO_JERK_NODES", "NO_JERK_REFINEMENTS",
+           "bound_kinks", "default_grid", "grid_anchors", "kink_anchors", "leg_grid",
+           "no_jerk_grid"]
 
 #: Uniform grid of a request without jerk limit (the O(n) pass is exact on any grid).
 NO_JERK_NODES = 1001
@@ -55,13 +56,14 @@ def default_grid(request: PlanRequest, leg_bound: SpeedBound, lo: float, hi: flo
         turnaround_speed(v, a, lim.j_max) for v, a in ((v0, a0), (vf, -af))
         if v > 0 and a < 0]
     v_top = top_speed(leg_bound, length, lim.v_max, v0 * v0, vf * vf)
+    breaks = bound_breakpoints(request.path, leg_bound)
     return adaptive_grid(length, lambda q: env.cap(q, leg_bound(q)), a_max=lim.a_max,
                          a_decel=lim.a_decel, v_max=lim.v_max, j_max=lim.j_max,
                          w_start=v0**2, w_end=vf**2,
                          v_low=min((v for v in low if v > 0), default=None),
                          anchors=grid_anchors(request, lo, hi), max_nodes=max_nodes,
-                         breakpoints=bound_breakpoints(request.path, leg_bound),
-                         v_top=v_top)
+                         breakpoints=breaks, v_top=v_top,
+                         nodes_at=kink_anchors(request, leg_bound, length, breaks))
 
 
 def no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: float,
@@ -142,6 +144,59 @@ def _cut_out_dips(s: FloatArray, edges: FloatArray) -> FloatArray:
     apart = np.minimum(new - s[k - 1], s[k] - new) > 1e-12 * float(s[-1] - s[0])
     out: FloatArray = np.union1d(s, new[apart])  # no cell of a few ulps
     return out
+
+
+#: Relative offset [of the leg's length] at which `bound_kinks` reads the bound's one-sided
+#: values and slopes next to a breakpoint.
+KINK_PROBE = 1e-7
+
+
+def bound_kinks(bound: SpeedBound, breaks: FloatArray, length: float) -> FloatArray:
+    """The ``breaks`` where the bound steps or kinks convexly (its slope increases).
+
+    There the chord of a cell with the point inside lies above the bound by ``O(h)``
+    (`chord_node_bounds`); a node on it costs nothing. A concave kink (the bound leaving
+    ``v_max²`` into a curve) or a join where the bound is smooth needs none.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from speedplan import Limits
+    >>> from speedplan.geometry import Arc, Clothoid, Line, Path, SpeedBound
+    >>> p = Path.from_segments([Line(5.0), Clothoid(2.0, 0.0, 0.5), Arc(radius=2.0, angle=1.0)])
+    >>> bound = SpeedBound(p, Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5))
+    >>> bound_kinks(bound, np.array([5.0, 7.0]), float(p.length)).tolist()  # the arc's start
+    [7.0]
+    """
+    breaks = breaks[(breaks > 0.0) & (breaks < length)]
+    if breaks.size == 0:
+        return breaks
+    eps = KINK_PROBE * length
+    probe = breaks[:, None] + eps * np.array([-2.0, -1.0, 1.0, 2.0])[None, :]
+    b = np.asarray(bound(probe.ravel()), dtype=np.float64).reshape(probe.shape)
+    left_slope, right_slope = (b[:, 1] - b[:, 0]) / eps, (b[:, 3] - b[:, 2]) / eps
+    left, right = b[:, 1] + eps * left_slope, b[:, 2] - eps * right_slope
+    scale = np.maximum(np.abs(b).max(axis=1), 1e-300)
+    step = np.abs(right - left) > 1e-6 * scale
+    kink = right_slope - left_slope > 1e-3 * np.maximum(np.abs(left_slope), np.abs(right_slope))
+    out: FloatArray = breaks[step | kink]
+    return out
+
+
+def kink_anchors(request: PlanRequest, leg_bound: SpeedBound, length: float,
+                 breaks: FloatArray | None = None) -> FloatArray:
+    """Where a jerk-limited leg's grids put nodes for its bound: `bound_kinks` (else none).
+
+    With a node on each, the node bounds of `chord_node_bounds` lose only
+    ``O(h²)`` of the bound, and the discrete optimum converges at second order in the step.
+    Without a jerk or lateral-jerk limit the law is linear per cell and the no-jerk grid
+    handles the bound by its own refinement (`no_jerk_grid`).
+    """
+    if not (request.jerk_limited or np.isfinite(request.limits.j_lat_max)):
+        return np.zeros(0)
+    if breaks is None:
+        breaks = bound_breakpoints(request.path, leg_bound)
+    return bound_kinks(leg_bound, breaks, length)
 
 
 def boundary_transient(request: PlanRequest, v: float, a: float, a_limit: float,

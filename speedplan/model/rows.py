@@ -76,6 +76,90 @@ def node_minima(values: FloatArray, per_interval: int = CELL_POINTS) -> FloatArr
     return w
 
 
+def chord_node_bounds(bound: Callable[[FloatArray], FloatArray], s: FloatArray,
+                      breakpoints: FloatArray | None = None,
+                      per_interval: int = 8) -> FloatArray:
+    """Bound at each node such that every cell's chord lies under the bound.
+
+    On each cell ``[s_i, s_{i+1}]`` the node bounds ``(B_i, B_{i+1})`` span a line under the
+    bound ``b``: a ``w`` under them and linear on the cell stays under ``b`` (to the sampling
+    of ``b``), as with the minimum over the cell (`node_bounds`). Of these lines the cell
+    takes the one that costs the least time to first order: a line under ``b`` maximising
+    ``B_i / b_i^{3/2} + B_{i+1} / b_{i+1}^{3/2}`` (the sensitivity of ``h / sqrt(w)``), which
+    is the lower convex hull of ``b`` over the cell at a point between its ends. Each node
+    takes the smaller of its two cells' values. Where ``b`` is smooth the bound is then lost
+    only where it is convex, by ``O(b'' h²)``; the minimum over the cells loses
+    ``O(|b'| h)`` wherever the bound falls. A kink or a step of the bound inside a cell (a
+    clothoid onto an arc, a zone's edge) still costs ``O(h)``: a node on it costs nothing
+    (`speedplan.model.leg_grid.bound_kinks`).
+
+    ``b`` is read at ``per_interval`` points per cell and at the ``breakpoints`` [m] of the
+    bound inside the cells, where it may kink, step or dip (`bound_breakpoints`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.linspace(0.0, 4.0, 5)
+    >>> falling = lambda q: 10.0 - np.asarray(q)  # linear: the chords lie on it
+    >>> chord_node_bounds(falling, s).tolist(), node_bounds(falling, s).tolist()
+    ([10.0, 9.0, 8.0, 7.0, 6.0], [9.0, 8.0, 7.0, 6.0, 6.0])
+    >>> step = lambda q: np.where(np.asarray(q) < 2.5, 4.0, 1.0)  # a step inside cell 2
+    >>> chord_node_bounds(step, s, breakpoints=np.array([2.5])).tolist()
+    [4.0, 4.0, 1.0, 1.0, 1.0]
+    """
+    m = s.size - 1
+    h = np.diff(s)
+    theta = np.tile(np.linspace(0.0, 1.0, per_interval + 1), (m, 1))
+    if breakpoints is not None and breakpoints.size:
+        brk = breakpoints[(breakpoints > s[0]) & (breakpoints < s[-1])]
+        k = np.clip(np.searchsorted(s, brk, side="right") - 1, 0, m - 1)
+        inside = (brk > s[k]) & (brk < s[k + 1])
+        brk, k = brk[inside], k[inside]
+        if brk.size:  # one more column per breakpoint of the busiest cell, the others at 1
+            rank = np.arange(brk.size) - np.searchsorted(k, k)
+            extra = np.ones((m, int(rank.max()) + 1))
+            extra[k, rank] = (brk - s[k]) / h[k]
+            theta = np.hstack((theta, extra))
+    # One call to the bound: the nodes, then the points inside the cells.
+    inside = np.ones(theta.shape, dtype=bool)
+    inside[:, [0, per_interval]] = False
+    inside &= theta < 1.0
+    points = (s[:-1, None] + h[:, None] * theta)[inside]
+    val = np.asarray(bound(np.concatenate((s, points))), dtype=np.float64)
+    at = val[:s.size]
+    b = np.where(theta >= 1.0, at[1:, None], at[:-1, None])
+    b[inside] = val[s.size:]
+    # The weights b^{-3/2} of the ends, as the share of the right one (bounds of 0 allowed).
+    ends = np.log(np.maximum(at, 1e-300))
+    star = 1.0 / (1.0 + np.exp(np.clip(1.5 * (ends[1:] - ends[:-1]), -50.0, 50.0)))
+    star = np.clip(star, 1e-6, 1.0 - 1e-6)
+    # The lower convex hull at `star`: the least value there of a chord between two samples
+    # on either side of it.
+    best_val = np.full(m, np.inf)
+    slope, left = np.zeros(m), b[:, 0].copy()
+    for i, j in zip(*np.triu_indices(theta.shape[1], 1), strict=True):
+        ti, tj, bi, bj = theta[:, i], theta[:, j], b[:, i], b[:, j]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sl = (bj - bi) / (tj - ti)
+            value = bi + sl * (star - ti)
+        spans = (np.minimum(ti, tj) <= star) & (star <= np.maximum(ti, tj)) & (ti != tj)
+        better = spans & (value < best_val)
+        best_val = np.where(better, value, best_val)
+        slope = np.where(better, sl, slope)
+        left = np.where(better, bi - sl * ti, left)
+    # The line through the hull's edge at `star` lies under every sample; rounding aside.
+    left = left - np.maximum((left[:, None] + slope[:, None] * theta - b).max(axis=1), 0.0)
+    right = left + slope
+    # A bound of 0 at a node is never left in finite time where it rises like s² (a v_limit
+    # knot at 0 m/s): no line from 0 lies under it. The cell is flat at 0, as the minimum.
+    zero = np.minimum(at[:-1], at[1:]) <= 0.0
+    left, right = np.where(zero, 0.0, left), np.where(zero, 0.0, right)
+    out = at.copy()
+    out[:-1] = np.minimum(out[:-1], left)
+    out[1:] = np.minimum(out[1:], right)
+    return out
+
+
 @dataclass(frozen=True)
 class Envelopes:
     """Jerk-limited envelopes of the motions leaving the start state and reaching the end."""

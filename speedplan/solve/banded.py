@@ -209,7 +209,7 @@ def _primal_t(p: DiscreteProblem, w: FloatArray) -> FloatArray:
 
 def _lagrangian_bound(
     p: DiscreteProblem, mu_acc: FloatArray, mu_dec: FloatArray,
-    nu: list[tuple[FloatArray, FloatArray]],
+    nu: list[tuple[FloatArray, FloatArray]], linear: tuple[FloatArray, float] | None = None,
 ) -> float:
     """Lower bound from multipliers of the acceleration and stencil rows (weak duality).
 
@@ -220,8 +220,13 @@ def _lagrangian_bound(
     ``t``; its minimum over the box ``w_min <= w <= w_max`` is separable and closed-form (the
     minimiser of the convex ``g w + c / sqrt(w)`` clipped to the box). Any such multipliers
     give a valid bound; non-finite ones (an iterate that broke down) give none, ``-inf``.
+    ``linear = (g, c)`` adds ``g · w - c`` to the Lagrangian: the term of further rows
+    ``a · w <= b`` with their multipliers ``π >= 0`` (``g = A' π``, ``c = b · π``, as for
+    `speedplan.solve.cuts`).
     """
     arrays = [mu_acc, mu_dec, *(x for pair in nu for x in pair)]
+    if linear is not None:
+        arrays += [linear[0], np.array([linear[1]])]
     if not all(np.all(np.isfinite(x)) for x in arrays):
         return -np.inf
     mu_acc, mu_dec = np.maximum(mu_acc, 0.0), np.maximum(mu_dec, 0.0)
@@ -241,8 +246,12 @@ def _lagrangian_bound(
         finite = np.isfinite(family.bound)
         coef = np.where(finite, (a - b) * p.tau / np.where(finite, family.bound, 1.0), 0.0)
         g += p.stencil_adjoint(family.coef, coef)
+    extra = 0.0
+    if linear is not None:
+        g += linear[0]
+        extra = linear[1]
     const = (g[0] * p.w_start + g[-1] * p.w_end
-             - float(mu_acc @ (p.accel * p.h)) - float(mu_dec @ (p.decel * p.h)))
+             - float(mu_acc @ (p.accel * p.h)) - float(mu_dec @ (p.decel * p.h)) - extra)
     gi, c, wmax = g[1:-1], lam * p.tau, p.w_max[1:-1]
     pos = gi > 0
     w_opt = wmax.copy()

@@ -23,12 +23,13 @@ import numpy as np
 from ..core.checks import FloatArray, IntArray
 from ..core.deadline import remaining
 from ..core.errors import InfeasibleError, SolverError
+from .cuts import SecantCuts
 from .problem import DiscreteProblem
 
 if TYPE_CHECKING:  # scipy.sparse is imported where the SOCP is built: import speedplan stays light
     import scipy.sparse as sp
 
-__all__ = ["RelaxationResult", "solve_relaxation"]
+__all__ = ["RelaxationResult", "row_multipliers", "solve_relaxation"]
 
 _SOLVED = {"Solved"}
 _ALMOST = {"AlmostSolved"}
@@ -48,6 +49,7 @@ class RelaxationResult:
     iterations: int
     solve_time: float
     setup_time: float
+    z: FloatArray | None = None  # Clarabel's dual variables, in the rows' order (build_socp)
 
 
 def _rows(
@@ -93,12 +95,14 @@ class _Rows:
         return A, np.concatenate(self.b)
 
 
-def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, FloatArray, list[Any]]:
+def build_socp(problem: DiscreteProblem, cuts: SecantCuts | None = None
+               ) -> tuple[sp.csc_matrix, FloatArray, FloatArray, list[Any]]:
     """Return ``(A, b, q, cones)`` of the relaxation in Clarabel's ``Ax + s = b`` form.
 
     Variables: ``w`` (n), the epigraph ``t`` and auxiliary ``z`` of each interior node
     (``t_i >= τ_i / sqrt(w_i)`` through ``z_i² <= w_i`` and ``t_i z_i >= τ_i``), and with a
-    friction ellipse each cell's acceleration fraction ``u``.
+    friction ellipse each cell's acceleration fraction ``u``. ``cuts`` (`secant_cuts`) adds
+    its linear rows.
     """
     n = problem.n
     m = n - 2
@@ -126,6 +130,10 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
                                       (iw + seg + 1, iw + seg, problem.decel)):
             rows.add(n - 1, [hi_col, lo_col, ucol],
                      [1.0 / (h * limit), -1.0 / (h * limit), -one(n - 1)], np.zeros(n - 1))
+    if cuts is not None and cuts.size:
+        i = iw + cuts.node
+        rows.add(cuts.size, [i - 1, i, i + 1], [cuts.coef[:, 0], cuts.coef[:, 1], cuts.coef[:, 2]],
+                 cuts.rhs)
     n_nonneg = rows.count - 2
     _add_node_cones(rows, problem.tau, iw, it, iz)
     n_grip_cones = 0
@@ -139,6 +147,36 @@ def build_socp(problem: DiscreteProblem) -> tuple[sp.csc_matrix, FloatArray, Flo
     cones = [clarabel.ZeroConeT(2), clarabel.NonnegativeConeT(n_nonneg)]
     cones += [clarabel.SecondOrderConeT(3)] * (2 * m + n_grip_cones)
     return A, b, q, cones
+
+
+def row_multipliers(problem: DiscreteProblem, z: FloatArray, cuts: SecantCuts | None = None
+                    ) -> tuple[FloatArray, FloatArray, list[tuple[FloatArray, FloatArray]],
+                               FloatArray]:
+    """Clarabel's multipliers of the rows of `build_socp`, by kind.
+
+    Returns ``(μ_acc, μ_dec, [(ν⁺_f, ν⁻_f) per family, per interior node], π_cuts)``, in the
+    order `build_socp` lays the rows out (the bounds' rows and the cones are left out: a
+    Lagrangian bound takes the bounds as its box).
+    """
+    n, m = problem.n, problem.n - 2
+    k = 2
+    mu_acc, k = z[k:k + n - 1], k + n - 1
+    mu_dec, k = z[k:k + n - 1], k + n - 1
+    k += m
+    if problem.has_lower_bounds:
+        assert problem.w_min is not None
+        k += int(np.count_nonzero(problem.w_min[1:-1] > 0))
+    nu = []
+    for family in problem.stencil_families():
+        finite = np.flatnonzero(np.isfinite(family.bound))
+        plus, minus = np.zeros(m), np.zeros(m)
+        plus[finite], k = z[k:k + finite.size], k + finite.size
+        minus[finite], k = z[k:k + finite.size], k + finite.size
+        nu.append((plus, minus))
+    if problem.has_grip:
+        k += 2 * (n - 1)
+    size = 0 if cuts is None else cuts.size
+    return mu_acc, mu_dec, nu, z[k:k + size]
 
 
 def _add_stencil_rows(rows: _Rows, problem: DiscreteProblem, iw: int, it: int) -> None:
@@ -228,13 +266,14 @@ def _run(P: sp.csc_matrix, q: FloatArray, A: sp.csc_matrix, b: FloatArray, cones
 
 
 def solve_relaxation(
-    problem: DiscreteProblem, settings: clarabel.DefaultSettings | None = None
+    problem: DiscreteProblem, settings: clarabel.DefaultSettings | None = None,
+    cuts: SecantCuts | None = None,
 ) -> RelaxationResult:
-    """Solve the SOCP relaxation; raise on infeasibility or solver failure."""
+    """Solve the SOCP relaxation (with ``cuts``, if given); raise on infeasibility or failure."""
     import scipy.sparse as sp
 
     t0 = time.perf_counter()
-    A, b, q, cones = build_socp(problem)
+    A, b, q, cones = build_socp(problem, cuts)
     P = sp.csc_matrix((q.size, q.size))
     t1 = time.perf_counter()
     first = settings or default_settings()
@@ -261,6 +300,7 @@ def solve_relaxation(
     x = np.asarray(sol.x)
     n, m = problem.n, problem.n - 2
     return RelaxationResult(
+        z=np.asarray(sol.z, dtype=np.float64),
         w=x[:n].copy(),
         t=x[n : n + m].copy(),
         primal_objective=float(sol.obj_val),

@@ -42,6 +42,12 @@ class RelaxationInfo:
         Largest jerk-row violation of ``w`` (``<= jerk_tol``: the relaxation is exact).
     fallback : str or None
         Why the first backend tried was abandoned, or ``None`` when it answered.
+    cut_bound : float or None
+        The lower bound of the relaxation with the stencil rows' secant cuts
+        (`speedplan.solve.cuts`) [s], solved when the relaxation was not exact and its gap
+        large; ``None`` when not solved (or when it failed).
+    cut_time : float
+        Setup and solve time of that relaxation [s] (0 when not solved).
     """
 
     backend: str
@@ -51,6 +57,8 @@ class RelaxationInfo:
     w: FloatArray
     jerk_violation: float
     fallback: str | None = None
+    cut_bound: float | None = None
+    cut_time: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -223,9 +223,24 @@ def test_lateral_rows_match_an_independent_relaxation_on_a_clothoid():
     # growing curvature: sqrt(w) (κ' w - κ 2 a_decel) <= j_lat_max, the largest root.
     caps = np.array([max(np.roots([r, 0.0, -k * 2 * lim.a_decel, -lim.j_lat_max]).real) ** 2
                      for k, r in zip(kappa, rate, strict=True)])
-    expected = _node_min(w_max)
-    expected[1:-1] = np.minimum(expected[1:-1], caps)
-    np.testing.assert_allclose(leg.problem.w_max, expected, rtol=1e-8)
+    got = leg.problem.w_max
+    # The node bounds: the chord of every cell under the bound (read 64 times per cell; the
+    # model reads it 8 times, which leaves a convex bound up to |b''| (h/8)² / 8 above the
+    # chord between its readings; b = a_lat_max L / (k1 s) here), at most the bound at the
+    # node and the caps, and below them by no more than the bound's curvature allows,
+    # |b''| h²; the minimum over a node's two cells loses |b'| h instead.
+    h = s[1] - s[0]
+    theta = np.linspace(0.0, 1.0, 65)
+    q = s[:-1, None] + h * theta
+    chord = got[:-1, None] + (got[1:] - got[:-1])[:, None] * theta
+    bound = np.minimum(lim.v_max**2, lim.a_lat_max * length / (k1 * np.maximum(q, 1e-300)))
+    curvature = 2 * lim.a_lat_max * length / (k1 * np.maximum(s - h, h) ** 3)
+    assert np.all(chord <= bound + (curvature[:-1, None] * (h / 8) ** 2 / 8 + 1e-12))
+    upper = w_max.copy()
+    upper[1:-1] = np.minimum(upper[1:-1], caps)
+    assert np.all(got <= upper * (1 + 1e-8))
+    assert np.all(got >= upper * (1 - 1e-8) - curvature * h**2)
+    assert np.sum(got - _node_min(upper)) > 0.5  # well above the minimum over the cells
     reference = _cvxpy_lateral_relaxation(s, leg.problem.w_max, lim.a_max, lim.j_max, kappa,
                                           rate, lim.j_lat_max)
     sol = solve_problem(leg.problem)  # the lateral rows bind: refined, with its bound

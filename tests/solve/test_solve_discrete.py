@@ -334,7 +334,13 @@ def test_fine_uniform_grid_gets_the_same_answer_from_auto_and_clarabel():
     auto = sp.plan(path, limits, n=5000, refine="never")
     ref = sp.plan(path, limits, n=5000, refine="never", backend="clarabel")
     assert auto.status == ref.status == "optimal"
-    assert auto.duration == pytest.approx(ref.duration, rel=1e-6)
+    # Each certificate holds against the other backend's answer. Clarabel's AlmostSolved
+    # point may exceed a jerk row by its reduced tolerance (measured: 5.4e-5 of the row,
+    # within the exactness test), which makes its travel time up to ~2e-6 shorter than the
+    # relaxation's optimum: the banded method's bound may lie that far above it.
+    assert ref.lower_bound <= auto.solution.objective
+    assert auto.lower_bound <= ref.solution.objective * (1 + 5e-6)
+    assert auto.duration == pytest.approx(ref.duration, rel=5e-6)
     # Whichever backend answered, its certificate is tight; Clarabel may stop at AlmostSolved
     # on this grid with its reduced tolerances, its bound then 1.3e-6 below (measured).
     assert auto.solution.objective - auto.lower_bound <= 1e-6 * auto.solution.objective
