@@ -155,9 +155,12 @@ class Kernels:
     def __repr__(self) -> str:
         return f"Kernels({self.name!r}, {self.module_name!r})"
 
-    def _entries(self) -> tuple[ModuleType, list[tuple[Any, Any]]]:
+    def _entries(self, *, every: bool = False) -> tuple[ModuleType, list[tuple[Any, Any]]]:
+        """The module and ``(dispatcher, signature)`` of its entry points (``every``: all)."""
         kn = importlib.import_module(self.module_name)  # imports numba
-        return kn, [(getattr(kn, name), sig) for name, sig in kn.signatures().items()]
+        sigs = kn.signatures()
+        names = list(sigs) if every else getattr(kn, "ENTRY_POINTS", list(sigs))
+        return kn, [(getattr(kn, name), sigs[name]) for name in names]
 
     def _finish(self, kn: ModuleType, entries: list[tuple[Any, Any]]) -> ModuleType:
         for disp, _ in entries:
@@ -188,10 +191,11 @@ class Kernels:
         if self.background is not None:
             self.background.wait()
             self.background = None
-        kn, entries = self._entries()
+        kn, entries = self._entries(every=True)
         for disp, sig in entries:
             if not load_cached_overload(disp, sig):
                 disp.compile(sig)
+            disp.disable_compile()  # its callers use this overload, whatever they pass
         return self._finish(kn, entries)
 
     def ready(self, *, start: bool = True) -> bool:

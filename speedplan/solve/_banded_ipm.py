@@ -24,6 +24,7 @@ The reduced Newton system is derived in ``docs/banded-ipm.md``.
 
 from __future__ import annotations
 
+import inspect
 import math
 from collections.abc import Callable
 from typing import Any, NamedTuple, TypeVar
@@ -50,6 +51,13 @@ _K = TypeVar("_K", bound=Callable[..., Any])
 def _inner(kernel: _K) -> _K:
     """``njit(**_INNER)``: a kernel called only from other kernels."""
     compiled: _K = njit(**_INNER)(kernel)
+    return compiled
+
+
+def _sequence(kernel: _K) -> _K:
+    """A kernel that calls others in sequence, inlined into its callers by numba."""
+    compiled: _K = njit(inline="always", error_model="numpy", no_cpython_wrapper=True,
+                        no_cfunc_wrapper=True)(kernel)
     return compiled
 
 #: Fraction of the step to the cone boundary taken per iteration.
@@ -455,7 +463,7 @@ def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> 
 @_inner
 def g_adjoint_into(
     d: Data, yl: FloatArray, ys: FloatArray, gw: FloatArray, gt: FloatArray, gz: FloatArray,
-    mode: int = ADJ_SET,
+    mode: int,
 ) -> tuple[float, float, float]:
     """``G' y`` split into its ``w``, ``t`` and ``z`` parts, written into ``g`` by ``mode``.
 
@@ -853,7 +861,7 @@ def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> No
         dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
 
 
-@_inner
+@_sequence
 def newton_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     corrector: bool, sigma_mu: float, refine_above: float, dn: Direction,
@@ -960,7 +968,7 @@ def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
         us[0, c] += shift
 
 
-@_inner
+@_sequence
 def start_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, dn: Direction
 ) -> tuple[bool, float]:
@@ -1001,7 +1009,7 @@ def start_into(
     return True, -shift
 
 
-@_inner
+@_sequence
 def dual_residual_into(d: Data, pt: Point, res: Residual) -> float:
     """The dual residual, negated, ``-(G'y + c)``, into ``res``; returns its squared norm."""
     sw, st, sz = g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz, ADJ_DUAL_RESIDUAL)
@@ -1040,37 +1048,14 @@ def residuals_into(
     return pcost, dcost, gap, ry2, rx2
 
 
-@_inner
+@_sequence
 def _max_step(pt: Point, dn: Direction) -> float:
     """Largest step along ``dn`` keeping ``s`` and ``y`` in their cones."""
     return min(max_step_lin(pt.sl, dn.dsl), max_step_lin(pt.yl, dn.dyl),
                max_step_slack_soc(pt, dn), max_step_soc(pt.ys, dn.dys))
 
 
-@_inner
-def predictor_into(
-    d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
-    refine_above: float, dn: Direction,
-) -> float:
-    """Affine-scaling direction (right-hand side ``-λ∘λ``); returns Mehrotra's ``σ``."""
-    newton_into(d, sc, fac, pt, res, rp, False, 0.0, refine_above, dn)
-    alpha = _max_step(pt, dn)
-    return float((1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT)
-
-
-@_inner
-def corrector_into(
-    d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
-    refine_above: float, sigma_mu: float, dn: Direction,
-) -> None:
-    """Combined direction: the predictor's second-order term and centring ``σ μ``.
-
-    On entry ``dn`` holds the predictor's direction.
-    """
-    newton_into(d, sc, fac, pt, res, rp, True, sigma_mu, refine_above, dn)
-
-
-@_inner
+@_sequence
 def step(pt: Point, dn: Direction) -> float:
     """Move ``pt`` a fraction ``STEP`` of the way to the cone boundary along ``dn``.
 
@@ -1171,8 +1156,11 @@ def iterate(
         # Refinement only pays once the scaling is ill-conditioned, close to the optimum, and
         # only where the solve's own residual could show in the dual residual's test.
         refine_above = REFINE_RESIDUAL * tol * res_x0 if relgap < REFINE_BELOW else np.inf
-        sigma = predictor_into(d, sc, fac, pt, res, rp, refine_above, dn)
-        corrector_into(d, sc, fac, pt, res, rp, refine_above, sigma * (gap / nu), dn)
+        # Predictor: the affine-scaling direction (right-hand side -λ∘λ), whose largest step
+        # sets Mehrotra's σ; then the corrector: its second-order term and centring σ μ.
+        newton_into(d, sc, fac, pt, res, rp, False, 0.0, refine_above, dn)
+        sigma = (1.0 - min(1.0, _max_step(pt, dn))) ** SIGMA_EXPONENT
+        newton_into(d, sc, fac, pt, res, rp, True, sigma * (gap / nu), refine_above, dn)
         alpha = step(pt, dn)
         rp *= 1.0 - alpha  # G Δx + Δs = by: the step removes the fraction α of it
         log[it, 5], log[it, 6] = sigma, alpha
@@ -1182,28 +1170,58 @@ def iterate(
     return it, status
 
 
-def signatures() -> dict[str, Any]:
-    """The kernel called from Python and its signature (see `speedplan.core.jit`).
+#: The kernels called from Python (the others are called only from compiled code).
+ENTRY_POINTS = ("iterate",)
 
-    The types of `iterate`'s arguments as `speedplan.solve.banded` builds them;
-    only their types matter, so the arrays here are of the smallest sizes.
+
+def signatures() -> dict[str, tuple[Any, ...]]:
+    """Every kernel of the module and its one signature, each after the kernels it calls.
+
+    `speedplan.core.jit` compiles them in this order, each for exactly this signature, and
+    then refuses any other: a caller passing a constant (``ADJ_ADD``, ``False``) uses the
+    kernel compiled for its type instead of compiling a copy specialised to the value.
+    The types are those of `iterate`'s arguments as `speedplan.solve.banded` builds them,
+    so the arrays here are of the smallest sizes.
     """
     import numba
+    from numba import types as nt
 
     lay = layout(1, 1, 0)
-    d = Data(jstart=np.zeros(2, dtype=np.intp), jc=np.zeros((3, 1)), cj=np.zeros(1),
-             lk=np.zeros(0, dtype=np.intp), ct=np.zeros(1), cw=np.zeros(1),
-             b_lin=np.zeros(lay.jm), lay=lay)
-    args = (d, empty(Point, lay), empty(Residual, lay), empty(Direction, lay),
-            Scaling.identity(lay), empty(Factor, lay), np.zeros((2, len(LOG_COLUMNS))), 1e-8, 1)
-    return {"iterate": tuple(numba.typeof(a) for a in args)}  # type: ignore[no-untyped-call]
+    data = Data(jstart=np.zeros(2, dtype=np.intp), jc=np.zeros((3, 1)), cj=np.zeros(1),
+                lk=np.zeros(0, dtype=np.intp), ct=np.zeros(1), cw=np.zeros(1),
+                b_lin=np.zeros(lay.jm), lay=lay)
+    d, pt, res, dn, sc, fac = (numba.typeof(a) for a in (  # type: ignore[no-untyped-call]
+        data, empty(Point, lay), empty(Residual, lay), empty(Direction, lay),
+        Scaling.identity(lay), empty(Factor, lay)))
+    v, mat, i, x, b = nt.float64[::1], nt.float64[:, ::1], nt.intp, nt.float64, nt.boolean
+    return {
+        "_pad": (v, i), "_b_lin": (d, i), "_stencil_dot": (d, v, i, i),
+        "_scatter_stencil": (d, i, i, x, v), "_jnorm2": (x, x, x), "_h_entries": (sc, i),
+        "_apply_h": (sc, x, x, x, i), "_apply_w": (sc, x, x, x, i),
+        "_apply_winv": (sc, x, x, x, i), "_jordan_solve": (x, x, x, x, x, x),
+        "_b_soc": (i, i, i), "_cone_s": (v, v, v, i), "_cone_ds": (v, v, v, i),
+        "g_lin_into": (d, v, v, v), "g_soc_into": (v, v, v, mat),
+        "g_adjoint_into": (d, v, mat, v, v, v, i), "_cone_step": (x, x, x, x, x, x),
+        "max_step_soc": (mat, mat), "max_step_slack_soc": (pt, dn), "max_step_lin": (v, v),
+        "_interior": (x, x, x), "_interior_after_step": (pt, x, dn),
+        "cone_scaling_into": (sc, i, x, x, x, x, x, x), "scaling_into": (pt, sc),
+        "_lambda": (sc, mat, i), "_eliminate_tz": (d, sc, v, v, fac, i),
+        "factor_into": (d, sc, v, v, fac), "solve_banded_inplace": (fac, v),
+        "solve_normal_inplace": (d, fac, v, v, v), "_v_into": (sc, pt, x, b, x, dn),
+        "_recover_v_into": (sc, pt, x, dn), "_ds_dy_into": (d, sc, pt, x, dn),
+        "_dot": (v, v), "_dot2": (mat, mat), "_axpy": (x, v, v), "_axpy2": (x, mat, mat),
+        "_shift": (x, x), "_shift_into_cone": (v, mat),
+        "residuals_into": (d, pt, res, v),
+        "iterate": (d, pt, res, dn, sc, fac, mat, x, i),
+    }
 
 
 def python_callable(kernel: Any) -> Any:
     """``kernel`` (any of this module's) callable from Python: for tests and diagnostics.
 
     The kernels other than `iterate` have no Python entry point (see ``_INNER``); this
-    wraps one in a compiled trampoline (compiled on first call, not cached).
+    wraps one in a compiled trampoline (compiled on first call, not cached) with the
+    kernel's own parameters (numba inlines a `_sequence` kernel, which takes no ``*args``).
 
     Examples
     --------
@@ -1212,11 +1230,10 @@ def python_callable(kernel: Any) -> Any:
     1.0
     """
     if kernel not in _TRAMPOLINES:
-        @njit
-        def call(*args: Any) -> Any:  # pragma: no cover - compiled
-            return kernel(*args)
-
-        _TRAMPOLINES[kernel] = call
+        params = ", ".join(inspect.signature(kernel.py_func).parameters)
+        scope: dict[str, Any] = {"kernel": kernel}
+        exec(f"def call({params}):\n    return kernel({params})\n", scope)  # noqa: S102
+        _TRAMPOLINES[kernel] = njit(scope["call"])
     return _TRAMPOLINES[kernel]
 
 
