@@ -44,7 +44,7 @@ _T = TypeVar("_T")
 #: compile time (measured: 28 s of CPU instead of 34 s). `python_callable` calls one
 #: from Python.
 _INNER: dict[str, Any] = {"cache": True, "error_model": "numpy", "no_cpython_wrapper": True,
-                          "no_cfunc_wrapper": True}
+                          "no_cfunc_wrapper": True, "_nrt": False}
 _K = TypeVar("_K", bound=Callable[..., Any])
 
 
@@ -57,7 +57,7 @@ def _inner(kernel: _K) -> _K:
 def _sequence(kernel: _K) -> _K:
     """A kernel that calls others in sequence, inlined into its callers by numba."""
     compiled: _K = njit(inline="always", error_model="numpy", no_cpython_wrapper=True,
-                        no_cfunc_wrapper=True)(kernel)
+                        no_cfunc_wrapper=True, _nrt=False)(kernel)
     return compiled
 
 #: Fraction of the step to the cone boundary taken per iteration.
@@ -1083,7 +1083,7 @@ def step(pt: Point, dn: Direction) -> float:
     return alpha
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def iterate(
     d: Data, pt: Point, res: Residual, dn: Direction, sc: Scaling, fac: Factor,
     log: FloatArray, tol: float, max_iter: int,
