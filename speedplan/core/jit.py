@@ -47,14 +47,58 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from types import ModuleType
-from typing import Any
+from typing import Any, TypeVar
 
 __all__ = [
     "BACKGROUND_COMPILE_ENV", "COMPILE_LOCK_STALE", "FAMILIES", "Kernels", "compile_families",
-    "load_cached_overload", "tolerate_stale_indexes",
+    "inlined", "inner", "kernel", "load_cached_overload", "tolerate_stale_indexes",
 ]
+
+_K = TypeVar("_K", bound=Callable[..., Any])
+
+#: numba options of every kernel. The kernels allocate nothing (their callers pass every
+#: array), so they run without numba's reference counting (``_nrt=False``): no increments
+#: and decrements of every array at every call to lower, optimise and emit; no C entry point
+#: either. The result is the same arithmetic; the relaxation compiled in 8.5 s of CPU
+#: instead of 9.6 s without the reference counting alone.
+KERNEL_OPTIONS: dict[str, Any] = {"cache": True, "error_model": "numpy", "_nrt": False,
+                                  "no_cfunc_wrapper": True}
+
+
+def kernel(fn: _K, error_model: str = "numpy") -> _K:
+    """A kernel called from Python: ``numba.njit(**KERNEL_OPTIONS)``.
+
+    ``error_model="python"`` makes a division by zero raise instead of giving ``inf``.
+    """
+    from numba import njit
+
+    compiled: _K = njit(**{**KERNEL_OPTIONS, "error_model": error_model})(fn)
+    return compiled
+
+
+def inner(fn: _K, error_model: str = "numpy") -> _K:
+    """A kernel called only from other kernels: no Python entry point to generate."""
+    from numba import njit
+
+    options = {**KERNEL_OPTIONS, "error_model": error_model}
+    compiled: _K = njit(**options, no_cpython_wrapper=True)(fn)
+    return compiled
+
+
+def inlined(fn: _K) -> _K:
+    """A kernel that numba inlines into each caller: no code of its own to compile.
+
+    For kernels that only call others in sequence: compiled on their own, each would
+    carry a copy of everything they call, optimised and emitted once more (numba links
+    a callee's code into each caller's).
+    """
+    from numba import njit
+
+    options = {k: v for k, v in KERNEL_OPTIONS.items() if k != "cache"}
+    compiled: _K = njit(**options, no_cpython_wrapper=True, inline="always")(fn)
+    return compiled
 
 #: Environment variable: set to ``0`` to make every fallback compile its kernels in the calling
 #: process instead of answering without them while a background process compiles them.

@@ -26,39 +26,17 @@ from __future__ import annotations
 
 import inspect
 import math
-from collections.abc import Callable
 from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 from numba import njit
 
 from ..core.checks import FloatArray, IntArray
-from ..core.jit import tolerate_stale_indexes
+from ..core.jit import inlined, inner, kernel, tolerate_stale_indexes
 
 tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 _T = TypeVar("_T")
-
-#: numba options of every kernel here but `iterate`: called only from compiled code,
-#: they need no Python or C entry point, whose generation cost a sixth of the module's
-#: compile time (measured: 28 s of CPU instead of 34 s). `python_callable` calls one
-#: from Python.
-_INNER: dict[str, Any] = {"cache": True, "error_model": "numpy", "no_cpython_wrapper": True,
-                          "no_cfunc_wrapper": True, "_nrt": False}
-_K = TypeVar("_K", bound=Callable[..., Any])
-
-
-def _inner(kernel: _K) -> _K:
-    """``njit(**_INNER)``: a kernel called only from other kernels."""
-    compiled: _K = njit(**_INNER)(kernel)
-    return compiled
-
-
-def _sequence(kernel: _K) -> _K:
-    """A kernel that calls others in sequence, inlined into its callers by numba."""
-    compiled: _K = njit(inline="always", error_model="numpy", no_cpython_wrapper=True,
-                        no_cfunc_wrapper=True, _nrt=False)(kernel)
-    return compiled
 
 #: Fraction of the step to the cone boundary taken per iteration.
 STEP = 0.99
@@ -296,7 +274,7 @@ def check_sizes(d: Data, *parts: tuple[Any, ...]) -> None:
 # --- per-cone and per-node scalar kernels ------------------------------------------------------
 
 
-@_inner
+@inner
 def _pad(w: FloatArray, i: int) -> float:
     """``w[i]`` with zero outside ``0 <= i < len(w)`` (the eliminated end values)."""
     if i < 0 or i >= w.size:
@@ -304,7 +282,7 @@ def _pad(w: FloatArray, i: int) -> float:
     return float(w[i])
 
 
-@_inner
+@inner
 def _b_lin(d: Data, j: int) -> float:
     """Right-hand side of linear row ``j``.
 
@@ -314,13 +292,13 @@ def _b_lin(d: Data, j: int) -> float:
     return float(d.b_lin[j]) if j < d.lay.jm else -float(d.b_lin[j - d.lay.k])
 
 
-@_inner
+@inner
 def _stencil_dot(d: Data, w: FloatArray, i: int, r: int) -> float:
     """``jc_r · w_{i-1:i+2}`` for stencil row ``r`` at node ``i`` (zero outside the nodes)."""
     return float(d.jc[0, r] * _pad(w, i - 1) + d.jc[1, r] * w[i] + d.jc[2, r] * _pad(w, i + 1))
 
 
-@_inner
+@inner
 def _scatter_stencil(d: Data, i: int, r: int, value: float, out: FloatArray) -> None:
     """``out += value * jc_r`` at ``w_{i-1:i+2}`` (the adjoint of `_stencil_dot`)."""
     if i > 0:
@@ -330,7 +308,7 @@ def _scatter_stencil(d: Data, i: int, r: int, value: float, out: FloatArray) -> 
         out[i + 1] += value * d.jc[2, r]
 
 
-@_inner
+@inner
 def _jnorm2(u0: float, u1: float, u2: float) -> float:
     """``u' J u`` with ``J = diag(1, -1, -1)``, computed as ``(u_0 - |u_a|)(u_0 + |u_a|) - u_b²``.
 
@@ -343,7 +321,7 @@ def _jnorm2(u0: float, u1: float, u2: float) -> float:
     return (u0 - big) * (u0 + big) - small * small
 
 
-@_inner
+@inner
 def _h_entries(sc: Scaling, c: int) -> tuple[float, float, float, float, float, float]:
     """Entries 00, 01, 02, 11, 12, 22 of cone ``c``'s ``H = W⁻² = (2 ŵ ŵ' - J) / β²``.
 
@@ -356,7 +334,7 @@ def _h_entries(sc: Scaling, c: int) -> tuple[float, float, float, float, float, 
             (2.0 * u1 * u1 + 1.0) * ib2, 2.0 * u1 * u2 * ib2, (2.0 * u2 * u2 + 1.0) * ib2)
 
 
-@_inner
+@inner
 def _apply_h(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[float, float, float]:
     """``H u`` for cone ``c``."""
     h00, h01, h02, h11, h12, h22 = _h_entries(sc, c)
@@ -364,7 +342,7 @@ def _apply_h(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[floa
             h02 * u0 + h12 * u1 + h22 * u2)
 
 
-@_inner
+@inner
 def _apply_w(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[float, float, float]:
     """``W u`` for cone ``c``: ``W = β (2 v v' - J)``."""
     v0, v1, v2, bt = sc.v[0, c], sc.v[1, c], sc.v[2, c], sc.beta[c]
@@ -372,7 +350,7 @@ def _apply_w(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[floa
     return bt * (2.0 * vu * v0 - u0), bt * (2.0 * vu * v1 + u1), bt * (2.0 * vu * v2 + u2)
 
 
-@_inner
+@inner
 def _apply_winv(
     sc: Scaling, u0: float, u1: float, u2: float, c: int
 ) -> tuple[float, float, float]:
@@ -382,7 +360,7 @@ def _apply_winv(
     return (2.0 * vu * j0 - u0) / bt, (2.0 * vu * j1 + u1) / bt, (2.0 * vu * j2 + u2) / bt
 
 
-@_inner
+@inner
 def _jordan_solve(
     l0: float, l1: float, l2: float, b0: float, b1: float, b2: float
 ) -> tuple[float, float, float]:
@@ -391,7 +369,7 @@ def _jordan_solve(
     return u0, (b1 - u0 * l1) / l0, (b2 - u0 * l2) / l0
 
 
-@_inner
+@inner
 def _b_soc(r: int, c: int, m: int) -> float:
     """Constant part of the cone rows: ``(1, 0, -1)`` for node cones, ``(0, 0, 2)`` for t-z."""
     if r == 1:
@@ -401,7 +379,7 @@ def _b_soc(r: int, c: int, m: int) -> float:
     return 0.0 if r == 0 else 2.0
 
 
-@_inner
+@inner
 def _cone_s(w: FloatArray, t: FloatArray, z: FloatArray, c: int) -> tuple[float, float, float]:
     """Cone ``c``'s slack ``b - G x``: ``(1 + w, 2 z, w - 1)`` (node) or ``(t + z, t - z, 2)``."""
     m = w.size
@@ -411,7 +389,7 @@ def _cone_s(w: FloatArray, t: FloatArray, z: FloatArray, c: int) -> tuple[float,
     return t[i] + z[i], t[i] - z[i], 2.0
 
 
-@_inner
+@inner
 def _cone_ds(
     dw: FloatArray, dt: FloatArray, dz: FloatArray, c: int
 ) -> tuple[float, float, float]:
@@ -426,7 +404,7 @@ def _cone_ds(
 # --- the constraint map G and its adjoint -------------------------------------------------
 
 
-@_inner
+@inner
 def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
     """Linear rows of ``G x`` (no constants)."""
     lay = d.lay
@@ -447,7 +425,7 @@ def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
             out[lay.jm + r] = -jw - t[i]
 
 
-@_inner
+@inner
 def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> None:
     """Cone rows of ``G x`` (no constants), shape ``(3, 2 m)``."""
     m = w.size
@@ -460,7 +438,7 @@ def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> 
         out[2, m + i] = 0.0
 
 
-@_inner
+@inner
 def g_adjoint_into(
     d: Data, yl: FloatArray, ys: FloatArray, gw: FloatArray, gt: FloatArray, gz: FloatArray,
     mode: int,
@@ -511,7 +489,7 @@ def g_adjoint_into(
 # --- cones: steps, interiority, scaling --------------------------------------------------------
 
 
-@_inner
+@inner
 def _cone_step(
     u0: float, u1: float, u2: float, du0: float, du1: float, du2: float
 ) -> float:
@@ -539,7 +517,7 @@ def _cone_step(
     return root
 
 
-@_inner
+@inner
 def max_step_soc(u: FloatArray, du: FloatArray) -> float:
     """Largest ``α`` with ``u + α du`` in every cone (``u`` interior); ``inf`` if unbounded."""
     best = np.inf
@@ -548,7 +526,7 @@ def max_step_soc(u: FloatArray, du: FloatArray) -> float:
     return best
 
 
-@_inner
+@inner
 def max_step_slack_soc(pt: Point, dn: Direction) -> float:
     """`max_step_soc` for the cones' slacks ``s = b - G x`` along ``Δs = -G Δx``."""
     best = np.inf
@@ -559,7 +537,7 @@ def max_step_slack_soc(pt: Point, dn: Direction) -> float:
     return best
 
 
-@_inner
+@inner
 def max_step_lin(u: FloatArray, du: FloatArray) -> float:
     """Largest ``α`` with ``u + α du >= 0`` (``u > 0``); ``inf`` if unbounded."""
     worst = 0.0
@@ -568,13 +546,13 @@ def max_step_lin(u: FloatArray, du: FloatArray) -> float:
     return 1.0 / worst if worst > 0.0 else np.inf
 
 
-@_inner
+@inner
 def _interior(u0: float, u1: float, u2: float) -> bool:
     """Whether ``u`` is strictly inside the cone."""
     return u0 > 0.0 and _jnorm2(u0, u1, u2) > 0.0
 
 
-@_inner
+@inner
 def _interior_after_step(pt: Point, alpha: float, dn: Direction) -> bool:
     """Whether every cone of ``s`` and of ``y`` is strictly interior after the step ``α``."""
     for c in range(pt.ys.shape[1]):
@@ -588,7 +566,7 @@ def _interior_after_step(pt: Point, alpha: float, dn: Direction) -> bool:
     return True
 
 
-@_inner
+@inner
 def cone_scaling_into(
     sc: Scaling, c: int, s0: float, s1: float, s2: float, y0: float, y1: float, y2: float
 ) -> None:
@@ -607,7 +585,7 @@ def cone_scaling_into(
     sc.v[0, c], sc.v[1, c], sc.v[2, c] = (wb0 + 1.0) / nv, wb1 / nv, wb2 / nv
 
 
-@_inner
+@inner
 def scaling_into(pt: Point, sc: Scaling) -> None:
     """Nesterov–Todd scaling of every cone at the iterate's ``(s, y)``."""
     ys = pt.ys
@@ -616,7 +594,7 @@ def scaling_into(pt: Point, sc: Scaling) -> None:
         cone_scaling_into(sc, c, s0, s1, s2, ys[0, c], ys[1, c], ys[2, c])
 
 
-@_inner
+@inner
 def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
     """The scaled point ``λ = W y`` of cone ``c`` (equal to ``W⁻¹ s``)."""
     return _apply_w(sc, ys[0, c], ys[1, c], ys[2, c], c)
@@ -625,7 +603,7 @@ def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
 # --- the reduced (pentadiagonal) Newton system --------------------------------------------
 
 
-@_inner
+@inner
 def _eliminate_tz(
     d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor, i: int
 ) -> tuple[float, float, float, float, float, float, float]:
@@ -690,7 +668,7 @@ def _eliminate_tz(
     return m00, m01, m02, m11, m12, m22, dg
 
 
-@_inner
+@inner
 def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor) -> bool:
     """Assemble the Schur complement in ``w`` of ``G' H G`` and factor it.
 
@@ -751,7 +729,7 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
     return ok
 
 
-@_inner
+@inner
 def solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
     """Overwrite ``x`` with ``(L D L')⁻¹ x``."""
     m = x.size
@@ -767,7 +745,7 @@ def solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
             x[i] -= fac.l2[i + 2] * x[i + 2]
 
 
-@_inner
+@inner
 def solve_normal_inplace(
     d: Data, fac: Factor, xw: FloatArray, xt: FloatArray, xz: FloatArray
 ) -> None:
@@ -795,7 +773,7 @@ def solve_normal_inplace(
         xz[i] -= fac.q[i] * ct + fac.r[i] * cz
 
 
-@_inner
+@inner
 def _v_into(
     sc: Scaling, pt: Point, rp: float, corrector: bool, sigma_mu: float, dn: Direction
 ) -> None:
@@ -828,7 +806,7 @@ def _v_into(
         dys[0, c], dys[1, c], dys[2, c] = -w0, -w1, -w2
 
 
-@_inner
+@inner
 def _recover_v_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
     """Put back the ``v`` of `_v_into` into ``(dyl, dys)`` from the direction ``dn``.
 
@@ -845,7 +823,7 @@ def _recover_v_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
         dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
 
 
-@_inner
+@inner
 def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
     """``Δs = by - G Δx`` (linear rows) and ``Δy = H G Δx - v``, with ``v`` in ``(dyl, dys)``."""
     g_lin_into(d, dn.dw, dn.dt, dn.dsl)  # G Δx, linear rows, kept in dsl until replaced
@@ -861,7 +839,7 @@ def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> No
         dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
 
 
-@_sequence
+@inlined
 def newton_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     corrector: bool, sigma_mu: float, refine_above: float, dn: Direction,
@@ -908,7 +886,7 @@ def newton_into(
 # --- the iteration, step by step ------------------------------------------------------------
 
 
-@_inner
+@inner
 def _dot(a: FloatArray, b: FloatArray) -> float:
     """``a · b`` of two vectors, without a temporary."""
     acc = 0.0
@@ -917,7 +895,7 @@ def _dot(a: FloatArray, b: FloatArray) -> float:
     return acc
 
 
-@_inner
+@inner
 def _dot2(a: FloatArray, b: FloatArray) -> float:
     """``a · b`` over all entries of two 2-D arrays, row by row (as `_dot` of them flat)."""
     acc = 0.0
@@ -927,14 +905,14 @@ def _dot2(a: FloatArray, b: FloatArray) -> float:
     return acc
 
 
-@_inner
+@inner
 def _axpy(alpha: float, x: FloatArray, y: FloatArray) -> None:
     """``y += α x`` in place, for vectors."""
     for i in range(x.size):
         y[i] += alpha * x[i]
 
 
-@_inner
+@inner
 def _axpy2(alpha: float, x: FloatArray, y: FloatArray) -> None:
     """``y += α x`` in place, for 2-D arrays."""
     for r in range(x.shape[0]):
@@ -942,7 +920,7 @@ def _axpy2(alpha: float, x: FloatArray, y: FloatArray) -> None:
             y[r, c] += alpha * x[r, c]
 
 
-@_inner
+@inner
 def _shift(worst: float, nrm: float) -> float:
     """Return CVXOPT's initial-point shift along ``e``.
 
@@ -953,7 +931,7 @@ def _shift(worst: float, nrm: float) -> float:
     return 1.0 + ts if ts >= -1e-8 * max(nrm, 1.0) else 0.0
 
 
-@_inner
+@inner
 def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
     """Add `_shift` of ``(ul, us)`` to every linear entry and every cone's axis."""
     worst = np.inf
@@ -968,7 +946,7 @@ def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
         us[0, c] += shift
 
 
-@_sequence
+@inlined
 def start_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, dn: Direction
 ) -> tuple[bool, float]:
@@ -1009,14 +987,14 @@ def start_into(
     return True, -shift
 
 
-@_sequence
+@inlined
 def dual_residual_into(d: Data, pt: Point, res: Residual) -> float:
     """The dual residual, negated, ``-(G'y + c)``, into ``res``; returns its squared norm."""
     sw, st, sz = g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz, ADJ_DUAL_RESIDUAL)
     return sw + st + sz
 
 
-@_inner
+@inner
 def residuals_into(
     d: Data, pt: Point, res: Residual, scratch: FloatArray
 ) -> tuple[float, float, float, float, float]:
@@ -1048,14 +1026,14 @@ def residuals_into(
     return pcost, dcost, gap, ry2, rx2
 
 
-@_sequence
+@inlined
 def _max_step(pt: Point, dn: Direction) -> float:
     """Largest step along ``dn`` keeping ``s`` and ``y`` in their cones."""
     return min(max_step_lin(pt.sl, dn.dsl), max_step_lin(pt.yl, dn.dyl),
                max_step_slack_soc(pt, dn), max_step_soc(pt.ys, dn.dys))
 
 
-@_sequence
+@inlined
 def step(pt: Point, dn: Direction) -> float:
     """Move ``pt`` a fraction ``STEP`` of the way to the cone boundary along ``dn``.
 
@@ -1083,7 +1061,7 @@ def step(pt: Point, dn: Direction) -> float:
     return alpha
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@kernel
 def iterate(
     d: Data, pt: Point, res: Residual, dn: Direction, sc: Scaling, fac: Factor,
     log: FloatArray, tol: float, max_iter: int,
@@ -1216,12 +1194,13 @@ def signatures() -> dict[str, tuple[Any, ...]]:
     }
 
 
-def python_callable(kernel: Any) -> Any:
-    """``kernel`` (any of this module's) callable from Python: for tests and diagnostics.
+def python_callable(fn: Any) -> Any:
+    """``fn`` (any kernel of this module) callable from Python: for tests and diagnostics.
 
-    The kernels other than `iterate` have no Python entry point (see ``_INNER``); this
-    wraps one in a compiled trampoline (compiled on first call, not cached) with the
-    kernel's own parameters (numba inlines a `_sequence` kernel, which takes no ``*args``).
+    The kernels other than `iterate` have no Python entry point (see
+    `speedplan.core.jit.inner`); this wraps one in a compiled trampoline (compiled on first
+    call, not cached) with the kernel's own parameters (numba inlines an
+    `speedplan.core.jit.inlined` kernel, which takes no ``*args``).
 
     Examples
     --------
@@ -1229,12 +1208,12 @@ def python_callable(kernel: Any) -> Any:
     >>> python_callable(max_step_lin)(np.ones(3), -np.ones(3))
     1.0
     """
-    if kernel not in _TRAMPOLINES:
-        params = ", ".join(inspect.signature(kernel.py_func).parameters)
-        scope: dict[str, Any] = {"kernel": kernel}
+    if fn not in _TRAMPOLINES:
+        params = ", ".join(inspect.signature(fn.py_func).parameters)
+        scope: dict[str, Any] = {"kernel": fn}
         exec(f"def call({params}):\n    return kernel({params})\n", scope)  # noqa: S102
-        _TRAMPOLINES[kernel] = njit(scope["call"])
-    return _TRAMPOLINES[kernel]
+        _TRAMPOLINES[fn] = njit(scope["call"])
+    return _TRAMPOLINES[fn]
 
 
 _TRAMPOLINES: dict[Any, Any] = {}
