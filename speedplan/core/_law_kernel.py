@@ -28,6 +28,7 @@ import math
 from typing import Any
 
 import numpy as np
+
 from .checks import FloatArray, IntArray
 from .jit import inner, kernel, tolerate_stale_indexes
 from .numerics import GAUSS_NODES, GAUSS_WEIGHTS

@@ -1211,7 +1211,7 @@ def python_callable(fn: Any) -> Any:
     if fn not in _TRAMPOLINES:
         params = ", ".join(inspect.signature(fn.py_func).parameters)
         scope: dict[str, Any] = {"kernel": fn}
-        exec(f"def call({params}):\n    return kernel({params})\n", scope)  # noqa: S102
+        exec(f"def call({params}):\n    return kernel({params})\n", scope)
         _TRAMPOLINES[fn] = njit(scope["call"])
     return _TRAMPOLINES[fn]
 
