@@ -13,15 +13,30 @@ Three families of kernels are compiled with numba and cached on disk (``cache=Tr
     the banded refinement's array work (`speedplan.solve._banded_nlp_kernels`); until it
     is available, the same steps run in numpy (`speedplan.solve.banded_nlp`).
 
-Each kernel module lists the entry points called from Python and their explicit signatures
-(``signatures()``); `Kernels` loads each of them from numba's cache without ever
-compiling (`load_cached_overload`), compiles them when asked to, and otherwise starts
-one background Python process that compiles the family into the cache while the fallback
-answers. A lock file per family (`Kernels.lock_path`) keeps the workers of
-[`plan_many`][speedplan.plan_many], which all start cold, from compiling the same family at once.
-``speedplan compile`` (`compile_families`) compiles every family in parallel processes
-and waits: the step for CI jobs, containers and fresh virtual environments, after which the
-first ``plan()`` already runs the compiled kernels.
+Each kernel module declares its kernels with `kernel` (called from Python), `inner`
+(called only from other kernels) and `inlined` (inlined by numba into its callers), and
+lists every kernel numba compiles on its own with one explicit signature
+(``signatures()``), each after the kernels it calls, and the entry points called from
+Python (``ENTRY_POINTS``). `Kernels.load` loads the entry points from numba's cache without
+ever compiling (`load_cached_overload`); `Kernels.compile` loads or compiles every kernel in
+that order, each for its one signature, and then refuses any other. A caller passing a
+constant (a mode, ``False``) thus uses the kernel compiled for the constant's type, where
+numba would otherwise compile one more copy specialised to the value.
+
+Numba links the code of every kernel a function calls into that function and optimises and
+emits it again there, so a kernel's compilation costs about what it calls in all. The
+relaxation's single entry point, `speedplan.solve._banded_ipm.iterate`, is therefore the
+last and largest step; the kernels below it are independent subtrees (`Kernels.parts`),
+which helper processes compile side by side into the cache before the process compiling
+the family compiles the entry point, loading the rest (`part_count`, `_compile_whole`).
+
+When a family is not in the cache, `Kernels.ready` starts one background Python process
+that compiles it (and the families after it) while the fallback answers. A lock file per
+family (`Kernels.lock_path`) keeps the workers of [`plan_many`][speedplan.plan_many], which
+all start cold, from compiling the same family at once. ``speedplan compile``
+(`compile_families`) compiles every family in parallel processes and waits: the step for CI
+jobs, containers and fresh virtual environments, after which the first ``plan()`` already
+runs the compiled kernels.
 
 Setting the environment variable ``SPEEDPLAN_BACKGROUND_COMPILE=0`` makes every fallback
 compile in the calling process instead (the results are then independent of timing).

@@ -11,6 +11,12 @@ only the first use after installation pays the compilation. Arithmetic follows n
 (division by zero gives ``inf``/``nan``, which the iteration detects and reports as a
 numerical breakdown) rather than raising inside compiled code.
 
+How the kernels are compiled shapes them (`speedplan.core.jit`): every kernel that loops over
+the nodes is compiled once, for the one signature `signatures` gives it; the kernels that
+only call others in sequence (`newton_into`, `start_into`, `step`, ...) are inlined into
+`iterate` by numba, since compiled on their own each would be a copy of everything it calls;
+`iterate` calls `newton_into` from one place, for the predictor and then the corrector.
+
 Notation follows CVXOPT's ``coneqp``: ``G x + s = b``, ``s ∈ K``, ``G' y + c = 0``, ``y ∈ K``
 with ``x = (w, t, z)`` over the ``m`` interior nodes. ``K`` is a product of nonnegative
 orthants (the linear rows) and ``2 m`` three-dimensional second-order cones, stored
