@@ -27,7 +27,7 @@ Numba links the code of every kernel a function calls into that function and opt
 emits it again there, so a kernel's compilation costs about what it calls in all. The
 relaxation's single entry point, `speedplan.solve._banded_ipm.iterate`, is therefore the
 last and largest step; the kernels below it are independent subtrees (`Kernels.parts`),
-which helper processes compile side by side into the cache before the process compiling
+which worker processes compile side by side into the cache before the process compiling
 the family compiles the entry point, loading the rest (`part_count`, `_compile_whole`).
 
 When a family is not in the cache, `Kernels.ready` starts one background Python process
@@ -195,7 +195,7 @@ class Kernels:
     then : tuple of str
         Families that this family's background process compiles after it.
     split : bool
-        Whether a compilation of the whole family starts helper processes for parts of it
+        Whether a compilation of the whole family starts worker processes for parts of it
         (`parts`), up to one per core (at most `MAX_PARTS`), before its entry points.
     """
 
@@ -517,7 +517,7 @@ def _main(argv: list[str]) -> int:
     """The compiling process: ``[--no-lock] TOKEN...``, each token in turn.
 
     A token is a family's name (compile it, then release its lock) or ``NAME#I/K``, the
-    group ``I`` of the family's `Kernels.parts` in ``K`` (a helper of the former).
+    group ``I`` of the family's `Kernels.parts` in ``K`` (a worker of the former).
     """
     lock = "--no-lock" not in argv
     for token in (a for a in argv if a != "--no-lock"):
@@ -536,24 +536,24 @@ def _main(argv: list[str]) -> int:
 
 
 def _compile_whole(family: Kernels) -> None:
-    """Compile ``family``; a split one with helper processes for all of its parts but one.
+    """Compile ``family``; a split one with worker processes for all of its parts but one.
 
-    This process compiles the first part, waits for the helpers (their parts are then in
-    numba's cache), and compiles the entry points, loading the rest. A helper that fails
+    This process compiles the first part, waits for the workers (their parts are then in
+    numba's cache), and compiles the entry points, loading the rest. A worker that fails
     costs time only: whatever is missing is compiled here.
     """
-    helpers: list[subprocess.Popen[bytes]] = []
+    workers: list[subprocess.Popen[bytes]] = []
     try:
         if family.split and part_count() > 1:
             groups = family.parts(part_count())
             for index in range(1, len(groups)):
-                helper = _spawn([f"{family.name}#{index}/{part_count()}"], subprocess.DEVNULL)
-                if helper is not None:
-                    helpers.append(helper)
+                worker = _spawn([f"{family.name}#{index}/{part_count()}"], subprocess.DEVNULL)
+                if worker is not None:
+                    workers.append(worker)
             family.compile_part(groups[0])
     finally:
-        for helper in helpers:
-            helper.wait()
+        for worker in workers:
+            worker.wait()
     family.compile()
 
 

@@ -1085,6 +1085,24 @@ def step(pt: Point, dn: Direction) -> float:
     return alpha
 
 
+@inner
+def _residual_scales(d: Data) -> tuple[float, float]:
+    """The scales of the relative dual and primal residuals, ``(max(1, sqrt(m)), max(1, |b|))``.
+
+    ``|b|`` is the norm of the right-hand side of every row, linear and cone.
+    """
+    lay = d.lay
+    b_soc2 = 0.0  # |b_soc|², entries in storage order
+    for r in range(3):
+        for c in range(lay.nc):
+            b_soc2 += _b_soc(r, c, lay.m) * _b_soc(r, c, lay.m)
+    b_lin2 = 0.0
+    for j in range(lay.n_lin):
+        b = _b_lin(d, j)
+        b_lin2 += b * b
+    return max(1.0, math.sqrt(lay.m)), max(1.0, math.sqrt(b_lin2 + b_soc2))
+
+
 @kernel
 def iterate(
     d: Data, pt: Point, res: Residual, dn: Direction, sc: Scaling, fac: Factor,
@@ -1100,16 +1118,7 @@ def iterate(
     ok, rp = start_into(d, sc, fac, pt, dn)
     if not ok:
         return 0, NUMERICAL_ERROR
-    res_x0 = max(1.0, math.sqrt(lay.m))
-    b_soc2 = 0.0  # |b_soc|², entries in storage order
-    for r in range(3):
-        for c in range(lay.nc):
-            b_soc2 += _b_soc(r, c, lay.m) * _b_soc(r, c, lay.m)
-    b_lin2 = 0.0
-    for j in range(lay.n_lin):
-        b = _b_lin(d, j)
-        b_lin2 += b * b
-    res_y0 = max(1.0, math.sqrt(b_lin2 + b_soc2))
+    res_x0, res_y0 = _residual_scales(d)
     nu = lay.n_lin + lay.nc  # barrier degree: one per linear row and per cone
     status = MAX_ITERATIONS
     it = 0
@@ -1218,7 +1227,7 @@ def signatures() -> dict[str, tuple[Any, ...]]:
         "_recover_v_into": (sc, pt, x, dn), "_ds_dy_into": (d, sc, pt, x, dn),
         "_dot": (v, v), "_dot2": (mat, mat), "_axpy": (x, v, v), "_axpy2": (x, mat, mat),
         "_shift": (x, x), "_shift_into_cone": (v, mat),
-        "residuals_into": (d, pt, res, v),
+        "residuals_into": (d, pt, res, v), "_residual_scales": (d,),
         "iterate": (d, pt, res, dn, sc, fac, mat, x, i),
     }
 

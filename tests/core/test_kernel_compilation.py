@@ -84,7 +84,7 @@ def test_a_fresh_compilation_makes_one_specialisation_of_each_kernel(family, tmp
     assert counts and all(c == 1 for c in counts.values()), counts
 
 
-# The relaxation compiled as `speedplan compile` and background compilations do it (helper
+# The relaxation compiled as `speedplan compile` and background compilations do it (worker
 # processes for its parts, the entry point last, loading the parts from the cache), then
 # loaded by a new process without compiling, which solves one instance.
 _SPLIT = """
