@@ -28,10 +28,9 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit
 
 from .checks import FloatArray, IntArray
-from .jit import tolerate_stale_indexes
+from .jit import inner, kernel, tolerate_stale_indexes
 from .numerics import GAUSS_NODES, GAUSS_WEIGHTS
 
 tolerate_stale_indexes()  # before any kernel below is loaded from the cache
@@ -53,7 +52,7 @@ Pieces = tuple[FloatArray, FloatArray, FloatArray, FloatArray, np.ndarray, Float
                FloatArray]
 
 
-@njit(cache=True, error_model="numpy")
+@inner
 def _speed(pieces: Pieces, j: int, dx: float, dr: float) -> float:
     """``v`` at offsets ``(dx, dr)`` of piece ``j``: ``TimeLaw._speed`` for one point."""
     _x, y, g, c, is_u, y_right, g_right = pieces
@@ -68,7 +67,7 @@ def _speed(pieces: Pieces, j: int, dx: float, dr: float) -> float:
     return math.sqrt(val)
 
 
-@njit(cache=True, error_model="numpy")
+@inner
 def _state(pieces: Pieces, j: int, dx: float, dr: float) -> tuple[float, float, float, float]:
     """``w, v, a, jerk`` at offsets ``(dx, dr)`` of piece ``j``.
 
@@ -94,7 +93,7 @@ def _state(pieces: Pieces, j: int, dx: float, dr: float) -> tuple[float, float, 
     return val, v, 0.5 * dy, 0.5 * cj * v
 
 
-@njit(cache=True, error_model="numpy")
+@inner
 def _integral(pieces: Pieces, j: int, lo: float, hi: float, right: bool,
               rule: FloatArray) -> float:
     """``TimeLaw._integral`` for one stretch ``[lo, hi]`` of piece ``j``."""
@@ -136,7 +135,7 @@ def _integral(pieces: Pieces, j: int, lo: float, hi: float, right: bool,
     return total
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _integrals_into(pieces: Pieces, j: IntArray, lo: FloatArray, hi: FloatArray,
                     right: BoolArray, rule: FloatArray, out: FloatArray) -> None:
     for k in range(j.size):
@@ -153,7 +152,7 @@ def integrals(pieces: Any, j: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     return out
 
 
-@njit(cache=True, error_model="numpy")
+@inner
 def _step_settles(e: float, v: float, acc: float, jerk: float, ttol: float,
                   width: float) -> bool:
     """Whether a Newton step of length ``e`` [m] lands within the time tolerance ``ttol``.
@@ -172,7 +171,7 @@ def _step_settles(e: float, v: float, acc: float, jerk: float, ttol: float,
     return 10.0 * err <= 0.25 * ttol * v
 
 
-@njit(cache=True, error_model="numpy")
+@inner
 def _moving_offset(tau: float, y0: float, g0: float, c0: float) -> float:
     """Offset reached at time ``tau`` from a knot where ``w = y0 > 0``: the exact solution.
 
@@ -193,7 +192,7 @@ def _moving_offset(tau: float, y0: float, g0: float, c0: float) -> float:
     return math.sqrt(y0) * tau * s_full + 0.25 * g0 * tau * tau * s_half * s_half
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _invert_into(pieces: Pieces, T: FloatArray, j: IntArray, t: FloatArray, rule: FloatArray,
                  exact: BoolArray, dx_out: FloatArray, dr_out: FloatArray) -> None:
     """Offsets reached at times ``t`` in pieces ``j`` (``TimeLaw._invert``).
@@ -299,7 +298,7 @@ def invert(pieces: Any, T: np.ndarray, j: np.ndarray, t: np.ndarray, exact: np.n
     return dx, dr
 
 
-@njit(cache=True, error_model="numpy")
+@kernel
 def _kinematics_into(pieces: Pieces, j: IntArray, dx: FloatArray, dr: FloatArray,
                      w_out: FloatArray, v_out: FloatArray, a_out: FloatArray,
                      jerk_out: FloatArray) -> None:
@@ -330,9 +329,22 @@ def _arrays(p: Any) -> Pieces:
             np.ascontiguousarray(p.y_right), np.ascontiguousarray(p.g_right))
 
 
+#: The kernels called from Python (the others are called only from compiled code).
+ENTRY_POINTS = ("_integrals_into", "_invert_into", "_kinematics_into")
+
+
 def signatures() -> dict[str, str]:
-    """Every kernel called from Python and its signature (see `speedplan.core.jit`)."""
+    """Every kernel and its one signature, each after the kernels it calls.
+
+    `speedplan.core.jit` compiles them in this order and then refuses other types.
+    """
+    at = f"({_PIECES}, i8, f8, f8)"
     return {
+        "_speed": f"f8{at}",
+        "_state": f"UniTuple(f8, 4){at}",
+        "_integral": f"f8({_PIECES}, i8, f8, f8, b1, f8[:, ::1])",
+        "_step_settles": "b1(f8, f8, f8, f8, f8, f8)",
+        "_moving_offset": "f8(f8, f8, f8, f8)",
         "_integrals_into":
             f"void({_PIECES}, i8[::1], f8[::1], f8[::1], b1[::1], f8[:, ::1], f8[::1])",
         "_invert_into":

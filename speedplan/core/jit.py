@@ -13,15 +13,30 @@ Three families of kernels are compiled with numba and cached on disk (``cache=Tr
     the banded refinement's array work (`speedplan.solve._banded_nlp_kernels`); until it
     is available, the same steps run in numpy (`speedplan.solve.banded_nlp`).
 
-Each kernel module lists the entry points called from Python and their explicit signatures
-(``signatures()``); `Kernels` loads each of them from numba's cache without ever
-compiling (`load_cached_overload`), compiles them when asked to, and otherwise starts
-one background Python process that compiles the family into the cache while the fallback
-answers. A lock file per family (`Kernels.lock_path`) keeps the workers of
-[`plan_many`][speedplan.plan_many], which all start cold, from compiling the same family at once.
-``speedplan compile`` (`compile_families`) compiles every family in parallel processes
-and waits: the step for CI jobs, containers and fresh virtual environments, after which the
-first ``plan()`` already runs the compiled kernels.
+Each kernel module declares its kernels with `kernel` (called from Python), `inner`
+(called only from other kernels) and `inlined` (inlined by numba into its callers), and
+lists every kernel numba compiles on its own with one explicit signature
+(``signatures()``), each after the kernels it calls, and the entry points called from
+Python (``ENTRY_POINTS``). `Kernels.load` loads the entry points from numba's cache without
+ever compiling (`load_cached_overload`); `Kernels.compile` loads or compiles every kernel in
+that order, each for its one signature, and then refuses any other. A caller passing a
+constant (a mode, ``False``) thus uses the kernel compiled for the constant's type, where
+numba would otherwise compile one more copy specialised to the value.
+
+Numba links the code of every kernel a function calls into that function and optimises and
+emits it again there, so a kernel's compilation costs about what it calls in all. The
+relaxation's single entry point, `speedplan.solve._banded_ipm.iterate`, is therefore the
+last and largest step; the kernels below it are independent subtrees (`Kernels.parts`),
+which worker processes compile side by side into the cache before the process compiling
+the family compiles the entry point, loading the rest (`part_count`, `_compile_whole`).
+
+When a family is not in the cache, `Kernels.ready` starts one background Python process
+that compiles it (and the families after it) while the fallback answers. A lock file per
+family (`Kernels.lock_path`) keeps the workers of [`plan_many`][speedplan.plan_many], which
+all start cold, from compiling the same family at once. ``speedplan compile``
+(`compile_families`) compiles every family in parallel processes and waits: the step for CI
+jobs, containers and fresh virtual environments, after which the first ``plan()`` already
+runs the compiled kernels.
 
 Setting the environment variable ``SPEEDPLAN_BACKGROUND_COMPILE=0`` makes every fallback
 compile in the calling process instead (the results are then independent of timing).
@@ -47,14 +62,55 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from types import ModuleType
-from typing import Any
+from typing import Any, TypeVar
 
 __all__ = [
     "BACKGROUND_COMPILE_ENV", "COMPILE_LOCK_STALE", "FAMILIES", "Kernels", "compile_families",
-    "load_cached_overload", "tolerate_stale_indexes",
+    "inlined", "inner", "kernel", "load_cached_overload", "tolerate_stale_indexes",
 ]
+
+_K = TypeVar("_K", bound=Callable[..., Any])
+
+#: numba options of every kernel. The kernels allocate nothing (their callers pass every
+#: array), so they run without numba's reference counting (``_nrt=False``): no increment
+#: and decrement of every array at every call to lower, optimise and emit. No C entry point
+#: either. The arithmetic is the same.
+KERNEL_OPTIONS: dict[str, Any] = {"cache": True, "error_model": "numpy", "_nrt": False,
+                                  "no_cfunc_wrapper": True}
+
+
+def _njit(fn: _K, options: dict[str, Any]) -> _K:
+    from numba import njit
+
+    compiled: _K = njit(**options)(fn)
+    return compiled
+
+
+def kernel(fn: _K, error_model: str = "numpy") -> _K:
+    """A kernel called from Python: ``numba.njit(**KERNEL_OPTIONS)``.
+
+    ``error_model="python"`` makes a division by zero raise instead of giving ``inf``.
+    """
+    return _njit(fn, {**KERNEL_OPTIONS, "error_model": error_model})
+
+
+def inner(fn: _K, error_model: str = "numpy") -> _K:
+    """A kernel called only from other kernels: no Python entry point to generate."""
+    return _njit(fn, {**KERNEL_OPTIONS, "error_model": error_model, "no_cpython_wrapper": True})
+
+
+def inlined(fn: _K) -> _K:
+    """A kernel that numba inlines into each caller: no code of its own to compile.
+
+    For kernels that only call others in sequence: compiled on their own, each would carry
+    a copy of everything it calls, optimised and emitted once more (numba links a callee's
+    code into each of its callers').
+    """
+    options = {k: v for k, v in KERNEL_OPTIONS.items() if k != "cache"}
+    return _njit(fn, {**options, "no_cpython_wrapper": True, "inline": "always"})
+
 
 #: Environment variable: set to ``0`` to make every fallback compile its kernels in the calling
 #: process instead of answering without them while a background process compiles them.
@@ -138,13 +194,19 @@ class Kernels:
         Python; nothing else of the family is ever compiled in a process that uses it.
     then : tuple of str
         Families that this family's background process compiles after it.
+    split : bool
+        Whether a compilation of the whole family starts worker processes for parts of it
+        (`parts`), up to one per core (at most `MAX_PARTS`), before its entry points.
     """
 
-    def __init__(self, name: str, module: str, then: tuple[str, ...] = ()) -> None:
+    def __init__(self, name: str, module: str, then: tuple[str, ...] = (),
+                 split: bool = False) -> None:
         self.name = name
         self.module_name = module
         #: Families its background process compiles next (when no other process does).
         self.then = then
+        #: Whether its compilation is split over several processes.
+        self.split = split
         #: The kernel module once every kernel of the family is loaded in this process.
         self.module: ModuleType | None = None
         #: The background compilation started by this process, while it runs.
@@ -155,9 +217,12 @@ class Kernels:
     def __repr__(self) -> str:
         return f"Kernels({self.name!r}, {self.module_name!r})"
 
-    def _entries(self) -> tuple[ModuleType, list[tuple[Any, Any]]]:
+    def _entries(self, *, every: bool = False) -> tuple[ModuleType, list[tuple[Any, Any]]]:
+        """The module and ``(dispatcher, signature)`` of its entry points (``every``: all)."""
         kn = importlib.import_module(self.module_name)  # imports numba
-        return kn, [(getattr(kn, name), sig) for name, sig in kn.signatures().items()]
+        sigs = kn.signatures()
+        names = list(sigs) if every else getattr(kn, "ENTRY_POINTS", list(sigs))
+        return kn, [(getattr(kn, name), sigs[name]) for name in names]
 
     def _finish(self, kn: ModuleType, entries: list[tuple[Any, Any]]) -> ModuleType:
         for disp, _ in entries:
@@ -188,11 +253,50 @@ class Kernels:
         if self.background is not None:
             self.background.wait()
             self.background = None
-        kn, entries = self._entries()
+        kn, entries = self._entries(every=True)
         for disp, sig in entries:
             if not load_cached_overload(disp, sig):
                 disp.compile(sig)
+            disp.disable_compile()  # its callers use this overload, whatever they pass
         return self._finish(kn, entries)
+
+    def compile_part(self, names: Iterable[str]) -> None:
+        """Load or compile the kernels ``names`` here, in the family's order; nothing else."""
+        kn = importlib.import_module(self.module_name)
+        chosen = set(names)
+        for name, sig in kn.signatures().items():
+            if name in chosen:
+                disp = getattr(kn, name)
+                if not load_cached_overload(disp, sig):
+                    disp.compile(sig)
+                disp.disable_compile()
+
+    def parts(self, count: int) -> list[list[str]]:
+        """The kernels below the entry points in up to ``count`` groups of similar size.
+
+        Each group holds whole subtrees of calls (a kernel with every kernel it calls), so
+        that processes compiling one group each need nothing from the others: a kernel
+        called from two groups is compiled in both. Sizes are measured in bytecode. The
+        entry points compiled afterwards load every group from numba's cache.
+
+        Examples
+        --------
+        >>> groups = FAMILIES["relaxation"].parts(2)
+        >>> len(groups), "iterate" in groups[0] + groups[1]
+        (2, False)
+        """
+        kn = importlib.import_module(self.module_name)
+        sigs = kn.signatures()
+        entries = set(getattr(kn, "ENTRY_POINTS", sigs))
+        below = _callees(kn, list(sigs))
+        called = set().union(*(below[n] - {n} for n in sigs if n not in entries))
+        tops = [n for n in sigs if n not in entries and n not in called]
+        size = {n: len(getattr(kn, n).py_func.__code__.co_code) for n in sigs}
+        groups: list[set[str]] = [set() for _ in range(max(1, count))]
+        for top in sorted(tops, key=lambda t: -sum(size[k] for k in below[t])):
+            group = min(groups, key=lambda g: sum(size[k] for k in g | below[top]))
+            group |= below[top]
+        return [[n for n in sigs if n in g] for g in groups if g]
 
     def ready(self, *, start: bool = True) -> bool:
         """Whether the kernels run now without compiling; else compile them in the background.
@@ -259,9 +363,42 @@ class Kernels:
         return os.path.join(tempfile.gettempdir(), f"speedplan-kernel-{digest}.lock")
 
 
+def _callees(kn: ModuleType, names: list[str]) -> dict[str, set[str]]:
+    """Each kernel of ``names`` with every kernel of ``names`` it calls, directly or not.
+
+    Read from the functions' code (the global names they use), through kernels numba
+    inlines (`inlined`), which are not in ``names``.
+    """
+    from numba.core.registry import CPUDispatcher
+
+    kernels = {n: d for n in dir(kn) if isinstance(d := getattr(kn, n), CPUDispatcher)}
+    direct = {n: {c for c in d.py_func.__code__.co_names if c in kernels and c != n}
+              for n, d in kernels.items()}
+    out: dict[str, set[str]] = {}
+    for name in names:
+        seen, todo = set(), [name]
+        while todo:
+            k = todo.pop()
+            if k not in seen:
+                seen.add(k)
+                todo.extend(direct[k])
+        out[name] = seen & set(names)
+    return out
+
+
+#: Most processes a split family's compilation uses (`Kernels.parts`).
+MAX_PARTS = 4
+
+
+def part_count() -> int:
+    """How many processes compile a split family: one per core, at most `MAX_PARTS`."""
+    return max(1, min(MAX_PARTS, os.cpu_count() or 1))
+
+
 #: Every family of compiled kernels, by name, in the order a plan() needs them.
 FAMILIES: dict[str, Kernels] = {
-    "relaxation": Kernels("relaxation", "speedplan.solve._banded_ipm", then=("time law",)),
+    "relaxation": Kernels("relaxation", "speedplan.solve._banded_ipm", then=("time law",),
+                          split=True),
     "time law": Kernels("time law", "speedplan.core._law_kernel"),
     "refinement": Kernels("refinement", "speedplan.solve._banded_nlp_kernels"),
 }
@@ -304,14 +441,22 @@ def spawn_compile(names: Iterable[str]) -> subprocess.Popen[bytes] | None:
     loaded 2-core machine, a compilation at the lowest priority took 75 s instead of 25 s,
     and every plan meanwhile ran on the slower fallback.
     """
+    return _spawn(list(names), subprocess.DEVNULL)
+
+
+def _spawn(args: list[str], output: int) -> subprocess.Popen[bytes] | None:
+    """A Python process running `_main` with ``args`` on this copy of speedplan.
+
+    Its standard output and error go to ``output``; None if no process could start.
+    """
     if not sys.executable:
         return None
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (_package_root(), env.get("PYTHONPATH")) if p)
     try:
-        return subprocess.Popen([sys.executable, "-c", _MAIN, *names], env=env,
-                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)
+        return subprocess.Popen([sys.executable, "-c", _MAIN, *args], env=env,
+                                stdin=subprocess.DEVNULL, stdout=output,
+                                stderr=subprocess.STDOUT)
     except OSError:
         return None
 
@@ -351,14 +496,9 @@ def compile_families(names: Iterable[str] | None = None, *, parallel: bool = Tru
             FAMILIES[name].compile()
             seconds[name] = time.perf_counter() - t0
         return seconds
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(p for p in (_package_root(), env.get("PYTHONPATH")) if p)
-    procs = {name: subprocess.Popen([sys.executable, "-c", _MAIN, "--no-lock", name],
-                                    env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                    stderr=subprocess.STDOUT)
-             for name in chosen}
-    failed = []
-    pending = dict(procs)
+    procs = {name: _spawn(["--no-lock", name], subprocess.PIPE) for name in chosen}
+    failed = [f"{name}: no process could start" for name, p in procs.items() if p is None]
+    pending = {name: proc for name, proc in procs.items() if proc is not None}
     while pending:
         for name, proc in list(pending.items()):
             if proc.poll() is not None:
@@ -374,16 +514,47 @@ def compile_families(names: Iterable[str] | None = None, *, parallel: bool = Tru
 
 
 def _main(argv: list[str]) -> int:
-    """The compiling process: ``[--no-lock] NAME...``; compile each, then release its lock."""
+    """The compiling process: ``[--no-lock] TOKEN...``, each token in turn.
+
+    A token is a family's name (compile it, then release its lock) or ``NAME#I/K``, the
+    group ``I`` of the family's `Kernels.parts` in ``K`` (a worker of the former).
+    """
     lock = "--no-lock" not in argv
-    for name in (a for a in argv if a != "--no-lock"):
+    for token in (a for a in argv if a != "--no-lock"):
+        name, _, part = token.partition("#")
         family = FAMILIES[name]
+        if part:
+            index, count = (int(x) for x in part.split("/"))
+            family.compile_part(family.parts(count)[index])
+            continue
         try:
-            family.compile()
+            _compile_whole(family)
         finally:
             if lock:
                 _release(family)
     return 0
+
+
+def _compile_whole(family: Kernels) -> None:
+    """Compile ``family``; a split one with worker processes for all of its parts but one.
+
+    This process compiles the first part, waits for the workers (their parts are then in
+    numba's cache), and compiles the entry points, loading the rest. A worker that fails
+    costs time only: whatever is missing is compiled here.
+    """
+    workers: list[subprocess.Popen[bytes]] = []
+    try:
+        if family.split and part_count() > 1:
+            groups = family.parts(part_count())
+            for index in range(1, len(groups)):
+                worker = _spawn([f"{family.name}#{index}/{part_count()}"], subprocess.DEVNULL)
+                if worker is not None:
+                    workers.append(worker)
+            family.compile_part(groups[0])
+    finally:
+        for worker in workers:
+            worker.wait()
+    family.compile()
 
 
 def _release(family: Kernels) -> None:

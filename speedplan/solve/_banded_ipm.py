@@ -11,6 +11,12 @@ only the first use after installation pays the compilation. Arithmetic follows n
 (division by zero gives ``inf``/``nan``, which the iteration detects and reports as a
 numerical breakdown) rather than raising inside compiled code.
 
+How the kernels are compiled shapes them (`speedplan.core.jit`): every kernel that loops over
+the nodes is compiled once, for the one signature `signatures` gives it; the kernels that
+only call others in sequence (`newton_into`, `start_into`, `step`, ...) are inlined into
+`iterate` by numba, since compiled on their own each would be a copy of everything it calls;
+`iterate` calls `newton_into` from one place, for the predictor and then the corrector.
+
 Notation follows CVXOPT's ``coneqp``: ``G x + s = b``, ``s ∈ K``, ``G' y + c = 0``, ``y ∈ K``
 with ``x = (w, t, z)`` over the ``m`` interior nodes. ``K`` is a product of nonnegative
 orthants (the linear rows) and ``2 m`` three-dimensional second-order cones, stored
@@ -24,33 +30,19 @@ The reduced Newton system is derived in ``docs/banded-ipm.md``.
 
 from __future__ import annotations
 
+import inspect
 import math
-from collections.abc import Callable
 from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 from numba import njit
 
 from ..core.checks import FloatArray, IntArray
-from ..core.jit import tolerate_stale_indexes
+from ..core.jit import inlined, inner, kernel, tolerate_stale_indexes
 
 tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 _T = TypeVar("_T")
-
-#: numba options of every kernel here but `iterate`: called only from compiled code,
-#: they need no Python or C entry point, whose generation cost a sixth of the module's
-#: compile time (measured: 28 s of CPU instead of 34 s). `python_callable` calls one
-#: from Python.
-_INNER: dict[str, Any] = {"cache": True, "error_model": "numpy", "no_cpython_wrapper": True,
-                          "no_cfunc_wrapper": True}
-_K = TypeVar("_K", bound=Callable[..., Any])
-
-
-def _inner(kernel: _K) -> _K:
-    """``njit(**_INNER)``: a kernel called only from other kernels."""
-    compiled: _K = njit(**_INNER)(kernel)
-    return compiled
 
 #: Fraction of the step to the cone boundary taken per iteration.
 STEP = 0.99
@@ -288,7 +280,7 @@ def check_sizes(d: Data, *parts: tuple[Any, ...]) -> None:
 # --- per-cone and per-node scalar kernels ------------------------------------------------------
 
 
-@_inner
+@inner
 def _pad(w: FloatArray, i: int) -> float:
     """``w[i]`` with zero outside ``0 <= i < len(w)`` (the eliminated end values)."""
     if i < 0 or i >= w.size:
@@ -296,7 +288,7 @@ def _pad(w: FloatArray, i: int) -> float:
     return float(w[i])
 
 
-@_inner
+@inner
 def _b_lin(d: Data, j: int) -> float:
     """Right-hand side of linear row ``j``.
 
@@ -306,13 +298,13 @@ def _b_lin(d: Data, j: int) -> float:
     return float(d.b_lin[j]) if j < d.lay.jm else -float(d.b_lin[j - d.lay.k])
 
 
-@_inner
+@inner
 def _stencil_dot(d: Data, w: FloatArray, i: int, r: int) -> float:
     """``jc_r · w_{i-1:i+2}`` for stencil row ``r`` at node ``i`` (zero outside the nodes)."""
     return float(d.jc[0, r] * _pad(w, i - 1) + d.jc[1, r] * w[i] + d.jc[2, r] * _pad(w, i + 1))
 
 
-@_inner
+@inner
 def _scatter_stencil(d: Data, i: int, r: int, value: float, out: FloatArray) -> None:
     """``out += value * jc_r`` at ``w_{i-1:i+2}`` (the adjoint of `_stencil_dot`)."""
     if i > 0:
@@ -322,7 +314,7 @@ def _scatter_stencil(d: Data, i: int, r: int, value: float, out: FloatArray) -> 
         out[i + 1] += value * d.jc[2, r]
 
 
-@_inner
+@inner
 def _jnorm2(u0: float, u1: float, u2: float) -> float:
     """``u' J u`` with ``J = diag(1, -1, -1)``, computed as ``(u_0 - |u_a|)(u_0 + |u_a|) - u_b²``.
 
@@ -335,7 +327,7 @@ def _jnorm2(u0: float, u1: float, u2: float) -> float:
     return (u0 - big) * (u0 + big) - small * small
 
 
-@_inner
+@inner
 def _h_entries(sc: Scaling, c: int) -> tuple[float, float, float, float, float, float]:
     """Entries 00, 01, 02, 11, 12, 22 of cone ``c``'s ``H = W⁻² = (2 ŵ ŵ' - J) / β²``.
 
@@ -348,7 +340,7 @@ def _h_entries(sc: Scaling, c: int) -> tuple[float, float, float, float, float, 
             (2.0 * u1 * u1 + 1.0) * ib2, 2.0 * u1 * u2 * ib2, (2.0 * u2 * u2 + 1.0) * ib2)
 
 
-@_inner
+@inner
 def _apply_h(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[float, float, float]:
     """``H u`` for cone ``c``."""
     h00, h01, h02, h11, h12, h22 = _h_entries(sc, c)
@@ -356,7 +348,7 @@ def _apply_h(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[floa
             h02 * u0 + h12 * u1 + h22 * u2)
 
 
-@_inner
+@inner
 def _apply_w(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[float, float, float]:
     """``W u`` for cone ``c``: ``W = β (2 v v' - J)``."""
     v0, v1, v2, bt = sc.v[0, c], sc.v[1, c], sc.v[2, c], sc.beta[c]
@@ -364,7 +356,7 @@ def _apply_w(sc: Scaling, u0: float, u1: float, u2: float, c: int) -> tuple[floa
     return bt * (2.0 * vu * v0 - u0), bt * (2.0 * vu * v1 + u1), bt * (2.0 * vu * v2 + u2)
 
 
-@_inner
+@inner
 def _apply_winv(
     sc: Scaling, u0: float, u1: float, u2: float, c: int
 ) -> tuple[float, float, float]:
@@ -374,7 +366,7 @@ def _apply_winv(
     return (2.0 * vu * j0 - u0) / bt, (2.0 * vu * j1 + u1) / bt, (2.0 * vu * j2 + u2) / bt
 
 
-@_inner
+@inner
 def _jordan_solve(
     l0: float, l1: float, l2: float, b0: float, b1: float, b2: float
 ) -> tuple[float, float, float]:
@@ -383,7 +375,7 @@ def _jordan_solve(
     return u0, (b1 - u0 * l1) / l0, (b2 - u0 * l2) / l0
 
 
-@_inner
+@inner
 def _b_soc(r: int, c: int, m: int) -> float:
     """Constant part of the cone rows: ``(1, 0, -1)`` for node cones, ``(0, 0, 2)`` for t-z."""
     if r == 1:
@@ -393,7 +385,7 @@ def _b_soc(r: int, c: int, m: int) -> float:
     return 0.0 if r == 0 else 2.0
 
 
-@_inner
+@inner
 def _cone_s(w: FloatArray, t: FloatArray, z: FloatArray, c: int) -> tuple[float, float, float]:
     """Cone ``c``'s slack ``b - G x``: ``(1 + w, 2 z, w - 1)`` (node) or ``(t + z, t - z, 2)``."""
     m = w.size
@@ -403,7 +395,7 @@ def _cone_s(w: FloatArray, t: FloatArray, z: FloatArray, c: int) -> tuple[float,
     return t[i] + z[i], t[i] - z[i], 2.0
 
 
-@_inner
+@inner
 def _cone_ds(
     dw: FloatArray, dt: FloatArray, dz: FloatArray, c: int
 ) -> tuple[float, float, float]:
@@ -418,7 +410,7 @@ def _cone_ds(
 # --- the constraint map G and its adjoint -------------------------------------------------
 
 
-@_inner
+@inner
 def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
     """Linear rows of ``G x`` (no constants)."""
     lay = d.lay
@@ -439,7 +431,7 @@ def g_lin_into(d: Data, w: FloatArray, t: FloatArray, out: FloatArray) -> None:
             out[lay.jm + r] = -jw - t[i]
 
 
-@_inner
+@inner
 def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> None:
     """Cone rows of ``G x`` (no constants), shape ``(3, 2 m)``."""
     m = w.size
@@ -452,10 +444,10 @@ def g_soc_into(w: FloatArray, t: FloatArray, z: FloatArray, out: FloatArray) -> 
         out[2, m + i] = 0.0
 
 
-@_inner
+@inner
 def g_adjoint_into(
     d: Data, yl: FloatArray, ys: FloatArray, gw: FloatArray, gt: FloatArray, gz: FloatArray,
-    mode: int = ADJ_SET,
+    mode: int,
 ) -> tuple[float, float, float]:
     """``G' y`` split into its ``w``, ``t`` and ``z`` parts, written into ``g`` by ``mode``.
 
@@ -503,7 +495,7 @@ def g_adjoint_into(
 # --- cones: steps, interiority, scaling --------------------------------------------------------
 
 
-@_inner
+@inner
 def _cone_step(
     u0: float, u1: float, u2: float, du0: float, du1: float, du2: float
 ) -> float:
@@ -531,7 +523,7 @@ def _cone_step(
     return root
 
 
-@_inner
+@inner
 def max_step_soc(u: FloatArray, du: FloatArray) -> float:
     """Largest ``α`` with ``u + α du`` in every cone (``u`` interior); ``inf`` if unbounded."""
     best = np.inf
@@ -540,7 +532,7 @@ def max_step_soc(u: FloatArray, du: FloatArray) -> float:
     return best
 
 
-@_inner
+@inner
 def max_step_slack_soc(pt: Point, dn: Direction) -> float:
     """`max_step_soc` for the cones' slacks ``s = b - G x`` along ``Δs = -G Δx``."""
     best = np.inf
@@ -551,7 +543,7 @@ def max_step_slack_soc(pt: Point, dn: Direction) -> float:
     return best
 
 
-@_inner
+@inner
 def max_step_lin(u: FloatArray, du: FloatArray) -> float:
     """Largest ``α`` with ``u + α du >= 0`` (``u > 0``); ``inf`` if unbounded."""
     worst = 0.0
@@ -560,13 +552,13 @@ def max_step_lin(u: FloatArray, du: FloatArray) -> float:
     return 1.0 / worst if worst > 0.0 else np.inf
 
 
-@_inner
+@inner
 def _interior(u0: float, u1: float, u2: float) -> bool:
     """Whether ``u`` is strictly inside the cone."""
     return u0 > 0.0 and _jnorm2(u0, u1, u2) > 0.0
 
 
-@_inner
+@inner
 def _interior_after_step(pt: Point, alpha: float, dn: Direction) -> bool:
     """Whether every cone of ``s`` and of ``y`` is strictly interior after the step ``α``."""
     for c in range(pt.ys.shape[1]):
@@ -580,7 +572,7 @@ def _interior_after_step(pt: Point, alpha: float, dn: Direction) -> bool:
     return True
 
 
-@_inner
+@inner
 def cone_scaling_into(
     sc: Scaling, c: int, s0: float, s1: float, s2: float, y0: float, y1: float, y2: float
 ) -> None:
@@ -599,7 +591,7 @@ def cone_scaling_into(
     sc.v[0, c], sc.v[1, c], sc.v[2, c] = (wb0 + 1.0) / nv, wb1 / nv, wb2 / nv
 
 
-@_inner
+@inner
 def scaling_into(pt: Point, sc: Scaling) -> None:
     """Nesterov–Todd scaling of every cone at the iterate's ``(s, y)``."""
     ys = pt.ys
@@ -608,7 +600,7 @@ def scaling_into(pt: Point, sc: Scaling) -> None:
         cone_scaling_into(sc, c, s0, s1, s2, ys[0, c], ys[1, c], ys[2, c])
 
 
-@_inner
+@inner
 def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
     """The scaled point ``λ = W y`` of cone ``c`` (equal to ``W⁻¹ s``)."""
     return _apply_w(sc, ys[0, c], ys[1, c], ys[2, c], c)
@@ -617,7 +609,7 @@ def _lambda(sc: Scaling, ys: FloatArray, c: int) -> tuple[float, float, float]:
 # --- the reduced (pentadiagonal) Newton system --------------------------------------------
 
 
-@_inner
+@inner
 def _eliminate_tz(
     d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor, i: int
 ) -> tuple[float, float, float, float, float, float, float]:
@@ -682,7 +674,7 @@ def _eliminate_tz(
     return m00, m01, m02, m11, m12, m22, dg
 
 
-@_inner
+@inner
 def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Factor) -> bool:
     """Assemble the Schur complement in ``w`` of ``G' H G`` and factor it.
 
@@ -743,7 +735,7 @@ def factor_into(d: Data, sc: Scaling, yl: FloatArray, sl: FloatArray, fac: Facto
     return ok
 
 
-@_inner
+@inner
 def solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
     """Overwrite ``x`` with ``(L D L')⁻¹ x``."""
     m = x.size
@@ -759,7 +751,7 @@ def solve_banded_inplace(fac: Factor, x: FloatArray) -> None:
             x[i] -= fac.l2[i + 2] * x[i + 2]
 
 
-@_inner
+@inner
 def solve_normal_inplace(
     d: Data, fac: Factor, xw: FloatArray, xt: FloatArray, xz: FloatArray
 ) -> None:
@@ -787,7 +779,7 @@ def solve_normal_inplace(
         xz[i] -= fac.q[i] * ct + fac.r[i] * cz
 
 
-@_inner
+@inlined
 def _v_into(
     sc: Scaling, pt: Point, rp: float, corrector: bool, sigma_mu: float, dn: Direction
 ) -> None:
@@ -820,7 +812,22 @@ def _v_into(
         dys[0, c], dys[1, c], dys[2, c] = -w0, -w1, -w2
 
 
-@_inner
+@inner
+def _v_predictor_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
+    """`_v_into` of the predictor (``bs = -λ ∘ λ``)."""
+    _v_into(sc, pt, rp, False, 0.0, dn)
+
+
+@inner
+def _v_corrector_into(sc: Scaling, pt: Point, rp: float, sigma_mu: float, dn: Direction) -> None:
+    """`_v_into` of the corrector: compiled apart, so that neither loop tests ``corrector``.
+
+    One kernel for both, testing it on every entry, made the whole iteration 10 % slower.
+    """
+    _v_into(sc, pt, rp, True, sigma_mu, dn)
+
+
+@inner
 def _recover_v_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
     """Put back the ``v`` of `_v_into` into ``(dyl, dys)`` from the direction ``dn``.
 
@@ -837,7 +844,7 @@ def _recover_v_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
         dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
 
 
-@_inner
+@inner
 def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
     """``Δs = by - G Δx`` (linear rows) and ``Δy = H G Δx - v``, with ``v`` in ``(dyl, dys)``."""
     g_lin_into(d, dn.dw, dn.dt, dn.dsl)  # G Δx, linear rows, kept in dsl until replaced
@@ -853,7 +860,7 @@ def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> No
         dys[0, c], dys[1, c], dys[2, c] = h0 - dys[0, c], h1 - dys[1, c], h2 - dys[2, c]
 
 
-@_inner
+@inlined
 def newton_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
     corrector: bool, sigma_mu: float, refine_above: float, dn: Direction,
@@ -869,7 +876,10 @@ def newton_into(
     and the residual is not computed).
     """
     # With v = H by - W⁻¹ u (λ ∘ u = bs): (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
-    _v_into(sc, pt, rp, corrector, sigma_mu, dn)
+    if corrector:
+        _v_corrector_into(sc, pt, rp, sigma_mu, dn)
+    else:
+        _v_predictor_into(sc, pt, rp, dn)
     for i in range(dn.dw.size):  # loops, not slice assignments: they cost seconds to compile
         dn.dw[i], dn.dt[i], dn.dz[i] = res.gw[i], res.gt[i], res.gz[i]
     g_adjoint_into(d, dn.dyl, dn.dys, dn.dw, dn.dt, dn.dz, ADJ_ADD)
@@ -900,7 +910,7 @@ def newton_into(
 # --- the iteration, step by step ------------------------------------------------------------
 
 
-@_inner
+@inner
 def _dot(a: FloatArray, b: FloatArray) -> float:
     """``a · b`` of two vectors, without a temporary."""
     acc = 0.0
@@ -909,7 +919,7 @@ def _dot(a: FloatArray, b: FloatArray) -> float:
     return acc
 
 
-@_inner
+@inner
 def _dot2(a: FloatArray, b: FloatArray) -> float:
     """``a · b`` over all entries of two 2-D arrays, row by row (as `_dot` of them flat)."""
     acc = 0.0
@@ -919,14 +929,14 @@ def _dot2(a: FloatArray, b: FloatArray) -> float:
     return acc
 
 
-@_inner
+@inner
 def _axpy(alpha: float, x: FloatArray, y: FloatArray) -> None:
     """``y += α x`` in place, for vectors."""
     for i in range(x.size):
         y[i] += alpha * x[i]
 
 
-@_inner
+@inner
 def _axpy2(alpha: float, x: FloatArray, y: FloatArray) -> None:
     """``y += α x`` in place, for 2-D arrays."""
     for r in range(x.shape[0]):
@@ -934,7 +944,7 @@ def _axpy2(alpha: float, x: FloatArray, y: FloatArray) -> None:
             y[r, c] += alpha * x[r, c]
 
 
-@_inner
+@inner
 def _shift(worst: float, nrm: float) -> float:
     """Return CVXOPT's initial-point shift along ``e``.
 
@@ -945,7 +955,7 @@ def _shift(worst: float, nrm: float) -> float:
     return 1.0 + ts if ts >= -1e-8 * max(nrm, 1.0) else 0.0
 
 
-@_inner
+@inner
 def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
     """Add `_shift` of ``(ul, us)`` to every linear entry and every cone's axis."""
     worst = np.inf
@@ -960,7 +970,7 @@ def _shift_into_cone(ul: FloatArray, us: FloatArray) -> None:
         us[0, c] += shift
 
 
-@_inner
+@inlined
 def start_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, dn: Direction
 ) -> tuple[bool, float]:
@@ -1001,14 +1011,14 @@ def start_into(
     return True, -shift
 
 
-@_inner
+@inlined
 def dual_residual_into(d: Data, pt: Point, res: Residual) -> float:
     """The dual residual, negated, ``-(G'y + c)``, into ``res``; returns its squared norm."""
     sw, st, sz = g_adjoint_into(d, pt.yl, pt.ys, res.gw, res.gt, res.gz, ADJ_DUAL_RESIDUAL)
     return sw + st + sz
 
 
-@_inner
+@inner
 def residuals_into(
     d: Data, pt: Point, res: Residual, scratch: FloatArray
 ) -> tuple[float, float, float, float, float]:
@@ -1040,37 +1050,14 @@ def residuals_into(
     return pcost, dcost, gap, ry2, rx2
 
 
-@_inner
+@inlined
 def _max_step(pt: Point, dn: Direction) -> float:
     """Largest step along ``dn`` keeping ``s`` and ``y`` in their cones."""
     return min(max_step_lin(pt.sl, dn.dsl), max_step_lin(pt.yl, dn.dyl),
                max_step_slack_soc(pt, dn), max_step_soc(pt.ys, dn.dys))
 
 
-@_inner
-def predictor_into(
-    d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
-    refine_above: float, dn: Direction,
-) -> float:
-    """Affine-scaling direction (right-hand side ``-λ∘λ``); returns Mehrotra's ``σ``."""
-    newton_into(d, sc, fac, pt, res, rp, False, 0.0, refine_above, dn)
-    alpha = _max_step(pt, dn)
-    return float((1.0 - min(1.0, alpha)) ** SIGMA_EXPONENT)
-
-
-@_inner
-def corrector_into(
-    d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
-    refine_above: float, sigma_mu: float, dn: Direction,
-) -> None:
-    """Combined direction: the predictor's second-order term and centring ``σ μ``.
-
-    On entry ``dn`` holds the predictor's direction.
-    """
-    newton_into(d, sc, fac, pt, res, rp, True, sigma_mu, refine_above, dn)
-
-
-@_inner
+@inlined
 def step(pt: Point, dn: Direction) -> float:
     """Move ``pt`` a fraction ``STEP`` of the way to the cone boundary along ``dn``.
 
@@ -1098,7 +1085,25 @@ def step(pt: Point, dn: Direction) -> float:
     return alpha
 
 
-@njit(cache=True, error_model="numpy")
+@inner
+def _residual_scales(d: Data) -> tuple[float, float]:
+    """The scales of the relative dual and primal residuals, ``(max(1, sqrt(m)), max(1, |b|))``.
+
+    ``|b|`` is the norm of the right-hand side of every row, linear and cone.
+    """
+    lay = d.lay
+    b_soc2 = 0.0  # |b_soc|², entries in storage order
+    for r in range(3):
+        for c in range(lay.nc):
+            b_soc2 += _b_soc(r, c, lay.m) * _b_soc(r, c, lay.m)
+    b_lin2 = 0.0
+    for j in range(lay.n_lin):
+        b = _b_lin(d, j)
+        b_lin2 += b * b
+    return max(1.0, math.sqrt(lay.m)), max(1.0, math.sqrt(b_lin2 + b_soc2))
+
+
+@kernel
 def iterate(
     d: Data, pt: Point, res: Residual, dn: Direction, sc: Scaling, fac: Factor,
     log: FloatArray, tol: float, max_iter: int,
@@ -1113,16 +1118,7 @@ def iterate(
     ok, rp = start_into(d, sc, fac, pt, dn)
     if not ok:
         return 0, NUMERICAL_ERROR
-    res_x0 = max(1.0, math.sqrt(lay.m))
-    b_soc2 = 0.0  # |b_soc|², entries in storage order
-    for r in range(3):
-        for c in range(lay.nc):
-            b_soc2 += _b_soc(r, c, lay.m) * _b_soc(r, c, lay.m)
-    b_lin2 = 0.0
-    for j in range(lay.n_lin):
-        b = _b_lin(d, j)
-        b_lin2 += b * b
-    res_y0 = max(1.0, math.sqrt(b_lin2 + b_soc2))
+    res_x0, res_y0 = _residual_scales(d)
     nu = lay.n_lin + lay.nc  # barrier degree: one per linear row and per cone
     status = MAX_ITERATIONS
     it = 0
@@ -1171,8 +1167,15 @@ def iterate(
         # Refinement only pays once the scaling is ill-conditioned, close to the optimum, and
         # only where the solve's own residual could show in the dual residual's test.
         refine_above = REFINE_RESIDUAL * tol * res_x0 if relgap < REFINE_BELOW else np.inf
-        sigma = predictor_into(d, sc, fac, pt, res, rp, refine_above, dn)
-        corrector_into(d, sc, fac, pt, res, rp, refine_above, sigma * (gap / nu), dn)
+        # Predictor: the affine-scaling direction (right-hand side -λ∘λ), whose largest step
+        # sets Mehrotra's σ; then the corrector: its second-order term and centring σ μ.
+        # One call in a loop: numba inlines newton_into, and one copy compiles faster.
+        sigma = sigma_mu = 0.0
+        for corrector in range(2):
+            newton_into(d, sc, fac, pt, res, rp, corrector == 1, sigma_mu, refine_above, dn)
+            if corrector == 0:
+                sigma = (1.0 - min(1.0, _max_step(pt, dn))) ** SIGMA_EXPONENT
+                sigma_mu = sigma * (gap / nu)
         alpha = step(pt, dn)
         rp *= 1.0 - alpha  # G Δx + Δs = by: the step removes the fraction α of it
         log[it, 5], log[it, 6] = sigma, alpha
@@ -1182,28 +1185,60 @@ def iterate(
     return it, status
 
 
-def signatures() -> dict[str, Any]:
-    """The kernel called from Python and its signature (see `speedplan.core.jit`).
+#: The kernels called from Python (the others are called only from compiled code).
+ENTRY_POINTS = ("iterate",)
 
-    The types of `iterate`'s arguments as `speedplan.solve.banded` builds them;
-    only their types matter, so the arrays here are of the smallest sizes.
+
+def signatures() -> dict[str, tuple[Any, ...]]:
+    """Every kernel of the module and its one signature, each after the kernels it calls.
+
+    `speedplan.core.jit` compiles them in this order, each for exactly this signature, and
+    then refuses any other: a caller passing a constant (``ADJ_ADD``, ``False``) uses the
+    kernel compiled for its type instead of compiling a copy specialised to the value.
+    The types are those of `iterate`'s arguments as `speedplan.solve.banded` builds them,
+    so the arrays here are of the smallest sizes.
     """
     import numba
+    from numba import types as nt
 
     lay = layout(1, 1, 0)
-    d = Data(jstart=np.zeros(2, dtype=np.intp), jc=np.zeros((3, 1)), cj=np.zeros(1),
-             lk=np.zeros(0, dtype=np.intp), ct=np.zeros(1), cw=np.zeros(1),
-             b_lin=np.zeros(lay.jm), lay=lay)
-    args = (d, empty(Point, lay), empty(Residual, lay), empty(Direction, lay),
-            Scaling.identity(lay), empty(Factor, lay), np.zeros((2, len(LOG_COLUMNS))), 1e-8, 1)
-    return {"iterate": tuple(numba.typeof(a) for a in args)}  # type: ignore[no-untyped-call]
+    data = Data(jstart=np.zeros(2, dtype=np.intp), jc=np.zeros((3, 1)), cj=np.zeros(1),
+                lk=np.zeros(0, dtype=np.intp), ct=np.zeros(1), cw=np.zeros(1),
+                b_lin=np.zeros(lay.jm), lay=lay)
+    d, pt, res, dn, sc, fac = (numba.typeof(a) for a in (  # type: ignore[no-untyped-call]
+        data, empty(Point, lay), empty(Residual, lay), empty(Direction, lay),
+        Scaling.identity(lay), empty(Factor, lay)))
+    v, mat, i, x = nt.float64[::1], nt.float64[:, ::1], nt.intp, nt.float64
+    return {
+        "_pad": (v, i), "_b_lin": (d, i), "_stencil_dot": (d, v, i, i),
+        "_scatter_stencil": (d, i, i, x, v), "_jnorm2": (x, x, x), "_h_entries": (sc, i),
+        "_apply_h": (sc, x, x, x, i), "_apply_w": (sc, x, x, x, i),
+        "_apply_winv": (sc, x, x, x, i), "_jordan_solve": (x, x, x, x, x, x),
+        "_b_soc": (i, i, i), "_cone_s": (v, v, v, i), "_cone_ds": (v, v, v, i),
+        "g_lin_into": (d, v, v, v), "g_soc_into": (v, v, v, mat),
+        "g_adjoint_into": (d, v, mat, v, v, v, i), "_cone_step": (x, x, x, x, x, x),
+        "max_step_soc": (mat, mat), "max_step_slack_soc": (pt, dn), "max_step_lin": (v, v),
+        "_interior": (x, x, x), "_interior_after_step": (pt, x, dn),
+        "cone_scaling_into": (sc, i, x, x, x, x, x, x), "scaling_into": (pt, sc),
+        "_lambda": (sc, mat, i), "_eliminate_tz": (d, sc, v, v, fac, i),
+        "factor_into": (d, sc, v, v, fac), "solve_banded_inplace": (fac, v),
+        "solve_normal_inplace": (d, fac, v, v, v), "_v_predictor_into": (sc, pt, x, dn),
+        "_v_corrector_into": (sc, pt, x, x, dn),
+        "_recover_v_into": (sc, pt, x, dn), "_ds_dy_into": (d, sc, pt, x, dn),
+        "_dot": (v, v), "_dot2": (mat, mat), "_axpy": (x, v, v), "_axpy2": (x, mat, mat),
+        "_shift": (x, x), "_shift_into_cone": (v, mat),
+        "residuals_into": (d, pt, res, v), "_residual_scales": (d,),
+        "iterate": (d, pt, res, dn, sc, fac, mat, x, i),
+    }
 
 
-def python_callable(kernel: Any) -> Any:
-    """``kernel`` (any of this module's) callable from Python: for tests and diagnostics.
+def python_callable(fn: Any) -> Any:
+    """``fn`` (any kernel of this module) callable from Python: for tests and diagnostics.
 
-    The kernels other than `iterate` have no Python entry point (see ``_INNER``); this
-    wraps one in a compiled trampoline (compiled on first call, not cached).
+    The kernels other than `iterate` have no Python entry point (see
+    `speedplan.core.jit.inner`); this wraps one in a compiled trampoline (compiled on first
+    call, not cached) with the kernel's own parameters (numba inlines an
+    `speedplan.core.jit.inlined` kernel, which takes no ``*args``).
 
     Examples
     --------
@@ -1211,13 +1246,12 @@ def python_callable(kernel: Any) -> Any:
     >>> python_callable(max_step_lin)(np.ones(3), -np.ones(3))
     1.0
     """
-    if kernel not in _TRAMPOLINES:
-        @njit
-        def call(*args: Any) -> Any:  # pragma: no cover - compiled
-            return kernel(*args)
-
-        _TRAMPOLINES[kernel] = call
-    return _TRAMPOLINES[kernel]
+    if fn not in _TRAMPOLINES:
+        params = ", ".join(inspect.signature(fn.py_func).parameters)
+        scope: dict[str, Any] = {"kernel": fn}
+        exec(f"def call({params}):\n    return kernel({params})\n", scope)
+        _TRAMPOLINES[fn] = njit(scope["call"])
+    return _TRAMPOLINES[fn]
 
 
 _TRAMPOLINES: dict[Any, Any] = {}

@@ -21,13 +21,25 @@ numba's cache or compiles them once, never per call.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
-from numba import njit
 
 from ..core.checks import FloatArray, IntArray
-from ..core.jit import tolerate_stale_indexes
+from ..core.jit import inner, kernel, tolerate_stale_indexes
 
 tolerate_stale_indexes()  # before any kernel below is loaded from the cache
+
+
+def _kernel(fn: Any) -> Any:
+    """`speedplan.core.jit.kernel` raising on a division by zero (numba's Python model)."""
+    return kernel(fn, error_model="python")
+
+
+def _inner(fn: Any) -> Any:
+    """`speedplan.core.jit.inner` raising on a division by zero."""
+    return inner(fn, error_model="python")
+
 
 # IPOPT's inertia-correction constants, the numpy path's (banded_nlp). Written here, not
 # imported: numba freezes globals into cached code and re-validates the cache against this
@@ -39,8 +51,12 @@ _F = "float64[::1]"
 _F2 = "float64[:, ::1]"
 _I = "int64[::1]"
 
-#: Explicit signature of every kernel (argument types as the callers pass them).
+#: Explicit signature of every kernel (argument types as the callers pass them), each after
+#: the kernels it calls.
 SIGNATURES: dict[str, str] = {
+    "_objective_value": f"float64(int64, {_F}, {_F}, {_F})",
+    "_cholesky": f"boolean({_F2}, float64, {_F2})",
+    "_band_solve": f"void({_F2}, {_F})",
     "evaluate": f"void(float64, float64, {_F}, {_I}, {_F2}, {_F}, {_F}, {_F2}, {_F}, {_F})",
     "jac_t": f"void({_F}, {_I}, {_F2}, {_F})",
     "objective": f"float64(int64, {_F}, {_F}, {_F}, {_F}, {_F})",
@@ -62,7 +78,7 @@ SIGNATURES: dict[str, str] = {
 }
 
 
-@njit(cache=True)
+@_kernel
 def evaluate(
     w_start: float, w_end: float, x: FloatArray, kk: IntArray, cc: FloatArray, rr: FloatArray,
     c: FloatArray, d: FloatArray, load: FloatArray, sq: FloatArray
@@ -89,7 +105,7 @@ def evaluate(
         sq[j] = s
 
 
-@njit(cache=True)
+@_kernel
 def jac_t(
     v: FloatArray, kk: IntArray, d: FloatArray, out: FloatArray
 ) -> None:  # pragma: no cover - compiled
@@ -108,7 +124,7 @@ def jac_t(
             out[k + 1] += vv * d[j, 2]
 
 
-@njit(cache=True)
+@_kernel
 def objective(
     mode: int, a: FloatArray, b: FloatArray, x: FloatArray, grad: FloatArray, hess: FloatArray
 ) -> float:  # pragma: no cover - compiled
@@ -128,7 +144,7 @@ def objective(
     return value
 
 
-@njit(cache=True)
+@_inner
 def _objective_value(
     mode: int, a: FloatArray, b: FloatArray, x: FloatArray
 ) -> float:  # pragma: no cover - compiled
@@ -142,7 +158,7 @@ def _objective_value(
     return value
 
 
-@njit(cache=True)
+@_kernel
 def gaps(
     x: FloatArray, s: FloatArray, p: FloatArray, q: FloatArray, lb: FloatArray, ub: FloatArray,
     lo: FloatArray, hi: FloatArray, g: FloatArray
@@ -162,7 +178,7 @@ def gaps(
         g[o + e + i] = q[i]
 
 
-@njit(cache=True)
+@_kernel
 def residual(
     c: FloatArray, s: FloatArray, p: FloatArray, q: FloatArray, ne: int, out: FloatArray
 ) -> None:  # pragma: no cover - compiled
@@ -173,7 +189,7 @@ def residual(
             out[i] = out[i] + p[i] - q[i]
 
 
-@njit(cache=True)
+@_kernel
 def barrier(
     mode: int, a: FloatArray, b: FloatArray, x: FloatArray, p: FloatArray, q: FloatArray,
     rho: float, g: FloatArray
@@ -188,7 +204,7 @@ def barrier(
     return _objective_value(mode, a, b, x) + rho * pen, logs
 
 
-@njit(cache=True)
+@_kernel
 def errors(
     m: int, ne: int, grad: FloatArray, jty: FloatArray, y: FloatArray, z: FloatArray, g:
     FloatArray, res: FloatArray, tmp: FloatArray, rho: float, mu: float
@@ -227,7 +243,7 @@ def errors(
     return max(rest, gz_max / s_c), max(rest, gz_mu / s_c)
 
 
-@njit(cache=True)
+@_inner
 def _cholesky(
     ab: FloatArray, shift: float, f: FloatArray
 ) -> bool:  # pragma: no cover - compiled
@@ -257,7 +273,7 @@ def _cholesky(
     return True
 
 
-@njit(cache=True)
+@_inner
 def _band_solve(
     f: FloatArray, b: FloatArray
 ) -> None:  # pragma: no cover - compiled
@@ -279,7 +295,7 @@ def _band_solve(
         b[j] = v / f[0, j]
 
 
-@njit(cache=True)
+@_kernel
 def newton(
     m: int, ne: int, y: FloatArray, z: FloatArray, g: FloatArray, grad: FloatArray, jty:
     FloatArray, hess: FloatArray, kk: IntArray, d: FloatArray, rr: FloatArray, cc: FloatArray,
@@ -349,7 +365,7 @@ def newton(
     return -1.0, count
 
 
-@njit(cache=True)
+@_kernel
 def direction(
     ne: int, factor: FloatArray, sig: FloatArray, sig_s: FloatArray, sig_e: FloatArray, r_x:
     FloatArray, r_s: FloatArray, r_p: FloatArray, r_q: FloatArray, r_extra: FloatArray, kk:
@@ -395,7 +411,7 @@ def direction(
             dz[o + r + i] = dq[i]
 
 
-@njit(cache=True)
+@_kernel
 def max_step(
     v: FloatArray, dv: FloatArray, tau: float
 ) -> float:  # pragma: no cover - compiled
@@ -407,7 +423,7 @@ def max_step(
     return min(1.0, tau * ratio)
 
 
-@njit(cache=True)
+@_kernel
 def dual_step(
     ne: int, grad: FloatArray, dx: FloatArray, z: FloatArray, g: FloatArray, sig: FloatArray,
     gstep: FloatArray, mu: float, tau: float, rho: float, dz: FloatArray
@@ -435,7 +451,7 @@ def dual_step(
     return min(1.0, tau * ratio), dphi
 
 
-@njit(cache=True)
+@_kernel
 def new_z(
     z: FloatArray, a_dual: float, dz: FloatArray, g: FloatArray, mu: float, kappa_sigma: float,
     out: FloatArray
@@ -446,7 +462,7 @@ def new_z(
                      kappa_sigma * mu / g[i])
 
 
-@njit(cache=True)
+@_kernel
 def tiny(
     dv: FloatArray, g: FloatArray
 ) -> float:  # pragma: no cover - compiled
@@ -455,6 +471,10 @@ def tiny(
     for i in range(dv.size):
         out = max(out, abs(dv[i]) / (1.0 + g[i]))
     return out
+
+
+#: The kernels called from Python (all but the three called only from the others).
+ENTRY_POINTS = tuple(name for name in SIGNATURES if not name.startswith("_"))
 
 
 def signatures() -> dict[str, str]:

@@ -76,6 +76,7 @@ def test_fallbacks_and_compiled_kernels_give_the_same_plan(name, path, limits, k
 def test_the_compiled_time_law_matches_the_numpy_one(monkeypatch):
     from speedplan.timing import _law_numpy, law
 
+    jit.FAMILIES["time law"].compile()  # loaded, or compiled here in a fresh cache
     path = read_path(ROOT / "paths" / "warehouse_loop.json")
     compiled = sp.plan(path, LGV)
     assert law.backend().__name__ == "speedplan.core._law_kernel"

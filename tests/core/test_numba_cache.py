@@ -76,7 +76,7 @@ def test_every_kernel_module_hardens_the_cache_on_its_own(module):
     # In a fresh process, loading the module alone must install the guard (in this process
     # another module may already have). The kernel modules are imported lazily: their body
     # runs at the first attribute access, before any kernel can be called.
-    check = (f"import importlib; importlib.import_module({module!r}).njit; "
+    check = (f"import importlib; importlib.import_module({module!r}).signatures; "
              "from numba.core.caching import IndexDataCacheFile as C; "
              "print(C._load_index.__name__)")
     out = subprocess.run([sys.executable, "-c", check], capture_output=True, text=True,

@@ -242,7 +242,7 @@ def test_newton_refines_only_above_its_residual_threshold(seed):
         for a, b in zip(res, bx, strict=True):
             np.testing.assert_array_equal(a, b)
         gx = (np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m))
-        _py(ipm.g_adjoint_into)(d, dn.dyl, dn.dys, *gx)
+        _py(ipm.g_adjoint_into)(d, dn.dyl, dn.dys, *gx, ipm.ADJ_SET)
         residual = np.sqrt(sum(float(np.sum((b - g) ** 2))
                                for b, g in zip((res.gw, res.gt, res.gz), gx, strict=True)))
         return dn, residual

@@ -119,7 +119,7 @@ def test_constraint_map_matches_the_definition_and_its_adjoint(seed):
     # Adjoint: <G x, y> = <x, G' y>, and G' y is the dense transpose applied.
     yl, ys = rng.normal(size=lay.n_lin), rng.normal(size=(3, lay.nc))
     gw, gt, gz = np.zeros(lay.m), np.zeros(lay.m), np.zeros(lay.m)
-    _py(ipm.g_adjoint_into)(d, yl, ys, gw, gt, gz)
+    _py(ipm.g_adjoint_into)(d, yl, ys, gw, gt, gz, ipm.ADJ_SET)
     gty = np.concatenate((gw, gt, gz))
     lhs = float(out_lin @ yl + np.sum(out_soc * ys))
     assert lhs == pytest.approx(float(x @ gty), rel=1e-12)
