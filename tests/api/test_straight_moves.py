@@ -204,3 +204,36 @@ def test_a_braking_start_that_dips_near_rest_is_planned_through_the_dip():
     assert prof.duration == pytest.approx(ruckig_duration(1000.0, lim, **kw), rel=1e-12)
     assert float(np.min(prof.sample(0.001).v[1:-1])) > 0.0  # it does not stop
     _exact(prof, samples=30_000)
+
+
+@pytest.mark.parametrize("dip", [5e-7, 1e-7])
+@pytest.mark.parametrize("end", [False, True])
+def test_a_speed_dip_just_above_rest_is_passed_not_stopped_at(dip, end):
+    # From 1 m/s braking so hard that the speed falls to `dip` of itself before rising again
+    # (and, time reversed, an end state that comes from such a dip): the optimum passes the
+    # dip; stopping there costs a restart from rest, 6 µs for a 5e-7 dip at j_max = 0.05.
+    lim = sp.Limits(v_max=2.0, a_max=5.0, a_lat_max=1.0, j_max=0.05)
+    a = float(np.sqrt(2.0 * lim.j_max * 1.0 * (1.0 - dip)))
+    kw = {"vf": 1.0, "af": a} if end else {"v0": 1.0, "a0": -a}
+    prof = sp.plan(_line(20.0), lim, **kw)
+    assert prof.duration == pytest.approx(ruckig_duration(20.0, lim, **kw), rel=1e-9)
+    assert prof.status == "optimal"
+    assert _answered(prof) == ["model", "closed_form"]
+    _exact(prof, samples=30_000)
+
+
+def test_states_read_off_a_final_stop_replan_to_the_same_arrival():
+    # Each state of the last braking phase lies on the stop's curve to rounding: some dip a
+    # few 1e-19 m/s above 0 and leave a few 1e-17 m of the stretch after their stop. They
+    # stop there; passing such a dip and covering that rounding took microseconds more.
+    lim = sp.Limits(v_max=2.6708942015677413, a_max=0.27349932057246074, a_lat_max=1.0,
+                    j_max=1.0932075207844834)
+    path = _line(0.44859341538827374)
+    prof = sp.plan(path, lim)
+    for t in np.linspace(2.58, 2.80, 40):  # the last jerk phase: 2.57-2.82 s
+        state = prof.at([t])
+        assert float(state.a[0]) < 0 and float(state.v[0]) > 0
+        rest = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
+                       a0=float(state.a[0]))
+        assert rest.status == "optimal"
+        assert t + rest.duration == pytest.approx(prof.duration, rel=1e-9)
