@@ -170,11 +170,11 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
             # spans the stretch.
             forced = replace(forced, length=length, s=forced.s * (length / forced.length))
             head, tail = (forced, None) if forced.v0 > 0 else (None, forced)
-    # A forced stop shorter than a rounding of the stretch (a state a few ulps from rest)
-    # is no motion: the state is rest.
-    if head is not None and head.length <= 1e-12 * length:
+    # A forced stop whose acceleration and duration are roundings (a state a few ulps from
+    # rest) is no motion: the state is rest.
+    if head is not None and _no_motion(head, lim.a_decel, touching["least_duration"]):
         head, v0, a0 = None, 0.0, 0.0
-    if tail is not None and tail.length <= 1e-12 * length:
+    if tail is not None and _no_motion(tail, lim.a_max, touching["least_duration"]):
         tail, vf, af = None, 0.0, 0.0
     if head is not None:
         legs.append(_shifted(head, lo))
@@ -383,6 +383,21 @@ def _stops_in_closed_form(v: float, a: float, j_max: float, *, end: bool, touch:
     length, past = spans
     return (rounded or turnaround_speed(v, -a if end else a, j_max) <= 0.0
             or abs(forced.length - length) <= past * length)
+
+
+def _no_motion(forced: ForcedLeg, a_limit: float, least_duration: float) -> bool:
+    """Whether the forced stop ``forced`` is rest to rounding.
+
+    Its acceleration within ``1e-12`` of ``a_limit`` [m/s²] and its duration within ``1e-12``
+    of the stretch's ``least_duration`` [s]: taking its state for rest changes neither the
+    state nor the arrival beyond a rounding (and spares a law over a few hundred decades
+    below a metre, which overflows). Its length is no measure: a state 1.3e-6 m/s from rest
+    braking at 0.0115 m/s² (``j_max = 50``) stops within 1e-10 m, but in 0.23 ms and from an
+    acceleration the plan must start with.
+    """
+    v, a = (forced.v0, -forced.a0) if forced.v0 > 0 else (forced.vf, forced.af)
+    # The acceleration ramps linearly to 0: the stop lasts 2 v / a.
+    return a <= 1e-12 * a_limit and 2.0 * v <= 1e-12 * least_duration * a
 
 
 def _shifted(leg: ForcedLeg, start: float) -> ForcedLeg:

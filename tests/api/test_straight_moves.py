@@ -222,6 +222,42 @@ def test_a_speed_dip_just_above_rest_is_passed_not_stopped_at(dip, end):
     _exact(prof, samples=30_000)
 
 
+@pytest.mark.parametrize("end", [False, True])
+def test_a_state_on_a_short_stop_keeps_its_acceleration_and_its_time(end):
+    # 1.3e-6 m/s braking at 0.0115 m/s² with j_max = 50: the speed reaches 0 within 1e-10 m
+    # (1e-13 of the 1 km move) but after 0.23 ms, and the plan must start from that braking
+    # (time reversed: arrive in such a state). Taken for rest, the move started at a = 0 and
+    # arrived 0.23 ms earlier than physics allows.
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=50.0)
+    a = 0.0115
+    v = a * a / (2.0 * lim.j_max)
+    kw = {"vf": v, "af": a} if end else {"v0": v, "a0": -a}
+    prof = sp.plan(_line(1000.0), lim, **kw)
+    # The stop (jerk j_max for a / j_max) and the rest-to-rest move over what it leaves.
+    stop = a / lim.j_max, a**3 / (6.0 * lim.j_max**2)
+    expected = stop[0] + ruckig_duration(1000.0 - stop[1], lim)
+    assert prof.duration == pytest.approx(expected, rel=1e-9)
+    assert prof.duration == pytest.approx(ruckig_duration(1000.0, lim, **kw), rel=1e-9)
+    state = prof.at([prof.duration if end else 0.0])
+    assert float(state.v[0]) == pytest.approx(v, rel=1e-9)
+    assert float(state.a[0]) == pytest.approx(a if end else -a, rel=1e-9)
+    _exact(prof, samples=30_000)
+
+
+@pytest.mark.parametrize("end", [False, True])
+def test_a_state_a_few_ulps_from_rest_is_rest(end):
+    # 1e-200 m/s braking at 1e-100 m/s²: a stop of 2e-100 s over 7e-301 m, no motion at any
+    # resolution; planned as the move from (to) rest, without a NaN or a warning.
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    a = float(np.sqrt(2.0 * lim.j_max * 1e-200))
+    kw = {"vf": 1e-200, "af": a} if end else {"v0": 1e-200, "a0": -a}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        prof = sp.plan(_line(1.0), lim, **kw)
+    assert prof.status == "optimal"
+    assert prof.duration == pytest.approx(ruckig_duration(1.0, lim), rel=1e-12)
+
+
 def test_states_read_off_a_final_stop_replan_to_the_same_arrival():
     # Each state of the last braking phase lies on the stop's curve to rounding: some dip a
     # few 1e-19 m/s above 0 and leave a few 1e-17 m of the stretch after their stop. They
