@@ -16,6 +16,7 @@ from oracles import measure, ruckig_duration, ruckig_move
 
 import speedplan as sp
 from speedplan.geometry import Line, Path, SpeedZone
+from speedplan.model.boundary import min_distance
 
 
 def _line(length: float) -> Path:
@@ -273,3 +274,40 @@ def test_states_read_off_a_final_stop_replan_to_the_same_arrival():
                        a0=float(state.a[0]))
         assert rest.status == "optimal"
         assert t + rest.duration == pytest.approx(prof.duration, rel=1e-9)
+
+
+def test_states_read_off_a_braking_replan_in_closed_form_to_the_same_arrival():
+    # A 1.35 km move braking at a_decel for 113 s: each state of its braking lies on the
+    # time-optimal stop that spans what is left of the path (to a few ulps either way). No
+    # motion with a speed peak joins it to rest; on a grid such states arrived 2e-6 early,
+    # or were refused ("cannot come from the speed bound ... at s=308.251 m").
+    lim = sp.Limits(v_max=7.685008579671641, a_max=0.12083772002444583, a_lat_max=1.0,
+                    j_max=10.65161057850779, a_decel=0.06765066886069035)
+    path = _line(1353.1995532062)
+    prof = sp.plan(path, lim)
+    # The braking's jerk phase (151.085-151.092 s) and its hold (until 264.68 s).
+    times = np.concatenate((np.linspace(151.0855, 151.0915, 7), np.linspace(152.0, 264.0, 23)))
+    for t in times:
+        state = prof.at([t])
+        assert float(state.a[0]) < 0
+        rest = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
+                       a0=float(state.a[0]))
+        assert t + rest.duration == pytest.approx(prof.duration, rel=1e-9)
+        assert rest.status == "optimal" and _answered(rest) == ["model", "closed_form"]
+        _exact(rest, samples=3_000)
+
+
+@pytest.mark.parametrize(("v", "a", "end"), [(6.458080789041951, -0.06765066886069035, False),
+                                              (2.0, -0.01, False), (2.0, 0.05, True)])
+def test_a_stretch_as_long_as_the_stop_from_a_moving_state_is_that_stop(v, a, end):
+    # The stretch is exactly the time-optimal braking's length (time reversed: the start
+    # that reaches the end state): the only motion, ruckig's.
+    lim = sp.Limits(v_max=7.685008579671641, a_max=0.12083772002444583, a_lat_max=1.0,
+                    j_max=10.65161057850779, a_decel=0.06765066886069035)
+    kw = {"vf": v, "af": a} if end else {"v0": v, "a0": a}
+    length = min_distance(0.0, 0.0, v, a, lim.j_max, lim.a_max, lim.a_decel) if end else (
+        min_distance(v, a, 0.0, 0.0, lim.j_max, lim.a_max, lim.a_decel))
+    prof = sp.plan(_line(length), lim, **kw)
+    assert prof.duration == pytest.approx(ruckig_duration(length, lim, **kw), rel=1e-9)
+    assert prof.status == "optimal" and _answered(prof) == ["model", "closed_form"]
+    _exact(prof, samples=30_000)
