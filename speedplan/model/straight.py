@@ -49,9 +49,11 @@ __all__ = ["BOUNDARY_ROUNDING", "JerkPhases", "constant_bound", "straight_applie
            "straight_motion"]
 
 #: Boundary states this fraction beyond the reach of a motion of the family are on its
-#: boundary up to rounding, as in the reachability test (`check_reachable_states`): a
-#: stretch shorter than the shortest change between a moving state and rest. A state read
-#: off a plan lies there: its stop's length is the plan's to a few ulps.
+#: boundary up to rounding, as in the reachability test (`check_reachable_states`): an
+#: accelerating start that turns around above ``v_top`` (a state read off a plan's rise to
+#: ``v_max``), a stretch shorter than the shortest change between a moving state and rest
+#: (one read off its braking). The turnaround speed, or the stop's length, is the plan's to
+#: a few ulps either way.
 BOUNDARY_ROUNDING = 1e-9
 
 
@@ -171,8 +173,9 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
         return None
     turns = (turnaround_speed(v0, a0, j_max), turnaround_speed(vf, -af, j_max))
     low = max(turns)
-    if min(turns) < 0 or low > v_top:
+    if min(turns) < 0 or low > v_top * (1.0 + BOUNDARY_ROUNDING):
         return None
+    low = min(low, v_top)  # a start turning around a rounding above v_top ends at it
     if a0 == 0.0 and af == 0.0:
         def distance(vp: float) -> float:
             return _changes_distance(vp, v0, vf, a_max, a_decel, j_max)

@@ -311,3 +311,19 @@ def test_a_stretch_as_long_as_the_stop_from_a_moving_state_is_that_stop(v, a, en
     assert prof.duration == pytest.approx(ruckig_duration(length, lim, **kw), rel=1e-9)
     assert prof.status == "optimal" and _answered(prof) == ["model", "closed_form"]
     _exact(prof, samples=30_000)
+
+
+def test_states_read_off_a_rise_to_v_max_replan_in_closed_form_to_the_same_arrival():
+    # Each state of the rise to v_max turns around at v_max (v + a²/(2 j_max)) to a few ulps
+    # either way; a start turning around 1e-16 above v_max went to a grid, 3e-6 later.
+    lim = sp.Limits(v_max=0.9366650337681903, a_max=2.3654449640657, a_lat_max=1.0,
+                    j_max=0.030965605814174697, a_decel=2.572381255349051)
+    path = _line(52.71367976704063)
+    prof = sp.plan(path, lim)
+    for t in np.linspace(0.5, 10.5, 41):  # the rise: two jerk phases of 5.5 s
+        state = prof.at([t])
+        rest = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
+                       a0=float(state.a[0]))
+        assert t + rest.duration == pytest.approx(prof.duration, rel=1e-9)
+        assert rest.status == "optimal" and _answered(rest) == ["model", "closed_form"]
+        _exact(rest, samples=3_000)
