@@ -327,3 +327,17 @@ def test_states_read_off_a_rise_to_v_max_replan_in_closed_form_to_the_same_arriv
         assert t + rest.duration == pytest.approx(prof.duration, rel=1e-9)
         assert rest.status == "optimal" and _answered(rest) == ["model", "closed_form"]
         _exact(rest, samples=3_000)
+
+
+def test_a_span_ending_a_rounding_short_of_the_path_covers_its_end():
+    # 9.795351824457594 + 30 m: a span to 39.79535182445759 m (the same sum in another order)
+    # ends one ulp short of the path's 39.7953518244576 m; the last point kept v_max = 2 m/s
+    # and the bound was no longer constant.
+    lim = sp.Limits(v_max=2.0, a_max=0.3, a_lat_max=1.0, j_max=0.5, a_decel=0.2)
+    path = Path.from_segments([Line(9.795351824457594), Line(30.0)])
+    span = sp.SpanLimit(0.0, float(np.nextafter(path.length, 0.0)), v_max=1.5)
+    prof = sp.plan(path, lim, spans=[span])
+    capped = sp.Limits(v_max=1.5, a_max=0.3, a_lat_max=1.0, j_max=0.5, a_decel=0.2)
+    assert prof.duration == pytest.approx(ruckig_duration(path.length, capped), rel=1e-9)
+    assert float(prof.speed_bound([path.length])[0]) == 1.5**2
+    assert _answered(prof) == ["model", "closed_form"]
