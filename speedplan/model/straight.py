@@ -185,8 +185,10 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
                     + _rise_distance(vf, -af, vp, j_max, a_decel, a_max))
     if distance(low) > length:
         return _forced_change(length, v0, a0, vf, af, a_max, a_decel, j_max)
+    # The peak to a few ulps of itself (an absolute tolerance in v_top left a peak 1e5 times
+    # below v_top 7e-6 short of the root, and a cruise at it in place of the jerk phases).
     vp = v_top if distance(v_top) <= length else brentq(
-        lambda x: distance(x) - length, low, v_top, xtol=1e-15 * v_top,
+        lambda x: distance(x) - length, low, v_top, xtol=np.finfo(float).tiny,
         rtol=4 * np.finfo(float).eps)
     for k in range(60):
         t_up, d_up, v_up, a_up, j_up = _rising(v0, a0, vp, j_max, a_max, a_decel)

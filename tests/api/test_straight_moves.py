@@ -341,3 +341,15 @@ def test_a_span_ending_a_rounding_short_of_the_path_covers_its_end():
     assert prof.duration == pytest.approx(ruckig_duration(path.length, capped), rel=1e-9)
     assert float(prof.speed_bound([path.length])[0]) == 1.5**2
     assert _answered(prof) == ["model", "closed_form"]
+
+
+
+def test_a_move_peaking_far_below_v_max_is_its_jerk_phases():
+    # 0.1 mm at j_max = 1e-6: four jerk phases of 3.7 s peaking at 1.4e-5 m/s, 7e9 times
+    # below v_max (the limits within their range). The peak was found to 1e-15 v_max, not to
+    # its own precision: 7e-6 below the root, a cruise in place of jerk, 4.2e-7 longer.
+    lim = sp.Limits(v_max=1e5, a_max=1e6, a_lat_max=1.0, j_max=1e-6)
+    prof = sp.plan(_line(1e-4), lim)
+    assert prof.duration == pytest.approx(4.0 * (1e-4 / (2.0 * 1e-6)) ** (1 / 3), rel=1e-12)
+    assert prof.duration == pytest.approx(ruckig_duration(1e-4, lim), rel=1e-12)
+    assert _answered(prof) == ["model", "closed_form"]
