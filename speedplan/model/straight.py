@@ -251,12 +251,15 @@ def constant_bound(bound: SpeedBound, lo: float, hi: float) -> float | None:
     Evaluated at the ends, at every breakpoint inside (piece joins, zone entries and exits,
     ``v_limit`` knots, span ends: `bound_breakpoints`) and between consecutive ones; on a
     straight stretch the bound is piecewise constant or linear between breakpoints, so equal
-    values there mean a constant bound.
+    values there mean a constant bound. The ends are read one ulp inside the stretch: at a
+    join the bound is that of the piece (zone, span) beginning there, which the stretch only
+    touches — a line ending at a stop where an arc begins has the line's bound up to it.
     """
     breaks = bound_breakpoints(bound.path, bound)
     inner = breaks[(breaks > lo) & (breaks < hi)]
     knots = np.concatenate(([lo], inner, [hi]))
-    probes = np.concatenate((knots, 0.5 * (knots[:-1] + knots[1:])))
+    ends = np.array([np.nextafter(lo, hi), np.nextafter(hi, lo)])
+    probes = np.concatenate((ends, inner, 0.5 * (knots[:-1] + knots[1:])))
     w = np.asarray(bound(probes), dtype=np.float64)
     top = float(w[0])
     return top if top > 0 and np.isfinite(top) and bool(np.all(w == top)) else None

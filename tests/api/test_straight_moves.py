@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from oracles import measure, ruckig_duration, ruckig_move
+from oracles import measure, ruckig_duration, ruckig_move, within_promise
 
 import speedplan as sp
-from speedplan.geometry import Line, Path, SpeedZone
+from speedplan.geometry import Arc, Line, Path, SpeedZone
 from speedplan.model.boundary import min_distance
 
 
@@ -353,3 +353,16 @@ def test_a_move_peaking_far_below_v_max_is_its_jerk_phases():
     assert prof.duration == pytest.approx(4.0 * (1e-4 / (2.0 * 1e-6)) ** (1 / 3), rel=1e-12)
     assert prof.duration == pytest.approx(ruckig_duration(1e-4, lim), rel=1e-12)
     assert _answered(prof) == ["model", "closed_form"]
+
+
+def test_a_line_ending_at_a_stop_where_an_arc_begins_is_planned_in_closed_form():
+    # At the join the bound is the arc's (1.41 m/s): read there, the line's bound was not
+    # constant and the line went to a grid, 1.1e-4 s slower than its optimum.
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    path = Path.from_segments([Line(10.0), Arc(radius=2.0, angle=np.pi / 2), Line(10.0)])
+    prof = sp.plan(path, lim, stops=[10.0, 10.0 + np.pi])
+    first, _, last = (leg.law.duration for leg in prof.legs)
+    assert first == pytest.approx(ruckig_duration(10.0, lim), rel=1e-12)
+    assert last == pytest.approx(ruckig_duration(10.0, lim), rel=1e-12)
+    assert _answered(prof) == ["model", "closed_form", "default_grid", "closed_form"]
+    assert within_promise(measure(prof, samples=30_000))  # the arc on its grid
