@@ -121,14 +121,29 @@ class SpanLimit:
 
 
 def check_spans(spans: object, length: float | None = None) -> list[SpanLimit]:
-    """``spans`` as a list of [`SpanLimit`][speedplan.SpanLimit] (one, a sequence, or ``None``)."""
+    """``spans`` as a list of [`SpanLimit`][speedplan.SpanLimit] (one, a sequence, or ``None``).
+
+    With the path's ``length`` [m]: a span ending within ``1e-9`` of it, on either side,
+    ends at it (its end summed in another order, as a route's edges: one ulp short, the
+    path's last point kept the path's own limit); one ending further beyond is refused.
+
+    Examples
+    --------
+    >>> check_spans(SpanLimit(0.0, 39.79535182445759, v_max=1.5), 39.7953518244576)[0].end
+    39.7953518244576
+    """
     out = instances("spans", spans, SpanLimit)
     for i, span in enumerate(out):
-        if length is not None and span.end > length * (1 + 1e-9):
+        if length is None:
+            continue
+        if span.end > length * (1 + 1e-9):
             raise InvalidInputError(
                 f"`spans[{i}]` ends at {span.end:.9g} m, beyond the path's length "
                 f"{length:.9g} m"
             )
+        if span.end != length and abs(span.end - length) <= 1e-9 * length \
+                and span.start < length:
+            out[i] = replace(span, end=length)
     return out
 
 

@@ -145,10 +145,11 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
     touch = max(TOUCH_ZERO, 4.0 * STATE_JERK_ROUNDING) if rounded else TOUCH_ZERO
     past = 5.0 * STATE_JERK_ROUNDING if rounded else STATE_ROUNDING
     touching = {"touch": touch, "least_duration": length / lim.v_max}
-    # In closed form a speed dip next to rest is exact: only a state on a stop's curve (to
-    # rounding) stops on the way; the dips a grid could not resolve are passed.
+    # In closed form a speed dip next to rest is exact: only a state that stops on the way
+    # (`_stops_in_closed_form`) is planned as a stop and the rest of the stretch.
     if request.jerk_limited and not any(
-            _forced_stop(v, a, j_state, end=end, touch=touch, least_duration=0.0)
+            _stops_in_closed_form(v, a, j_state, end=end, touch=touch, rounded=rounded,
+                                  spans=(length, past))
             for v, a, end in ((v0, a0, False), (vf, af, True))):
         whole = straight_leg(request, bound, lo, hi, v0, a0, vf, af)
         if whole is not None:
@@ -169,11 +170,11 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
             # spans the stretch.
             forced = replace(forced, length=length, s=forced.s * (length / forced.length))
             head, tail = (forced, None) if forced.v0 > 0 else (None, forced)
-    # A forced stop shorter than a rounding of the stretch (a state a few ulps from rest)
-    # is no motion: the state is rest.
-    if head is not None and head.length <= 1e-12 * length:
+    # A forced stop whose acceleration and duration are roundings (a state a few ulps from
+    # rest) is no motion: the state is rest.
+    if head is not None and _no_motion(head, lim.a_decel, touching["least_duration"]):
         head, v0, a0 = None, 0.0, 0.0
-    if tail is not None and tail.length <= 1e-12 * length:
+    if tail is not None and _no_motion(tail, lim.a_max, touching["least_duration"]):
         tail, vf, af = None, 0.0, 0.0
     if head is not None:
         legs.append(_shifted(head, lo))
@@ -366,6 +367,41 @@ def _forced_stop(v: float, a: float, j_max: float, *, end: bool, touch: float,
     law = TimeLawSpec(j_max=j_max, accel_start=a, accel_end=None)
     return ForcedLeg(start=0.0, length=length, v0=v, a0=a, vf=0.0, af=0.0, s=s, w=w,
                      time_law=law)
+
+
+def _stops_in_closed_form(v: float, a: float, j_max: float, *, end: bool, touch: float,
+                          rounded: bool, spans: tuple[float, float]) -> bool:
+    """Whether a straight stretch in closed form stops at the state ``(v, a)`` on the way.
+
+    A state whose speed falls to 0 (``v - a²/(2 j) <= 0`` at the start), one read off a
+    plan's final stop (``rounded``: on the stop's curve to the law's rounding), and one
+    within ``touch`` of it whose stop spans the stretch (``spans``: its length [m] and the
+    relative rounding of that) do. A dip above 0 with room after it is passed exactly: a
+    stop there costs a restart from rest (6 µs for a 5e-7 dip at ``j_max = 0.05``). Next to
+    the stretch's end there is no such room: what a rounding of the positions leaves after
+    the stop (1e-17 m) would take a rise and a fall of microseconds.
+    """
+    forced = _forced_stop(v, a, j_max, end=end, touch=touch, least_duration=0.0)
+    if forced is None:
+        return False
+    length, past = spans
+    return (rounded or turnaround_speed(v, -a if end else a, j_max) <= 0.0
+            or abs(forced.length - length) <= past * length)
+
+
+def _no_motion(forced: ForcedLeg, a_limit: float, least_duration: float) -> bool:
+    """Whether the forced stop ``forced`` is rest to rounding.
+
+    Its acceleration within ``1e-12`` of ``a_limit`` [m/s²] and its duration within ``1e-12``
+    of the stretch's ``least_duration`` [s]: taking its state for rest changes neither the
+    state nor the arrival beyond a rounding (and spares a law over a few hundred decades
+    below a metre, which overflows). Its length is no measure: a state 1.3e-6 m/s from rest
+    braking at 0.0115 m/s² (``j_max = 50``) stops within 1e-10 m, but in 0.23 ms and from an
+    acceleration the plan must start with.
+    """
+    v, a = (forced.v0, -forced.a0) if forced.v0 > 0 else (forced.vf, forced.af)
+    # The acceleration ramps linearly to 0: the stop lasts 2 v / a.
+    return a <= 1e-12 * a_limit and 2.0 * v <= 1e-12 * least_duration * a
 
 
 def _shifted(leg: ForcedLeg, start: float) -> ForcedLeg:

@@ -27,8 +27,10 @@ target states*, 2021); those that rise to one speed peak and fall from it are th
 The others — a motion that never has a peak (still accelerating on arrival past any peak),
 or one that must dip towards rest to arrive faster — have no member here: if even the lowest
 admissible peak does not fit in ``L``, `straight_motion` returns ``None`` and the leg is
-planned on a grid like any other. ``tests/api/test_straight_moves.py`` holds every motion of
-this family against ruckig's optimum over decades of scale, boundary states included.
+planned on a grid like any other — unless ``L`` is the length of the shortest change between
+a moving state and rest itself (a state read off a plan's braking): that change is then the
+only motion. ``tests/api/test_straight_moves.py`` holds every motion of this family against
+ruckig's optimum over decades of scale, boundary states included.
 """
 
 from __future__ import annotations
@@ -43,7 +45,16 @@ from ..geometry import SpeedBound, bound_breakpoints
 from .boundary import run_phases, transition, turnaround_speed
 from .request import PlanRequest
 
-__all__ = ["JerkPhases", "constant_bound", "straight_applies", "straight_motion"]
+__all__ = ["BOUNDARY_ROUNDING", "JerkPhases", "constant_bound", "straight_applies",
+           "straight_motion"]
+
+#: Boundary states this fraction beyond the reach of a motion of the family are on its
+#: boundary up to rounding, as in the reachability test (`check_reachable_states`): an
+#: accelerating start that turns around above ``v_top`` (a state read off a plan's rise to
+#: ``v_max``), a stretch shorter than the shortest change between a moving state and rest
+#: (one read off its braking). The turnaround speed, or the stop's length, is the plan's to
+#: a few ulps either way.
+BOUNDARY_ROUNDING = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,7 +155,10 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
     JerkPhases or None
         The motion (see the module notes for when it is the optimum), or ``None`` when no
         motion that rises to one speed peak joins the states within ``length`` and
-        ``v_top`` (the states then need a grid, or no motion joins them).
+        ``v_top`` (the states then need a grid, or no motion joins them) — unless the
+        stretch is as long as the shortest change from a moving state to rest (or from rest
+        to a moving state), to `BOUNDARY_ROUNDING`: that change is the only motion
+        (`_forced_change`).
 
     Examples
     --------
@@ -159,8 +173,9 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
         return None
     turns = (turnaround_speed(v0, a0, j_max), turnaround_speed(vf, -af, j_max))
     low = max(turns)
-    if min(turns) < 0 or low > v_top:
+    if min(turns) < 0 or low > v_top * (1.0 + BOUNDARY_ROUNDING):
         return None
+    low = min(low, v_top)  # a start turning around a rounding above v_top ends at it
     if a0 == 0.0 and af == 0.0:
         def distance(vp: float) -> float:
             return _changes_distance(vp, v0, vf, a_max, a_decel, j_max)
@@ -169,9 +184,11 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
             return (_rise_distance(v0, a0, vp, j_max, a_max, a_decel)
                     + _rise_distance(vf, -af, vp, j_max, a_decel, a_max))
     if distance(low) > length:
-        return None
+        return _forced_change(length, v0, a0, vf, af, a_max, a_decel, j_max)
+    # The peak to a few ulps of itself (an absolute tolerance in v_top left a peak 1e5 times
+    # below v_top 7e-6 short of the root, and a cruise at it in place of the jerk phases).
     vp = v_top if distance(v_top) <= length else brentq(
-        lambda x: distance(x) - length, low, v_top, xtol=1e-15 * v_top,
+        lambda x: distance(x) - length, low, v_top, xtol=np.finfo(float).tiny,
         rtol=4 * np.finfo(float).eps)
     for k in range(60):
         t_up, d_up, v_up, a_up, j_up = _rising(v0, a0, vp, j_max, a_max, a_decel)
@@ -200,18 +217,49 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
                       jerk=np.concatenate(jerk))
 
 
+def _forced_change(length: float, v0: float, a0: float, vf: float, af: float, a_max: float,
+                   a_decel: float, j_max: float) -> JerkPhases | None:
+    """The time-optimal change between a moving state and rest, if it spans ``length``.
+
+    From ``(v0, a0)`` to rest the shortest motion is the time-optimal braking (time
+    reversed, from rest to ``(vf, af)`` the time-optimal start); over a stretch that long,
+    to `BOUNDARY_ROUNDING`, it is the only motion. A state read off a plan's braking (its
+    acceleration still falling, or held at ``-a_decel``) lies there: no motion with a speed
+    peak joins it to rest. ``None`` elsewhere.
+
+    The change is stretched in time by ``k = length / distance`` to cover ``length``
+    exactly: positions and times times ``k``, the same speeds, accelerations over ``k`` and
+    jerks over ``k²`` — a rounding, and the phases stay consistent (positions scaled alone
+    would jump by ``(k - 1) s`` inside each phase).
+    """
+    if vf == 0.0 and af == 0.0 and v0 > 0.0:
+        t, d, v, a, jerk = _rising(v0, a0, 0.0, j_max, a_max, a_decel)
+    elif v0 == 0.0 and a0 == 0.0 and vf > 0.0:  # time reversed, from the end
+        t, d, v, a, jerk = _rising(vf, -af, 0.0, j_max, a_decel, a_max)
+        t, d, v, a, jerk = t[-1] - t[::-1], d[-1] - d[::-1], v[::-1], -a[::-1], jerk[::-1]
+    else:
+        return None
+    if jerk.size == 0 or not abs(d[-1] - length) <= BOUNDARY_ROUNDING * length:
+        return None
+    k = length / d[-1]
+    return JerkPhases(t=t * k, s=d * k, v=v, a=a / k + 0.0, jerk=jerk / (k * k))
+
+
 def constant_bound(bound: SpeedBound, lo: float, hi: float) -> float | None:
     """The speed bound's value [m²/s²] if it is one constant over ``[lo, hi]``, else ``None``.
 
     Evaluated at the ends, at every breakpoint inside (piece joins, zone entries and exits,
     ``v_limit`` knots, span ends: `bound_breakpoints`) and between consecutive ones; on a
     straight stretch the bound is piecewise constant or linear between breakpoints, so equal
-    values there mean a constant bound.
+    values there mean a constant bound. The ends are read one ulp inside the stretch: at a
+    join the bound is that of the piece (zone, span) beginning there, which the stretch only
+    touches — a line ending at a stop where an arc begins has the line's bound up to it.
     """
     breaks = bound_breakpoints(bound.path, bound)
     inner = breaks[(breaks > lo) & (breaks < hi)]
     knots = np.concatenate(([lo], inner, [hi]))
-    probes = np.concatenate((knots, 0.5 * (knots[:-1] + knots[1:])))
+    ends = np.array([np.nextafter(lo, hi), np.nextafter(hi, lo)])
+    probes = np.concatenate((ends, inner, 0.5 * (knots[:-1] + knots[1:])))
     w = np.asarray(bound(probes), dtype=np.float64)
     top = float(w[0])
     return top if top > 0 and np.isfinite(top) and bool(np.all(w == top)) else None

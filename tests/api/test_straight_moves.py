@@ -12,10 +12,11 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from oracles import measure, ruckig_duration, ruckig_move
+from oracles import measure, ruckig_duration, ruckig_move, within_promise
 
 import speedplan as sp
-from speedplan.geometry import Line, Path, SpeedZone
+from speedplan.geometry import Arc, Line, Path, SpeedZone
+from speedplan.model.boundary import min_distance
 
 
 def _line(length: float) -> Path:
@@ -204,3 +205,164 @@ def test_a_braking_start_that_dips_near_rest_is_planned_through_the_dip():
     assert prof.duration == pytest.approx(ruckig_duration(1000.0, lim, **kw), rel=1e-12)
     assert float(np.min(prof.sample(0.001).v[1:-1])) > 0.0  # it does not stop
     _exact(prof, samples=30_000)
+
+
+@pytest.mark.parametrize("dip", [5e-7, 1e-7])
+@pytest.mark.parametrize("end", [False, True])
+def test_a_speed_dip_just_above_rest_is_passed_not_stopped_at(dip, end):
+    # From 1 m/s braking so hard that the speed falls to `dip` of itself before rising again
+    # (and, time reversed, an end state that comes from such a dip): the optimum passes the
+    # dip; stopping there costs a restart from rest, 6 µs for a 5e-7 dip at j_max = 0.05.
+    lim = sp.Limits(v_max=2.0, a_max=5.0, a_lat_max=1.0, j_max=0.05)
+    a = float(np.sqrt(2.0 * lim.j_max * 1.0 * (1.0 - dip)))
+    kw = {"vf": 1.0, "af": a} if end else {"v0": 1.0, "a0": -a}
+    prof = sp.plan(_line(20.0), lim, **kw)
+    assert prof.duration == pytest.approx(ruckig_duration(20.0, lim, **kw), rel=1e-9)
+    assert prof.status == "optimal"
+    assert _answered(prof) == ["model", "closed_form"]
+    _exact(prof, samples=30_000)
+
+
+@pytest.mark.parametrize("end", [False, True])
+def test_a_state_on_a_short_stop_keeps_its_acceleration_and_its_time(end):
+    # 1.3e-6 m/s braking at 0.0115 m/s² with j_max = 50: the speed reaches 0 within 1e-10 m
+    # (1e-13 of the 1 km move) but after 0.23 ms, and the plan must start from that braking
+    # (time reversed: arrive in such a state). Taken for rest, the move started at a = 0 and
+    # arrived 0.23 ms earlier than physics allows.
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=50.0)
+    a = 0.0115
+    v = a * a / (2.0 * lim.j_max)
+    kw = {"vf": v, "af": a} if end else {"v0": v, "a0": -a}
+    prof = sp.plan(_line(1000.0), lim, **kw)
+    # The stop (jerk j_max for a / j_max) and the rest-to-rest move over what it leaves.
+    stop = a / lim.j_max, a**3 / (6.0 * lim.j_max**2)
+    expected = stop[0] + ruckig_duration(1000.0 - stop[1], lim)
+    assert prof.duration == pytest.approx(expected, rel=1e-9)
+    assert prof.duration == pytest.approx(ruckig_duration(1000.0, lim, **kw), rel=1e-9)
+    state = prof.at([prof.duration if end else 0.0])
+    assert float(state.v[0]) == pytest.approx(v, rel=1e-9)
+    assert float(state.a[0]) == pytest.approx(a if end else -a, rel=1e-9)
+    _exact(prof, samples=30_000)
+
+
+@pytest.mark.parametrize("end", [False, True])
+def test_a_state_a_few_ulps_from_rest_is_rest(end):
+    # 1e-200 m/s braking at 1e-100 m/s²: a stop of 2e-100 s over 7e-301 m, no motion at any
+    # resolution; planned as the move from (to) rest, without a NaN or a warning.
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    a = float(np.sqrt(2.0 * lim.j_max * 1e-200))
+    kw = {"vf": 1e-200, "af": a} if end else {"v0": 1e-200, "a0": -a}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        prof = sp.plan(_line(1.0), lim, **kw)
+    assert prof.status == "optimal"
+    assert prof.duration == pytest.approx(ruckig_duration(1.0, lim), rel=1e-12)
+
+
+def test_states_read_off_a_final_stop_replan_to_the_same_arrival():
+    # Each state of the last braking phase lies on the stop's curve to rounding: some dip a
+    # few 1e-19 m/s above 0 and leave a few 1e-17 m of the stretch after their stop. They
+    # stop there; passing such a dip and covering that rounding took microseconds more.
+    lim = sp.Limits(v_max=2.6708942015677413, a_max=0.27349932057246074, a_lat_max=1.0,
+                    j_max=1.0932075207844834)
+    path = _line(0.44859341538827374)
+    prof = sp.plan(path, lim)
+    for t in np.linspace(2.58, 2.80, 40):  # the last jerk phase: 2.57-2.82 s
+        state = prof.at([t])
+        assert float(state.a[0]) < 0 and float(state.v[0]) > 0
+        rest = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
+                       a0=float(state.a[0]))
+        assert rest.status == "optimal"
+        assert t + rest.duration == pytest.approx(prof.duration, rel=1e-9)
+
+
+def test_states_read_off_a_braking_replan_in_closed_form_to_the_same_arrival():
+    # A 1.35 km move braking at a_decel for 113 s: each state of its braking lies on the
+    # time-optimal stop that spans what is left of the path (to a few ulps either way). No
+    # motion with a speed peak joins it to rest; on a grid such states arrived 2e-6 early,
+    # or were refused ("cannot come from the speed bound ... at s=308.251 m").
+    lim = sp.Limits(v_max=7.685008579671641, a_max=0.12083772002444583, a_lat_max=1.0,
+                    j_max=10.65161057850779, a_decel=0.06765066886069035)
+    path = _line(1353.1995532062)
+    prof = sp.plan(path, lim)
+    # The braking's jerk phase (151.085-151.092 s) and its hold (until 264.68 s).
+    times = np.concatenate((np.linspace(151.0855, 151.0915, 7), np.linspace(152.0, 264.0, 23)))
+    for t in times:
+        state = prof.at([t])
+        assert float(state.a[0]) < 0
+        rest = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
+                       a0=float(state.a[0]))
+        assert t + rest.duration == pytest.approx(prof.duration, rel=1e-9)
+        assert rest.status == "optimal" and _answered(rest) == ["model", "closed_form"]
+        _exact(rest, samples=3_000)
+
+
+@pytest.mark.parametrize(("v", "a", "end"), [(6.458080789041951, -0.06765066886069035, False),
+                                              (2.0, -0.01, False), (2.0, 0.05, True)])
+def test_a_stretch_as_long_as_the_stop_from_a_moving_state_is_that_stop(v, a, end):
+    # The stretch is exactly the time-optimal braking's length (time reversed: the start
+    # that reaches the end state): the only motion, ruckig's.
+    lim = sp.Limits(v_max=7.685008579671641, a_max=0.12083772002444583, a_lat_max=1.0,
+                    j_max=10.65161057850779, a_decel=0.06765066886069035)
+    kw = {"vf": v, "af": a} if end else {"v0": v, "a0": a}
+    length = min_distance(0.0, 0.0, v, a, lim.j_max, lim.a_max, lim.a_decel) if end else (
+        min_distance(v, a, 0.0, 0.0, lim.j_max, lim.a_max, lim.a_decel))
+    prof = sp.plan(_line(length), lim, **kw)
+    assert prof.duration == pytest.approx(ruckig_duration(length, lim, **kw), rel=1e-9)
+    assert prof.status == "optimal" and _answered(prof) == ["model", "closed_form"]
+    _exact(prof, samples=30_000)
+
+
+def test_states_read_off_a_rise_to_v_max_replan_in_closed_form_to_the_same_arrival():
+    # Each state of the rise to v_max turns around at v_max (v + a²/(2 j_max)) to a few ulps
+    # either way; a start turning around 1e-16 above v_max went to a grid, 3e-6 later.
+    lim = sp.Limits(v_max=0.9366650337681903, a_max=2.3654449640657, a_lat_max=1.0,
+                    j_max=0.030965605814174697, a_decel=2.572381255349051)
+    path = _line(52.71367976704063)
+    prof = sp.plan(path, lim)
+    for t in np.linspace(0.5, 10.5, 41):  # the rise: two jerk phases of 5.5 s
+        state = prof.at([t])
+        rest = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
+                       a0=float(state.a[0]))
+        assert t + rest.duration == pytest.approx(prof.duration, rel=1e-9)
+        assert rest.status == "optimal" and _answered(rest) == ["model", "closed_form"]
+        _exact(rest, samples=3_000)
+
+
+def test_a_span_ending_a_rounding_short_of_the_path_covers_its_end():
+    # 9.795351824457594 + 30 m: a span to 39.79535182445759 m (the same sum in another order)
+    # ends one ulp short of the path's 39.7953518244576 m; the last point kept v_max = 2 m/s
+    # and the bound was no longer constant.
+    lim = sp.Limits(v_max=2.0, a_max=0.3, a_lat_max=1.0, j_max=0.5, a_decel=0.2)
+    path = Path.from_segments([Line(9.795351824457594), Line(30.0)])
+    span = sp.SpanLimit(0.0, float(np.nextafter(path.length, 0.0)), v_max=1.5)
+    prof = sp.plan(path, lim, spans=[span])
+    capped = sp.Limits(v_max=1.5, a_max=0.3, a_lat_max=1.0, j_max=0.5, a_decel=0.2)
+    assert prof.duration == pytest.approx(ruckig_duration(path.length, capped), rel=1e-9)
+    assert float(prof.speed_bound([path.length])[0]) == 1.5**2
+    assert _answered(prof) == ["model", "closed_form"]
+
+
+
+def test_a_move_peaking_far_below_v_max_is_its_jerk_phases():
+    # 0.1 mm at j_max = 1e-6: four jerk phases of 3.7 s peaking at 1.4e-5 m/s, 7e9 times
+    # below v_max (the limits within their range). The peak was found to 1e-15 v_max, not to
+    # its own precision: 7e-6 below the root, a cruise in place of jerk, 4.2e-7 longer.
+    lim = sp.Limits(v_max=1e5, a_max=1e6, a_lat_max=1.0, j_max=1e-6)
+    prof = sp.plan(_line(1e-4), lim)
+    assert prof.duration == pytest.approx(4.0 * (1e-4 / (2.0 * 1e-6)) ** (1 / 3), rel=1e-12)
+    assert prof.duration == pytest.approx(ruckig_duration(1e-4, lim), rel=1e-12)
+    assert _answered(prof) == ["model", "closed_form"]
+
+
+def test_a_line_ending_at_a_stop_where_an_arc_begins_is_planned_in_closed_form():
+    # At the join the bound is the arc's (1.41 m/s): read there, the line's bound was not
+    # constant and the line went to a grid, 1.1e-4 s slower than its optimum.
+    lim = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
+    path = Path.from_segments([Line(10.0), Arc(radius=2.0, angle=np.pi / 2), Line(10.0)])
+    prof = sp.plan(path, lim, stops=[10.0, 10.0 + np.pi])
+    first, _, last = (leg.law.duration for leg in prof.legs)
+    assert first == pytest.approx(ruckig_duration(10.0, lim), rel=1e-12)
+    assert last == pytest.approx(ruckig_duration(10.0, lim), rel=1e-12)
+    assert _answered(prof) == ["model", "closed_form", "default_grid", "closed_form"]
+    assert within_promise(measure(prof, samples=30_000))  # the arc on its grid

@@ -132,3 +132,18 @@ def test_an_update_during_a_turn_on_the_spot_is_refused_by_time():
     up = _order(1, [_node(1, 10, 0), _node(2, 10, 10)], [_edge(1)])
     with pytest.raises(InvalidInputError, match="turning on the spot"):
         plan_route_update(old, up, middle)
+
+
+def test_updates_of_a_straight_order_replan_to_the_same_arrival():
+    # Both edges at 1.5 m/s: from anywhere on the first, the rest of the base is one straight
+    # stretch at one speed limit, planned in closed form. The edges' limits are summed from
+    # the switch: where that ended an ulp before the rest of the path (one of these), its
+    # last point kept v_max, and the update went to a grid, 6.9e-7 from the original arrival.
+    nodes = [_node(0, 0, 0), _node(1, 10, 0), _node(2, 40, 0)]
+    edges = [_edge(0, maxSpeed=1.5), _edge(1, maxSpeed=1.5)]
+    old = plan_route(_order(0, nodes, edges), LGV)
+    for t in np.linspace(0.1, old.duration - 0.1, 60):
+        new = plan_route_update(old, _order(1, nodes, edges), float(t))
+        assert t + new.duration == pytest.approx(old.duration, rel=1e-9)
+        answered = {a.name for a in new.legs[0].attempts if a.outcome == "answered"}
+        assert answered <= {"model", "closed_form", "forced_motion"}  # no grid
