@@ -34,11 +34,9 @@ Run with ``PYTHONPATH`` at another checkout to measure another version on the sa
 from __future__ import annotations
 
 import argparse
-import contextlib
 import sys
 import time
 import warnings
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -47,31 +45,14 @@ import numpy as np
 import speedplan as sp
 from speedplan.io import read_path, read_zones
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from oracles import subdivided_default_grids  # the tests' reference: finer default grids
+
 PATHS = Path(__file__).resolve().parents[1] / "paths"
 LGV = dict(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 ROAD = dict(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0)
 COMFORT = dict(j_lat_max=0.3, yaw_rate_max=0.4)
 TARGET = 1e-4
-
-
-@contextlib.contextmanager
-def subdivided_default_grids(k: int) -> Iterator[None]:
-    """``plan()``'s default grids with every cell cut into ``k`` equal steps."""
-    from speedplan.model import leg_grid
-
-    original = leg_grid.default_grid
-
-    def finer(*args, **kw):
-        s = original(*args, **kw)
-        frac = np.arange(k) / k
-        inner = (s[:-1, None] + np.diff(s)[:, None] * frac[None, :]).ravel()
-        return np.append(inner, s[-1])
-
-    leg_grid.default_grid = finer
-    try:
-        yield
-    finally:
-        leg_grid.default_grid = original
 
 
 @dataclass

@@ -6,6 +6,8 @@ tolerances are written out, and the sampled trajectory is judged by its own numb
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -278,3 +280,26 @@ def assert_physical(profile, length, lim, **states):
     assert within_promise(m), m
     assert profile.duration >= ruckig_duration(length, lim, **states) * (1 - 1e-4)
     assert profile.status in ("optimal", "refined")
+
+
+@contextlib.contextmanager
+def subdivided_default_grids(k: int) -> Iterator[None]:
+    """``plan()``'s default grids with every cell cut into ``k`` equal steps.
+
+    The reference of a convergence check: the same grid family, ``k`` times finer everywhere
+    (Richardson's extrapolation over ``k = 2, 4`` gives the converged duration).
+    """
+    from speedplan.model import leg_grid
+
+    original = leg_grid.default_grid
+
+    def finer(*args, **kw):
+        s = original(*args, **kw)
+        inner = (s[:-1, None] + np.diff(s)[:, None] * (np.arange(k) / k)[None, :]).ravel()
+        return np.append(inner, s[-1])
+
+    leg_grid.default_grid = finer
+    try:
+        yield
+    finally:
+        leg_grid.default_grid = original

@@ -7,13 +7,11 @@ two and four equal steps.
 
 from __future__ import annotations
 
-import contextlib
 import os
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
-from oracles import ruckig_duration
+from oracles import ruckig_duration, subdivided_default_grids
 from shared import LGV
 
 import speedplan as sp
@@ -39,30 +37,11 @@ def test_a_circle_from_rest_to_rest_takes_the_straight_move_under_its_lateral_sp
     assert profile.duration == pytest.approx(exact, rel=ACCURACY)
 
 
-@contextlib.contextmanager
-def _subdivided(k: int) -> Iterator[None]:
-    """``plan()``'s default grids with every cell cut into ``k`` equal steps."""
-    from speedplan.model import leg_grid
-
-    original = leg_grid.default_grid
-
-    def finer(*args, **kw):
-        s = original(*args, **kw)
-        inner = (s[:-1, None] + np.diff(s)[:, None] * (np.arange(k) / k)[None, :]).ravel()
-        return np.append(inner, s[-1])
-
-    leg_grid.default_grid = finer
-    try:
-        yield
-    finally:
-        leg_grid.default_grid = original
-
-
 def _converged(path: sp.Path, lim: sp.Limits, zones) -> tuple[float, float]:
     """Richardson's limit of the subdivided grids (second order) and its own spread."""
     durations = []
     for k in (2, 4):
-        with _subdivided(k):
+        with subdivided_default_grids(k):
             durations.append(sp.plan(path, lim, zones=zones).duration)
     coarse, fine = durations
     return fine + (fine - coarse) / 3.0, abs(fine - coarse) / fine
