@@ -129,8 +129,8 @@ def plan(
         limit and where, ``s`` in metres). A moving state that ``j_max (1 +
         STATE_JERK_ROUNDING)`` (1e-4) reaches, such as a state read off a plan, is planned
         with that jerk, silently; one that ``j_max (1 + STATE_JERK_SLACK)`` (2 %) reaches,
-        with that jerk and a [`SpeedplanWarning`][speedplan.SpeedplanWarning]
-        (`speedplan.strategy.model_request`).
+        with up to that jerk while its acceleration is brought to 0 (``j_max`` after) and a
+        [`SpeedplanWarning`][speedplan.SpeedplanWarning] (`speedplan.strategy.model_request`).
     SolverError
         Neither relaxation backend converged on the leg's grid (nor, on a default grid, on
         the coarser ones), and no feasible speed law could be produced.

@@ -8,8 +8,11 @@ only when the ones before it did not answer:
   when the first refuses moving states that a motion whose speed first dips reaches;
   ``"state_rounding"`` and ``"exact_reach_state_rounding"``, both again with ``j_max (1 +
   STATE_JERK_ROUNDING)`` (a state read off a plan; silent); then
-  ``"jerk_slack"`` and ``"exact_reach_jerk_slack"`` with ``j_max (1 + STATE_JERK_SLACK)``,
-  for moving states just outside what ``j_max`` reaches (with a
+  ``"jerk_slack"`` and ``"exact_reach_jerk_slack"``, for moving states just outside what
+  ``j_max`` reaches: up to ``j_max (1 + STATE_JERK_SLACK)`` while such a state's
+  acceleration is brought to 0 (a `TurnLeg`), ``j_max`` elsewhere; then
+  ``"jerk_slack_whole_move"`` and ``"exact_reach_jerk_slack_whole_move"`` with that jerk
+  over the whole move, where a turn does not fit (both with a
   [`SpeedplanWarning`][speedplan.SpeedplanWarning]).
 * **solve** (per leg): ``"forced_motion"`` for a leg with no freedom left; ``"closed_form"``
   for a straight leg whose minimum-time motion is known exactly (`StraightLeg`); ``"given_grid"``
@@ -19,7 +22,12 @@ only when the ones before it did not answer:
   ``"other_backend"`` on each of these grids in turn.
 * **verify** (per leg whose continuous law exceeds a tolerance): up to
   `MAX_REFINEMENTS` rounds of ``"local_refinement"`` of the grid where it does, then,
-  for a leg answered on a coarser grid, ``"default_grid_other_backend"``.
+  for a leg answered on a coarser grid, ``"default_grid_other_backend"``. These improve a
+  law the plan already has, so they share a time of their own (`refinement_seconds`: as
+  long as the first answers took, at least `MIN_REFINEMENT_SECONDS`): an attempt that
+  would not end within it (it takes about as long as the leg's last solve) is not started
+  (recorded as ``"skipped"``), and a solver that can stop stops at its end; the plan then
+  keeps the law it has and reports any excess (``limits_exceeded``).
 
 `Budget` holds the caller's ``time_limit``: it is checked before every attempt, and
 an attempt the budget no longer covers is not started. The record of every attempt (which
@@ -52,7 +60,7 @@ from .core.errors import (
     SpeedplanWarning,
 )
 from .core.options import RelaxationBackend
-from .model import ForcedLeg, Leg, Model, PlanRequest, StraightLeg, build_model
+from .model import ForcedLeg, Leg, Model, ModelLeg, PlanRequest, StraightLeg, TurnLeg, build_model
 from .model.boundary import STATE_JERK_ROUNDING, STATE_JERK_SLACK, state_jerk
 from .model.build import leg_on_grid
 from .model.grid import MIN_NODES, refined_grid
@@ -69,15 +77,18 @@ from .timing import (
     law_for,
 )
 
-__all__ = ["ATTEMPTS", "COARSER_GRIDS", "EXCESS_GROWTH", "MAX_REFINEMENTS", "REFINE_FACTORS",
-           "STATE_CONSTRAINTS", "Budget", "Record", "coarsenable", "coarser_leg", "excess",
-           "model_request",
-           "refine_factor", "solve_leg", "solve_legs", "verified_profile"]
+__all__ = ["ATTEMPTS", "COARSER_GRIDS", "EXCESS_GROWTH", "MAX_REFINEMENTS",
+           "MIN_REFINEMENT_SECONDS", "REFINE_FACTORS", "STATE_CONSTRAINTS", "Budget", "Record",
+           "coarsenable", "coarser_leg", "excess", "model_request", "refine_factor",
+           "refinement_seconds", "solve_leg", "solve_legs", "verified_profile"]
 
 #: What the reachability checks of boundary states name when they refuse one.
 STATE_CONSTRAINTS = ("jerk", "v_max", "length", "speed_bound")
 #: Rounds of local grid refinement where the continuous law exceeds a tolerance.
 MAX_REFINEMENTS = 3
+#: The least time the attempts that improve a plan's first answers share [s]
+#: (`refinement_seconds`).
+MIN_REFINEMENT_SECONDS = 1.0
 #: A refined law whose worst excess (in tolerances, `excess`) is more than this many times
 #: that of the law it refines is dropped, and the leg is not refined again.
 EXCESS_GROWTH = 4.0
@@ -91,7 +102,7 @@ COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
 #: Every attempt's name, in the order the strategy tries them (see the module docstring).
 ATTEMPTS: tuple[str, ...] = (
     "model", "exact_reach", "state_rounding", "exact_reach_state_rounding", "jerk_slack",
-    "exact_reach_jerk_slack",
+    "exact_reach_jerk_slack", "jerk_slack_whole_move", "exact_reach_jerk_slack_whole_move",
     "forced_motion", "closed_form", "given_grid", "default_grid",
     *(f"coarser_grid_1/{round(1 / f)}" for f in COARSER_GRIDS),
     "other_backend", "local_refinement", "default_grid_other_backend",
@@ -150,18 +161,21 @@ class Record:
     entries: list[Attempt] = field(default_factory=list)
 
     def attempt(self, name: str, leg: int | None, run: Callable[[], T],
-                catch: tuple[type[Exception], ...] = (SolverError,)) -> T:
+                catch: tuple[type[Exception], ...] = (SolverError,),
+                until: float | None = None) -> T:
         """``run()`` as the attempt ``name``, recorded; an exception in ``catch`` is re-raised.
 
         Raises [`PlanTimeout`][speedplan.PlanTimeout] instead of starting ``run`` when the budget
-        has run out.
+        has run out. ``until`` (a ``time.perf_counter()`` value): an earlier deadline of this
+        attempt's own, for the backends that can stop at one.
         """
         if self.budget.expired():
             self.entries.append(Attempt(name, leg, "skipped", "time limit reached", 0.0))
             raise self.timeout()
+        at = min((t for t in (self.budget.deadline, until) if t is not None), default=None)
         t0 = time.perf_counter()
         try:
-            with deadline(self.budget.deadline):  # for backends that can stop at it
+            with deadline(at):  # for backends that can stop at it
                 result = run()
         except catch as exc:
             self.entries.append(Attempt(name, leg, "failed", _reason(exc),
@@ -169,6 +183,15 @@ class Record:
             raise
         self.entries.append(Attempt(name, leg, "answered", "", time.perf_counter() - t0))
         return result
+
+    def answer_seconds(self, leg: int | None) -> float:
+        """How long the latest attempt that answered ``leg`` took [s] (0 if none did)."""
+        return next((e.seconds for e in reversed(self.entries)
+                     if e.leg == leg and e.outcome in ("answered", "replaced")), 0.0)
+
+    def skip(self, name: str, leg: int | None, reason: str) -> None:
+        """Record the attempt ``name`` as not started, saying why."""
+        self.entries.append(Attempt(name, leg, "skipped", reason, 0.0))
 
     def mark_previous(self, leg: int | None, reason: str) -> None:
         """Mark the answer of ``leg`` before its latest one as replaced, saying why."""
@@ -252,11 +275,15 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
     Marginal states: a moving boundary state that ``j_max (1 + STATE_JERK_ROUNDING)``
     reaches (a state read off a plan, on the boundary of the reachable set up to the law's
     rounding) is planned with that jerk, silently; one just outside what ``j_max`` reaches
-    is planned with ``j_max (1 + STATE_JERK_SLACK)``, with a warning (a state measured on
-    the vehicle: refusing it would strand the vehicle). The looser jerk applies to the
-    jerk rows of the whole move (`PlanRequest.state_jerk`): held only near the state,
-    the varying jerk bound made the relaxation inexact and a 27.8 km move took minutes in
-    the refinement instead of 1 s. The plan is verified against the requested limits.
+    is planned with up to ``j_max (1 + STATE_JERK_SLACK)``, with a warning (a state measured
+    on the vehicle: refusing it would strand the vehicle). The looser jerk is used only
+    where the state needs it: its acceleration brought to 0 at constant jerk (`TurnLeg`,
+    `PlanRequest.turn_jerk`), the rest of the move planned from there with ``j_max``.
+    Where that turn does not fit (longer than the stretch, or above the speed bound) the
+    jerk rows of the whole move take the looser jerk (`PlanRequest.state_jerk`): held only
+    near the state in the rows, the varying jerk bound made the relaxation inexact and a
+    27.8 km move took minutes in the refinement instead of 1 s. The plan is verified
+    against the requested limits.
     """
     moving = any(x != 0.0 for x in (request.v0, request.a0, request.vf, request.af))
     try:
@@ -271,37 +298,46 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
         return exact, record.attempt("exact_reach", None, partial(build_model, exact),
                                      catch=(InfeasibleError,))
     j_max = request.limits.j_max
-    for name, base, jerk in (
-            ("state_rounding", request, j_max * (1.0 + STATE_JERK_ROUNDING)),
-            ("exact_reach_state_rounding", exact, j_max * (1.0 + STATE_JERK_ROUNDING)),
-            ("jerk_slack", request, state_jerk(j_max)),
-            ("exact_reach_jerk_slack", exact, state_jerk(j_max))):
-        looser = replace(base, state_jerk=jerk)
+    rounding, slack = j_max * (1.0 + STATE_JERK_ROUNDING), state_jerk(j_max)
+    for name, looser in (
+            ("state_rounding", replace(request, state_jerk=rounding)),
+            ("exact_reach_state_rounding", replace(exact, state_jerk=rounding)),
+            ("jerk_slack", replace(request, turn_jerk=slack)),
+            ("exact_reach_jerk_slack", replace(exact, turn_jerk=slack)),
+            ("jerk_slack_whole_move", replace(request, state_jerk=slack)),
+            ("exact_reach_jerk_slack_whole_move", replace(exact, state_jerk=slack))):
         with contextlib.suppress(InfeasibleError):
             model = record.attempt(name, None, partial(build_model, looser),
                                    catch=(InfeasibleError,))
             break
     else:
         raise refusal from None
-    if name.endswith("jerk_slack"):
+    if "jerk_slack" in name:
+        turns = [leg for leg in model.legs if isinstance(leg, TurnLeg)]
+        where = ("only while the state's acceleration is brought to 0 (" + ", ".join(
+            f"s={leg.start:.6g}..{leg.start + leg.length:.6g} m, {leg.motion.duration:.3g} s"
+            for leg in turns) + "), j_max elsewhere") if turns else "over the whole move"
+        used = max((abs(float(leg.motion.jerk[0])) for leg in turns), default=slack)
         warnings.warn(
-            f"the boundary states are reachable only with {STATE_JERK_SLACK:.0%} more jerk "
-            f"than j_max={j_max:.6g} m/s³ ({refusal}); planned with j_max={jerk:.6g} m/s³ "
-            "within the jerk tolerance", SpeedplanWarning, stacklevel=4,
+            f"the boundary states are reachable only with up to {STATE_JERK_SLACK:.0%} more "
+            f"jerk than j_max={j_max:.6g} m/s³ ({refusal}); planned with {used:.6g} m/s³ "
+            f"{where}, within the jerk tolerance", SpeedplanWarning, stacklevel=4,
         )
     return looser, model
 
 
 # ---- solve ----------------------------------------------------------------------------------
-def solve_leg(leg: Leg | ForcedLeg | StraightLeg, *, fallback: bool = True) -> LegResult:
+def solve_leg(leg: ModelLeg, *, fallback: bool = True) -> LegResult:
     """Solve one leg and build its law; an infeasibility is restated in metres.
 
     ``fallback``: whether a failed relaxation backend is retried with the other one
-    (`solve_problem`). A `ForcedLeg` or a `StraightLeg` carries its motion: only its law
-    is built.
+    (`solve_problem`). A `ForcedLeg`, `TurnLeg` or `StraightLeg` carries its motion: only its
+    law is built.
     """
     if isinstance(leg, ForcedLeg):
         return _known_motion(leg.start, law_for(leg.s, leg.w, leg.time_law), "forced")
+    if isinstance(leg, TurnLeg):
+        return _known_motion(leg.start, MotionLaw(leg.motion), "forced")
     if isinstance(leg, StraightLeg):
         return _known_motion(leg.start, MotionLaw(leg.motion), "closed_form")
     try:
@@ -339,7 +375,7 @@ def solve_legs(request: PlanRequest, model: Model, record: Record
     return results, coarsened
 
 
-def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg | StraightLeg, i: int,
+def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
                   record: Record) -> tuple[LegResult, bool]:
     """The first of the leg's solve attempts that answers.
 
@@ -350,7 +386,7 @@ def _first_answer(request: PlanRequest, leg: Leg | ForcedLeg | StraightLeg, i: i
     on the default grid and on the coarser ones, and only then the same grids with the other
     backend as well. A user grid is never changed.
     """
-    if isinstance(leg, ForcedLeg):
+    if isinstance(leg, ForcedLeg | TurnLeg):
         return record.attempt("forced_motion", i, lambda: solve_leg(leg)), False
     if isinstance(leg, StraightLeg):
         return record.attempt("closed_form", i, lambda: solve_leg(leg)), False
@@ -423,6 +459,7 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
                            speed_bound=model.bound, request=request)
     leg_checks = [profile.check_leg(i, leg.samples if isinstance(leg, Leg) else None)
                   for i, leg in enumerate(model.legs)]
+    window = _Window.after(record.budget.elapsed())
     stuck: set[int] = set()  # legs whose refined law did not arrive: retrying repeats it
     for _ in range(MAX_REFINEMENTS):
         if all(c.verification.ok for c in leg_checks):
@@ -431,11 +468,15 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
         for i, (leg, leg_check) in enumerate(zip(model.legs, leg_checks, strict=True)):
             if leg_check.verification.ok or not isinstance(leg, Leg) or i in stuck:
                 continue
+            if not window.admits(record, "local_refinement", i):
+                stuck.add(i)
+                continue
             grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess, leg.anchors,
                                 refine_factor(leg_check.verification))
             try:
                 refined = record.attempt("local_refinement", i,
-                                         partial(_solve_on_grid, request, leg, grid))
+                                         partial(_solve_on_grid, request, leg, grid),
+                                         until=window.until)
             except SolverError:  # keep the verified law; its excess is reported below
                 stuck.add(i)
                 continue
@@ -461,8 +502,11 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
     # passes (seen on a zone path whose eighth grid left six steps for the last rest phase).
     for i, (leg, coarse) in enumerate(zip(model.legs, coarsened, strict=True)):
         if coarse and not leg_checks[i].verification.ok and isinstance(leg, Leg):
+            if not window.admits(record, "default_grid_other_backend", i):
+                continue
             with contextlib.suppress(SolverError):
-                again = record.attempt("default_grid_other_backend", i, partial(solve_leg, leg))
+                again = record.attempt("default_grid_other_backend", i,
+                                       partial(solve_leg, leg), until=window.until)
                 trial = replace(profile, legs=(*legs[:i], again, *legs[i + 1:]))
                 trial_check = trial.check_leg(i)
                 if trial_check.verification.ok:
@@ -475,19 +519,65 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
     if not check.ok:
         if record.budget.expired():
             raise record.timeout()
-        worst = ", ".join(f"{k} {r:.3f}× at s={check.where.get(k, float('nan')):.4g} m"
-                          for k, r in check.violations.items())
-        rounds = sum(e.name == "local_refinement" for e in record.entries)
-        warnings.warn(
-            f"the planned trajectory exceeds limits beyond tolerance ({worst} of the limit) "
-            f"after {rounds} local refinement{'s' * (rounds != 1)} of the grid; status "
-            "'limits_exceeded' — see profile.verification and profile.attempts, or plan with "
-            "a finer grid (n or ds)", LimitWarning, stacklevel=4,
-        )
+        _warn_exceeded(check, record)
     # The bound's memo (every position evaluated while planning) stays with the plan, not
     # with the profile a caller keeps.
     return replace(profile, verification=check, limits_exceeded=not check.ok,
                    speed_bound=replace(model.bound, memo=None), attempts=tuple(record.entries))
+
+
+def _warn_exceeded(check: Verification, record: Record) -> None:
+    worst = ", ".join(f"{k} {r:.3f}× at s={check.where.get(k, float('nan')):.4g} m"
+                      for k, r in check.violations.items())
+    rounds = sum(e.name == "local_refinement" and e.outcome != "skipped"
+                 for e in record.entries)
+    warnings.warn(
+        f"the planned trajectory exceeds limits beyond tolerance ({worst} of the limit) "
+        f"after {rounds} local refinement{'s' * (rounds != 1)} of the grid; status "
+        "'limits_exceeded' — see profile.verification and profile.attempts, or plan with "
+        "a finer grid (n or ds)", LimitWarning, stacklevel=5,
+    )
+
+
+@dataclass(frozen=True)
+class _Window:
+    """The time the attempts improving a plan's first answers share (`refinement_seconds`)."""
+
+    seconds: float
+    until: float  # a time.perf_counter() value
+
+    @classmethod
+    def after(cls, first_answers: float) -> _Window:
+        seconds = refinement_seconds(first_answers)
+        return cls(seconds, time.perf_counter() + seconds)
+
+    def admits(self, record: Record, name: str, leg: int) -> bool:
+        """Whether the attempt ``name`` on ``leg`` would end in time; if not, it is skipped.
+
+        It is judged to take as long as the leg's last solve.
+        """
+        if time.perf_counter() + record.answer_seconds(leg) <= self.until:
+            return True
+        record.skip(name, leg, f"the {self.seconds:.3g} s for improving the first answers "
+                               "would be spent before it ended")
+        return False
+
+
+def refinement_seconds(first_answers: float) -> float:
+    """The time the attempts improving a plan's first answers share [s].
+
+    As long as the first answers took (``first_answers`` seconds: model and first solves),
+    at least `MIN_REFINEMENT_SECONDS`: a plan takes about twice its first answer, not the
+    minutes a relaxation backend can spend on a refined grid it does not suit (Clarabel,
+    as the fallback of a 22 000-node comfort grid the banded kernel could not start on:
+    67 s).
+
+    Examples
+    --------
+    >>> refinement_seconds(0.05), refinement_seconds(2.5)
+    (1.0, 2.5)
+    """
+    return max(MIN_REFINEMENT_SECONDS, first_answers)
 
 
 def _solve_on_grid(request: PlanRequest, leg: Leg, grid: FloatArray) -> LegResult:

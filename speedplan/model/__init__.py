@@ -13,7 +13,8 @@ Modules, one job each:
 * `standstill` — jerk rows next to a standstill;
 * `straight` — straight legs with a constant speed bound: their exact minimum-time motion in
   closed form (no grid);
-* `legs` — the data of a model: `Leg`, `ForcedLeg`, `StraightLeg`, `Rest`, `TimeLawSpec`,
+* `legs` — the data of a model: `Leg`, `ForcedLeg`, `StraightLeg`, `TurnLeg`, `Rest`,
+  `TimeLawSpec`,
   `Model`, and
   `explain_infeasible`, which restates a leg's infeasibility in physical terms;
 * `build` — `build_model`: request -> `Model`. The problems are solved by
@@ -23,8 +24,8 @@ This layer imports ``core``, ``geometry`` and the data of ``solve`` (`speedplan.
 """
 
 from .build import build_model, rest_points
-from .legs import ForcedLeg, Leg, Model, Rest, StraightLeg, TimeLawSpec
+from .legs import ForcedLeg, Leg, Model, ModelLeg, Rest, StraightLeg, TimeLawSpec, TurnLeg
 from .request import STANDSTILL_MODES, PlanRequest
 
-__all__ = ["STANDSTILL_MODES", "ForcedLeg", "Leg", "Model", "PlanRequest", "Rest", "StraightLeg",
-           "TimeLawSpec", "build_model", "rest_points"]
+__all__ = ["STANDSTILL_MODES", "ForcedLeg", "Leg", "Model", "ModelLeg", "PlanRequest", "Rest",
+           "StraightLeg", "TimeLawSpec", "TurnLeg", "build_model", "rest_points"]

@@ -26,7 +26,7 @@ from ..solve.problem import MAX_RAMP_STEPS, DiscreteProblem, ramp_steps
 from .boundary import STATE_JERK_ROUNDING, check_reachable_states, turnaround_speed
 from .grid import MIN_NODES
 from .leg_grid import default_grid, grid_anchors, kink_anchors, leg_grid, no_jerk_grid
-from .legs import ForcedLeg, Leg, Model, Rest, StraightLeg, TimeLawSpec
+from .legs import ForcedLeg, Leg, Model, ModelLeg, Rest, StraightLeg, TimeLawSpec, TurnLeg
 from .request import STATE_ROUNDING, PlanRequest, within_limit
 from .rows import (
     Envelopes,
@@ -38,7 +38,7 @@ from .rows import (
     node_minima,
 )
 from .standstill import calibrate_standstill_rows
-from .straight import constant_bound, straight_applies, straight_motion
+from .straight import JerkPhases, constant_bound, straight_applies, straight_motion
 
 __all__ = ["FORCED_NODES", "TOUCH_TIME", "TOUCH_ZERO", "build_leg", "build_model",
            "leg_on_grid", "rest_points", "straight_leg"]
@@ -103,7 +103,7 @@ def build_model(request: PlanRequest) -> Model:
     request = _end_speeds(request, bound, length)
     rests = rest_points(request)
     cuts = [0.0, *(r.s for r in rests), length]
-    legs: list[Leg | ForcedLeg | StraightLeg] = []
+    legs: list[ModelLeg] = []
     for j in range(len(cuts) - 1):
         first, last = j == 0, j == len(cuts) - 2
         legs += _stretch_legs(
@@ -117,26 +117,24 @@ def build_model(request: PlanRequest) -> Model:
 
 def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
                   start: tuple[float, float], end: tuple[float, float], rest_before: Rest | None,
-                  rest_after: Rest | None) -> list[Leg | ForcedLeg | StraightLeg]:
+                  rest_after: Rest | None) -> list[ModelLeg]:
     """The legs of the stretch ``[lo, hi]`` between two cuts (the path's ends or rests)."""
+    turned = None if request.turn_jerk is None else _turned_ends(request, bound, lo, hi, start,
+                                                                 end)
+    if turned is not None:
+        first, last = turned
+        inner = _stretch_legs(
+            replace(request, turn_jerk=None), bound,
+            lo + (first.length if first else 0.0), hi - (last.length if last else 0.0),
+            (first.vf, 0.0) if first else start, (last.v0, 0.0) if last else end,
+            rest_before, rest_after)
+        return [*([first] if first else []), *inner, *([last] if last else [])]
     lim = request.limits
     (v0, a0), (vf, af) = start, end
     length = hi - lo
     if request.jerk_limited:
-        try:
-            check_reachable_states(v0, a0, vf, af, length, lim.v_max, lim.a_max, lim.a_decel,
-                                   request.moving_state_jerk)
-        except InfeasibleError as exc:
-            if rest_before is None and rest_after is None:
-                raise
-            ends = " and ".join(
-                f"the {r.reason} at s={r.s:.6g} m" for r in (rest_before, rest_after)
-                if r is not None)
-            raise InfeasibleError(
-                f"between s={lo:.6g} m and s={hi:.6g} m ({ends}, where the vehicle must be at "
-                f"rest): {exc}", constraint=exc.constraint,
-                s=None if exc.s is None else lo + exc.s) from exc
-    legs: list[Leg | ForcedLeg | StraightLeg] = []
+        _check_stretch_states(request, lo, hi, start, end, rest_before, rest_after)
+    legs: list[ModelLeg] = []
     j_state = request.moving_state_jerk
     # A state read off a plan's final stop (it needs the rounding jerk) lies on the stop's
     # curve to the law's rounding, a few 1e-5: it touches zero within a few times that, and
@@ -191,6 +189,105 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
     if tail is not None:
         legs.append(_shifted(tail, hi - tail.length))
     return legs
+
+
+def _check_stretch_states(request: PlanRequest, lo: float, hi: float,
+                          start: tuple[float, float], end: tuple[float, float],
+                          rest_before: Rest | None, rest_after: Rest | None) -> None:
+    """`check_reachable_states` of a stretch; a refusal next to a rest names that rest."""
+    lim = request.limits
+    try:
+        check_reachable_states(*start, *end, hi - lo, lim.v_max, lim.a_max, lim.a_decel,
+                               request.moving_state_jerk)
+    except InfeasibleError as exc:
+        if rest_before is None and rest_after is None:
+            raise
+        ends = " and ".join(
+            f"the {r.reason} at s={r.s:.6g} m" for r in (rest_before, rest_after)
+            if r is not None)
+        raise InfeasibleError(
+            f"between s={lo:.6g} m and s={hi:.6g} m ({ends}, where the vehicle must be at "
+            f"rest): {exc}", constraint=exc.constraint,
+            s=None if exc.s is None else lo + exc.s) from exc
+
+
+def _turned_ends(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
+                 start: tuple[float, float], end: tuple[float, float]
+                 ) -> tuple[TurnLeg | None, TurnLeg | None] | None:
+    """The turns of the boundary states ``j_max`` does not reach (`TurnLeg`), or ``None``.
+
+    With ``request.turn_jerk``: a state whose speed ``j_max`` cannot keep within
+    ``[0, v_max]`` while its acceleration is brought to 0 gets that turn at constant jerk, at
+    most ``turn_jerk`` (an overshooting state the least jerk that stays under ``v_max``, a
+    dipping one ``turn_jerk``, which keeps its speed highest); the other state keeps
+    ``j_max``. ``None`` when neither needs a turn, or a turn would not fit: longer than the
+    stretch, or above the speed bound on its way (the caller then plans the whole move with
+    the looser jerk).
+    """
+    lim = request.limits
+    jerk = float(request.turn_jerk or lim.j_max)
+    turns = [_turn(v, a, lim.j_max, jerk, lim.v_max, end=is_end)
+             for (v, a), is_end in ((start, False), (end, True))]
+    if turns == [None, None]:
+        return None
+    head = None if turns[0] is None else TurnLeg(
+        start=lo, length=turns[0].length, v0=start[0], a0=start[1], vf=float(turns[0].v[-1]),
+        af=0.0, motion=turns[0])
+    tail = None if turns[1] is None else TurnLeg(
+        start=hi - turns[1].length, length=turns[1].length, v0=float(turns[1].v[0]), a0=0.0,
+        vf=end[0], af=end[1], motion=turns[1])
+    taken = sum(t.length for t in (head, tail) if t is not None)
+    if taken >= hi - lo:
+        return None
+    for leg in (head, tail):
+        if leg is None:
+            continue
+        frac = np.linspace(0.0, 1.0, 17)
+        t = frac * leg.motion.duration
+        m = leg.motion
+        d = t * (m.v[0] + t * (0.5 * m.a[0] + t * m.jerk[0] / 6.0))
+        v = m.v[0] + t * (m.a[0] + 0.5 * t * m.jerk[0])
+        top = np.asarray(bound(np.clip(leg.start + d, lo, hi)), dtype=np.float64)
+        if np.any(v * v > top * (1.0 + 1e-9)):
+            return None
+    return head, tail
+
+
+def _turn(v: float, a: float, j_max: float, jerk: float, v_max: float, *, end: bool
+          ) -> JerkPhases | None:
+    """The constant-jerk turn of the state ``(v, a)`` to zero acceleration, if it needs one.
+
+    ``None`` where ``j_max`` alone keeps its speed within ``[0, v_max]`` (no turn needed) or
+    ``jerk`` does not (no turn helps). At the end of a move (``end``) the turn arrives at
+    ``(v, a)`` from zero acceleration (the time reversal of the start's).
+    """
+    rise = a if not end else -a  # > 0: the speed rises while the acceleration is brought to 0
+    if rise == 0.0 or v <= 0.0:
+        return None
+    tol = 1e-9 * max(v_max, 1.0)
+    if rise > 0:
+        if turnaround_speed(v, rise, j_max) <= v_max + tol or v >= v_max:
+            return None
+        j = rise * rise / (2.0 * (v_max - v))  # the least jerk that stays under v_max
+        after = v_max
+    else:
+        if turnaround_speed(v, rise, j_max) >= -tol:
+            return None
+        j = jerk
+        after = turnaround_speed(v, rise, jerk)
+        if after <= TOUCH_ZERO * v:  # it stops on the way: a forced stop, not a turn
+            return None
+    if j > jerk * (1.0 + 1e-12):
+        return None
+    dt = abs(rise) / j
+    jerk_signed = -np.sign(rise) * j
+    length = dt * (v + dt * (0.5 * rise + dt * jerk_signed / 6.0))
+    if not end:
+        return JerkPhases(t=np.array([0.0, dt]), s=np.array([0.0, length]),
+                          v=np.array([v, after]), a=np.array([rise, 0.0]),
+                          jerk=np.array([jerk_signed]))
+    return JerkPhases(t=np.array([0.0, dt]), s=np.array([0.0, length]), v=np.array([after, v]),
+                      a=np.array([0.0, a]), jerk=np.array([a / dt]))
 
 
 def straight_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, v0: float,

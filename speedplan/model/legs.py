@@ -1,7 +1,7 @@
 """What a model is made of: legs between standstills, their time-law options, the rests.
 
 Pure data: `speedplan.model.build` fills them from a request, `speedplan.strategy` solves each
-`Leg`'s problem (a `ForcedLeg` or a `StraightLeg` carries its motion already), and
+`Leg`'s problem (a `ForcedLeg`, `StraightLeg` or `TurnLeg` carries its motion already), and
 `explain_infeasible` restates a discrete infeasibility of a leg's problem in speeds and metres
 along the path.
 """
@@ -21,8 +21,8 @@ from ..solve.problem import DiscreteProblem
 from .request import PlanRequest
 from .straight import JerkPhases
 
-__all__ = ["ForcedLeg", "Leg", "Model", "Rest", "StraightLeg", "TimeLawSpec",
-           "explain_infeasible"]
+__all__ = ["ForcedLeg", "Leg", "Model", "ModelLeg", "Rest", "StraightLeg", "TimeLawSpec",
+           "TurnLeg", "explain_infeasible"]
 
 @dataclass(frozen=True)
 class TimeLawSpec:
@@ -148,6 +148,29 @@ class StraightLeg(_Ends):
 
 
 @dataclass(frozen=True)
+class TurnLeg(_Ends):
+    """The turn of a marginal boundary state: its acceleration brought to 0 at constant jerk.
+
+    A moving state just outside what ``j_max`` reaches (`speedplan.strategy.model_request`,
+    attempt ``"jerk_slack"``) is planned with a little more jerk only here: from ``(v0, a0)``
+    to ``(vf, 0)`` at the start of the request (from ``(v0, 0)`` to ``(vf, af)`` at its end),
+    the rest of the move with ``j_max``. ``start``, ``length`` and the boundary states are
+    those of `Leg`.
+
+    Attributes
+    ----------
+    motion : JerkPhases
+        The turn, one constant-jerk phase (positions from the leg's start).
+    """
+
+    motion: JerkPhases
+
+
+#: Any leg of a `Model`.
+ModelLeg = Leg | ForcedLeg | StraightLeg | TurnLeg
+
+
+@dataclass(frozen=True)
 class Model:
     """A request modelled as legs between standstills.
 
@@ -165,7 +188,7 @@ class Model:
 
     request: PlanRequest
     bound: SpeedBound
-    legs: tuple[Leg | ForcedLeg | StraightLeg, ...] = field(default_factory=tuple)
+    legs: tuple[ModelLeg, ...] = field(default_factory=tuple)
     rests: tuple[Rest, ...] = ()
 
 

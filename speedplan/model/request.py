@@ -106,6 +106,10 @@ class PlanRequest:
     #: ``limits.j_max`` (``None``: ``limits.j_max``): set by plan() for states just outside
     #: what ``j_max`` reaches, not by callers.
     state_jerk: float | None = None
+    #: Jerk [m/s³] of the turn of a moving boundary state just outside what ``limits.j_max``
+    #: reaches (`TurnLeg`: its acceleration brought to 0, the rest of the move with
+    #: ``j_max``); ``None``: no such turn. Set by plan(), not by callers.
+    turn_jerk: float | None = None
 
     @classmethod
     def create(cls, path: Path, limits: Limits, *, n: int | None = None,

@@ -13,12 +13,12 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
-from oracles import measure, within_promise
+from oracles import measure, ruckig_duration, within_promise
 from shared import LGV
 
 import speedplan as sp
 from speedplan import strategy
-from speedplan.core.deadline import deadline
+from speedplan.core.deadline import deadline, remaining
 from speedplan.geometry import Line
 from speedplan.model import PlanRequest
 from speedplan.route import Route, RouteEdge, RouteNode
@@ -128,6 +128,53 @@ def test_a_budget_that_runs_out_before_the_law_passes_never_returns_it(ungraded)
     # With the time to refine, the same request is planned and verified.
     profile = plan_request(request, budget=_RunsOutAfter(100))
     assert profile.verification.ok
+
+
+def test_refinements_stop_at_their_own_time_without_a_time_limit(ungraded, monkeypatch):
+    # A stand-in for a relaxation backend that needs minutes on a refined grid (Clarabel as
+    # the fallback of a 22 000-node comfort grid: 67 s): it runs until its deadline.
+    monkeypatch.setattr(strategy, "MIN_REFINEMENT_SECONDS", 0.3)
+    seen = []
+
+    def runs_until_stopped(request, leg, grid):
+        left = remaining()
+        seen.append(left)
+        assert left is not None, "a refinement runs without a deadline"
+        time.sleep(left)
+        raise sp.SolverError("Clarabel stopped with status MaxTime", backend="clarabel")
+
+    monkeypatch.setattr(strategy, "_solve_on_grid", runs_until_stopped)
+    t0 = time.perf_counter()
+    with pytest.warns(sp.LimitWarning):
+        profile = sp.plan(STRAIGHT, LGV, n=300)
+    took = time.perf_counter() - t0
+    first = sum(a.seconds for a in profile.attempts[:2])
+    assert seen and seen[0] <= strategy.refinement_seconds(first) + 0.05
+    assert took < first + strategy.refinement_seconds(first) + 0.5
+    assert profile.limits_exceeded and profile.status == "limits_exceeded"
+    assert [(a.name, a.outcome) for a in profile.attempts] == [
+        ("model", "answered"), ("given_grid", "answered"), ("local_refinement", "failed")]
+
+
+def test_a_refinement_that_would_not_end_within_their_time_is_not_started(ungraded,
+                                                                          monkeypatch):
+    monkeypatch.setattr(strategy, "MIN_REFINEMENT_SECONDS", 0.3)
+
+    def slow_and_no_better(request, leg, grid):  # 0.25 s, the same uniform 300-node grid
+        time.sleep(0.25)
+        s = np.linspace(0.0, float(grid[-1]), 300)
+        return strategy.solve_leg(strategy.leg_on_grid(request, leg.bound, s, leg.start, leg.v0,
+                                                       leg.a0, leg.vf, leg.af))
+
+    monkeypatch.setattr(strategy, "_solve_on_grid", slow_and_no_better)
+    with pytest.warns(sp.LimitWarning):
+        profile = sp.plan(STRAIGHT, LGV, n=300)
+    rounds = [(a.outcome, a.reason) for a in profile.attempts if a.name == "local_refinement"]
+    # The first refinement starts (the first solve was quick); it takes 0.25 s of the 0.3 s,
+    # and a second one, judged to take as long, would end past them: not started.
+    assert [o for o, _ in rounds] == ["answered", "skipped"]
+    assert "would be spent before it ended" in rounds[-1][1]
+    assert profile.limits_exceeded
 
 
 def test_a_verified_plan_found_within_the_limit_is_returned():
@@ -258,27 +305,65 @@ def test_states_read_off_a_plans_final_stop_replan_to_rest():
         assert abs(t + again.duration - first.duration) <= 1e-3 * first.duration, t
 
 
-def _final_stop_jerk(profile: sp.SpeedProfile, seconds: float) -> float:
-    """Largest finite-difference jerk over the last ``seconds`` of the profile [m/s³]."""
+def _jerk_after(profile: sp.SpeedProfile, t0: float) -> float:
+    """Largest finite-difference jerk from ``t0`` to the end of the profile [m/s³]."""
     dt = 1e-3
-    t = np.arange(profile.duration - seconds, profile.duration, dt)
-    v = profile.at(t).v
+    v = profile.at(np.arange(t0, profile.duration, dt)).v
     return float(np.abs(np.diff(v, 2)).max() / dt**2)
 
 
-def test_an_outside_state_is_planned_with_the_jerk_slack_and_a_warning():
+def test_an_outside_state_is_planned_with_the_jerk_slack_only_in_its_turn():
     # Accelerating 0.4 % harder than the plan's own state at t = 3 s: the speed would
-    # overshoot v_max under j_max, not under 1.02 j_max. Planned with a warning, and the
-    # attempt that answered says so.
+    # overshoot v_max under j_max. The least jerk that keeps it under v_max (0.8 % more
+    # than j_max) brings the acceleration to 0 exactly at v_max; from there the move to rest
+    # is ruckig's with j_max.
     first = sp.plan(STRAIGHT, LGV)
     state = first.at(3.0)
-    rest = sp.Path.from_segments([Line(30.0 - float(state.s[0]))])
-    with pytest.warns(sp.SpeedplanWarning, match="reachable only with 2% more jerk"):
-        again = sp.plan(rest, LGV, v0=float(state.v[0]), a0=float(state.a[0]) * 1.004)
+    length = 30.0 - float(state.s[0])
+    v0, a0 = float(state.v[0]), float(state.a[0]) * 1.004
+    rest = sp.Path.from_segments([Line(length)])
+    with pytest.warns(sp.SpeedplanWarning, match="only while the state's acceleration"):
+        again = sp.plan(rest, LGV, v0=v0, a0=a0)
     assert next(a.name for a in again.attempts if a.outcome == "answered") == "jerk_slack"
     assert again.verification.ok
-    # Within the promised jerk tolerance of the requested limit (finite differences).
-    assert _final_stop_jerk(again, 4.0) <= LGV.j_max * 1.05
+    j = a0 * a0 / (2.0 * (LGV.v_max - v0))  # the turn, by hand
+    assert LGV.j_max < j < LGV.j_max * 1.02
+    t1 = a0 / j
+    d1 = v0 * t1 + a0 * t1**2 / 2 - j * t1**3 / 6
+    expected = t1 + ruckig_duration(length - d1, LGV, v0=LGV.v_max)
+    assert again.duration == pytest.approx(expected, rel=1e-9)
+    # Never faster than the whole move with the looser jerk (ruckig's optimum with it).
+    looser = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=LGV.j_max * 1.02)
+    assert again.duration >= ruckig_duration(length, looser, v0=v0, a0=a0) * (1 - 1e-12)
+    # The looser jerk only in the turn: j_max after it (finite differences).
+    assert _jerk_after(again, 0.0) <= j * (1 + 1e-3)
+    assert _jerk_after(again, t1 + 0.01) <= LGV.j_max * (1 + 1e-3)
+
+
+@pytest.mark.parametrize("curved", [False, True])
+def test_a_braking_state_just_outside_reach_turns_with_the_slack_and_goes_on_with_j_max(curved):
+    # v0 < a0²/(2 j_max): under j_max the speed would fall below 0 before the braking ends;
+    # under 1.02 j_max it turns at 0.003 m/s... above rest. The rest of the move keeps j_max.
+    path = (sp.Path.from_waypoints([[0, 0], [20, 0], [20, 15], [35, 15]]) if curved
+            else sp.Path.from_segments([Line(30.0)]))
+    v0, a0 = 0.247, -0.5
+    with pytest.warns(sp.SpeedplanWarning, match="only while the state's acceleration"):
+        profile = sp.plan(path, LGV, v0=v0, a0=a0)
+    assert profile.verification.ok
+    names = [a.name for a in profile.attempts if a.outcome == "answered"]
+    assert names[:2] == ["jerk_slack", "forced_motion"]
+    j = LGV.j_max * 1.02
+    t1 = -a0 / j
+    assert float(profile.at(t1).v[0]) == pytest.approx(v0 - a0 * a0 / (2 * j), rel=1e-9)
+    assert _jerk_after(profile, 0.0) <= j * (1 + 1e-3)
+    # After the turn: j_max, to the law's own tolerance on a grid (curved), exactly in
+    # closed form (straight).
+    after = _jerk_after(profile, t1 + 0.01)
+    assert after <= LGV.j_max * (1.015 if curved else 1 + 1e-3)
+    if not curved:
+        d1 = v0 * t1 + a0 * t1**2 / 2 + j * t1**3 / 6
+        expected = t1 + ruckig_duration(30.0 - d1, LGV, v0=v0 - a0 * a0 / (2 * j))
+        assert profile.duration == pytest.approx(expected, rel=1e-9)
 
 
 def test_a_backend_that_fails_on_a_grid_is_not_run_on_it_again(monkeypatch):
@@ -303,8 +388,9 @@ def test_a_backend_that_fails_on_a_grid_is_not_run_on_it_again(monkeypatch):
 
 def test_a_long_move_from_a_marginal_braking_state_answers_in_seconds():
     # A trust-fuzz move (27.8 km, braking start that j_max misses by a hair): with the jerk
-    # slack held near the state only, the relaxation was inexact and the refinement ran for
-    # minutes; with the slack over the whole move it answers in about a second.
+    # slack held near the state in the jerk rows, the relaxation was inexact and the
+    # refinement ran for minutes. The state's turn takes the slack (10 s, 10 m), the rest of
+    # the move j_max.
     lim = sp.Limits(v_max=5.720500233946498, a_max=1.0997156178083936, a_lat_max=1,
                     j_max=0.04562513470868499, a_decel=1.1432836388457868)
     path = sp.Path.from_segments([Line(27781.810078116458)])
@@ -312,3 +398,8 @@ def test_a_long_move_from_a_marginal_braking_state_answers_in_seconds():
         profile = sp.plan(path, lim, v0=2.7363134118689274, a0=-0.5026231549740972,
                           time_limit=30.0)
     assert profile.status == "optimal" and profile.verification.ok
+    assert [a.name for a in profile.attempts if a.outcome == "answered"][:2] == [
+        "jerk_slack", "forced_motion"]
+    dt = 1e-3  # j_max right after the turn (finite differences)
+    v = profile.at(np.arange(11.0, 60.0, dt)).v
+    assert float(np.abs(np.diff(v, 2)).max()) / dt**2 <= lim.j_max * (1 + 1e-3)
