@@ -34,7 +34,7 @@ from .banded import (
 from .clarabel_ import RelaxationResult, row_multipliers, solve_relaxation
 from .cuts import secant_cuts
 from .nojerk import check_reachable, max_feasible_w, positive_feasible_w
-from .problem import GRIP_TOL, DiscreteProblem
+from .problem import GRIP_TOL, ROW_TOL_REL, DiscreteProblem
 from .refine import refine as refine_nlp
 from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
@@ -294,8 +294,9 @@ def _relaxed(problem: DiscreteProblem, backend: str, fallback: bool) -> _Relaxed
     relaxed_violation = problem.jerk_violation(w_relaxed)
     # An interior-point answer meets the convex rows to its own tolerance: a friction
     # ellipse met to GRIP_TOL is exact (the convex rows are not relaxed).
-    exact = relaxed_violation <= problem.jerk_tol and problem.grip_violation(
-        w_relaxed) <= GRIP_TOL
+    exact = (relaxed_violation <= problem.jerk_tol
+             and problem.relative_row_excess(w_relaxed) <= ROW_TOL_REL
+             and problem.grip_violation(w_relaxed) <= GRIP_TOL)
     info = RelaxationInfo(
         backend=backend, status=relax.status, iterations=relax.iterations,
         time=relax.solve_time + relax.setup_time, w=w_relaxed,

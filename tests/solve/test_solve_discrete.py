@@ -391,3 +391,48 @@ def test_a_relaxed_law_that_stops_inside_the_leg_falls_back_to_the_other_backend
     assert "comes to rest inside the leg" in sol.relaxation.fallback
     assert np.isfinite(sol.objective)
     np.testing.assert_allclose(sol.w, reference.w, rtol=1e-12, atol=0)
+
+
+def _bent(n=2001, length=2.0, k=0.1, excess=0.14):
+    """A fine uniform grid and ``w = 0.5 + k (s - 1)² / 2`` whose curvature ``w'' = k`` is
+    ``excess`` above the jerk rows where ``w`` is largest: ``k sqrt(max w) = (1 + excess) J``."""
+    s = np.linspace(0.0, length, n)
+    w = 0.5 + 0.5 * k * (s - 1.0) ** 2
+    jerk = np.full(n - 2, k * np.sqrt(w[1:-1].max()) / (1.0 + excess))
+    problem = DiscreteProblem(s=s, w_max=np.full(n, 1.0), accel=np.full(n - 1, 1.0),
+                              decel=np.full(n - 1, 1.0), jerk=jerk, w_start=float(w[0]),
+                              w_end=float(w[-1]))
+    return problem, w
+
+
+def test_a_row_exceeded_by_a_fraction_of_itself_is_seen_on_a_fine_grid():
+    # The paper's measure τ² (|w''| - J / sqrt(w)) shrinks with the square of the step: a
+    # 14 % excess on a 1 mm grid is 1e-8, inside its exactness threshold; relative to the
+    # row it is the 14 %.
+    problem, w = _bent()
+    assert problem.jerk_violation(w) <= problem.jerk_tol
+    assert problem.relative_row_excess(w) == pytest.approx(0.14, rel=1e-6)
+    held, _ = _bent(excess=0.0)  # the same point against rows it meets
+    assert held.relative_row_excess(w) <= 1e-8  # the second difference to rounding
+
+
+def test_a_relaxed_point_over_its_rows_by_a_fraction_is_not_called_exact(monkeypatch):
+    # A relaxation backend answering that point: 'optimal' (exact) before, although its law
+    # breaks the jerk limit 1.14x; now it is 'relaxed' (refine='never') with a warning.
+    from speedplan.solve import discrete
+    from speedplan.solve.clarabel_ import RelaxationResult
+
+    problem, w = _bent()
+    scale = discrete.unit_scales(problem)
+
+    def answers_the_bent_point(unit):
+        wu = w / scale[1]
+        t = unit.travel_time(wu)
+        return RelaxationResult(w=wu, t=np.full(unit.n - 1, t / (unit.n - 1)),
+                                primal_objective=t, dual_objective=t, status="Solved",
+                                iterations=1, solve_time=0.0, setup_time=0.0)
+
+    monkeypatch.setitem(discrete.RELAXATION_BACKENDS, "clarabel", answers_the_bent_point)
+    with pytest.warns(SpeedplanWarning, match="relaxation is not exact"):
+        sol = solve_problem(problem, refine="never", backend="clarabel", fallback=False)
+    assert not sol.exact and sol.status == "relaxed"
