@@ -36,7 +36,9 @@ JERK_TOL_REL = JERK_TOL / 100.0
 #: ``w`` (``τ² (|w''| - J / sqrt(w))``), which shrinks with the square of the step: on a fine
 #: grid a relaxed point whose jerk exceeds a row by 14 % passed it (comfort plans of 20 000
 #: nodes, whose law then broke the jerk limit 1.14× and no refinement of the grid helped).
-ROW_TOL_REL = 1e-3
+#: Exact relaxed points of the latency fuzz's curved and comfort plans stay within 4e-4 of
+#: their rows (the interior-point methods' accuracy); the inexact ones were 2–14 % over.
+ROW_TOL_REL = 1e-2
 #: Largest excess of the friction-ellipse rows over 1 a solution may have: an interior-point
 #: method meets a cone to its own tolerance (Clarabel's answers: up to 1.5e-6, measured on an
 #: arc), 1e-5 of the grip is far inside what ``verify()`` tolerates (1 %).

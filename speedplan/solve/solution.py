@@ -103,7 +103,7 @@ class DiscreteSolution:
         ``(objective - lower_bound) / lower_bound``; 0 up to solver tolerance when exact.
     exact : bool
         Whether the relaxed ``w`` met every jerk (and lateral-jerk) row: the paper's test
-        (violation <= 1e-5) and within `ROW_TOL_REL` (0.1 %) of each row's own bound.
+        (violation <= 1e-5) and within `ROW_TOL_REL` (1 %) of each row's own bound.
     exact_a_priori : bool
         Whether Corollary 1 certified exactness before solving (constant bounds, ``w_max``
         meeting every positive jerk row).
