@@ -67,15 +67,20 @@ def test_a_refined_leg_records_the_law_it_replaced_and_why(ungraded):
     assert profile.verification.ok
 
 
+def _on_uniform_grid(n, seconds=0.0):
+    """A stand-in for a local refinement: the leg on a uniform ``n``-node grid instead."""
+    def solve(request, leg, grid):
+        time.sleep(seconds)
+        s = np.linspace(0.0, float(grid[-1]), n)
+        return strategy.solve_leg(strategy.leg_on_grid(request, leg.bound, s, leg.start, leg.v0,
+                                                       leg.a0, leg.vf, leg.af))
+    return solve
+
+
 def test_a_refinement_whose_law_is_worse_is_dropped_and_not_refined_again(ungraded,
                                                                           monkeypatch):
     # Stand-in for a finer grid the backend solves less well: a 30-node grid instead.
-    def coarse(request, leg, grid):
-        s = np.linspace(0.0, float(grid[-1]), 30)
-        return strategy.solve_leg(strategy.leg_on_grid(request, leg.bound, s, leg.start, leg.v0,
-                                                       leg.a0, leg.vf, leg.af))
-
-    monkeypatch.setattr(strategy, "_solve_on_grid", coarse)
+    monkeypatch.setattr(strategy, "_solve_on_grid", _on_uniform_grid(30))
     with pytest.warns(sp.LimitWarning):
         profile = sp.plan(STRAIGHT, LGV, n=300)
     names = [(a.name, a.outcome) for a in profile.attempts]
@@ -160,13 +165,8 @@ def test_a_refinement_that_would_not_end_within_their_time_is_not_started(ungrad
                                                                           monkeypatch):
     monkeypatch.setattr(strategy, "MIN_REFINEMENT_SECONDS", 0.3)
 
-    def slow_and_no_better(request, leg, grid):  # 0.25 s, the same uniform 300-node grid
-        time.sleep(0.25)
-        s = np.linspace(0.0, float(grid[-1]), 300)
-        return strategy.solve_leg(strategy.leg_on_grid(request, leg.bound, s, leg.start, leg.v0,
-                                                       leg.a0, leg.vf, leg.af))
-
-    monkeypatch.setattr(strategy, "_solve_on_grid", slow_and_no_better)
+    # 0.25 s each, and no better: the same uniform 300-node grid.
+    monkeypatch.setattr(strategy, "_solve_on_grid", _on_uniform_grid(300, seconds=0.25))
     with pytest.warns(sp.LimitWarning):
         profile = sp.plan(STRAIGHT, LGV, n=300)
     rounds = [(a.outcome, a.reason) for a in profile.attempts if a.name == "local_refinement"]
