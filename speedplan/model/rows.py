@@ -282,7 +282,61 @@ def lateral_jerk_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float, *,
         coef = lateral_rate_weights(kappa, rate, [0.0, 1.0, 0.0], first)  # w at the node
         families.append(StencilRows(coef=coef, bound=rows))
     families.extend(_midpoint_rows(path, lo, s, bound))
+    families.extend(_join_rows(path, lo, s, float(j_lat_max)))
     return tuple(families)
+
+
+def _join_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float) -> list[StencilRows]:
+    """Rows at the joins of pieces inside cells, with the law's ``w'`` there (none elsewhere).
+
+    A grid at its node cap keeps joins as nodes only where they fit; inside a cell the
+    lateral jerk jumps at the join (``κ'`` does) and neither the node nor the midpoint rows
+    see the side they are not on (a law 1.13× over ``j_lat_max`` next to such a join). Two
+    families hold each such join's row with the rate before and after it, at the node whose
+    dual cell holds the join (one join per dual cell: a second one there gets no row).
+    ``w'`` is the time law's (`speedplan.timing.TimeLaw`: the cell's secant slope at its
+    midpoint, bent by the second difference of the node on the join's side of it, split by
+    the step ratio), a stencil around that node; ``w`` the cell's linear interpolation.
+    """
+    joins = path.offsets[1:-1]
+    if joins.size == 0 or s.size < 4:
+        return []
+    at = lo + s
+    margin = 1e-12 * max(float(path.length), 1.0)
+    h = np.diff(s)
+    n = s.size
+    coefs = [np.zeros((n - 2, 3)), np.zeros((n - 2, 3))]
+    bound = np.full(n - 2, np.inf)
+    for j, x in enumerate(joins):
+        c = int(np.searchsorted(at, x)) - 1  # the cell [at[c], at[c + 1]] holding x
+        if not (0 <= c < n - 1 and at[c] + margin < x < at[c + 1] - margin):
+            continue  # a node, or outside the leg
+        theta = (x - at[c]) / h[c]
+        offset = x - 0.5 * (at[c] + at[c + 1])
+        # The node whose dual cell holds x, and its second difference's weights.
+        node = c + 1 if offset >= 0.0 else c
+        if not 1 <= node <= n - 2 or np.isfinite(bound[node - 1]):
+            continue  # next to the leg's end, or a second join in the same dual cell
+        h0, h1 = h[node - 1], h[node]
+        d2 = np.array([2.0 / (h0 * (h0 + h1)), -2.0 / (h0 * h1), 2.0 / (h1 * (h0 + h1))])
+        split = h1 / h0 if node == c + 1 else h0 / h1  # the law's curvature on x's side
+        if node == c + 1:  # stencil (w_c, w_{c+1}, w_{c+2})
+            value = np.array([1.0 - theta, theta, 0.0])
+            secant = np.array([-1.0, 1.0, 0.0]) / h[c]
+        else:  # stencil (w_{c-1}, w_c, w_{c+1})
+            value = np.array([0.0, 1.0 - theta, theta])
+            secant = np.array([0.0, -1.0, 1.0]) / h[c]
+        slope = secant + offset * split * d2
+        piece = path.pieces[j]  # the piece ending at the join
+        kappa = float(path.curvature(np.array([x]))[0])
+        for family, rate in ((0, float(path.curvature_rate(np.array([x]))[0])),
+                             (1, float(piece.curvature_rate(np.array(piece.length))))):
+            coefs[family][node - 1] = lateral_rate_weights(
+                np.array([kappa]), np.array([rate]), value, slope)[0]
+        bound[node - 1] = j_lat_max
+    if not np.isfinite(bound).any():
+        return []
+    return [StencilRows(coef=coefs[0], bound=bound), StencilRows(coef=coefs[1], bound=bound)]
 
 
 def curvature_at_nodes(path: Path, lo: float, s: FloatArray) -> NodeCurvature:

@@ -7,6 +7,8 @@ lateral jerk from the sampled ``a_lat``), and the same path planned without comf
 
 from __future__ import annotations
 
+import pathlib
+
 import numpy as np
 import pytest
 from oracles import PROMISED, corner_reversals
@@ -215,6 +217,27 @@ def test_every_join_of_pieces_is_a_node_and_its_lateral_jerk_is_held_on_both_sid
     assert np.min(np.abs(s[:, None] - joins[None, :]), axis=0).max() == 0.0
     profile = plan(path, lim)
     assert profile.verification.ok
+    t = np.linspace(0.0, profile.duration, 400_001)
+    traj = profile.at(t)
+    a_lat = np.asarray(path.curvature(traj.s)) * traj.v**2
+    j_lat = np.abs(np.diff(a_lat) / (t[1] - t[0]))
+    assert j_lat.max() <= (1.0 + PROMISED["lateral"]) * lim.j_lat_max
+
+
+@pytest.mark.parametrize("n", [150, 300, 600])
+def test_a_join_inside_a_cell_holds_the_lateral_jerk_on_both_sides(n):
+    # A user grid (and a default grid at its node cap) need not have a node on every join of
+    # pieces: the lateral jerk jumps there with the curvature rate, and rows at the nodes and
+    # the cells' midpoints saw one side only (the law reached 1.022-1.048x j_lat_max on the
+    # U-turn's four joins). Measured by finite differences of κ(s(t)) v(t)² in time.
+    from speedplan.io import read_path
+
+    path = read_path(str(pathlib.Path(__file__).parents[2] / "paths" / "u_turn.json"))
+    lim = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5, j_lat_max=0.3,
+                 yaw_rate_max=0.6)
+    profile = plan(path, lim, n=n)
+    joins = path.offsets[1:-1]
+    assert np.min(np.abs(profile.s[:, None] - joins[None, :]), axis=0).min() > 1e-6
     t = np.linspace(0.0, profile.duration, 400_001)
     traj = profile.at(t)
     a_lat = np.asarray(path.curvature(traj.s)) * traj.v**2
