@@ -23,8 +23,9 @@ only when the ones before it did not answer:
 * **verify** (per leg whose continuous law exceeds a tolerance): up to
   `MAX_REFINEMENTS` rounds of ``"local_refinement"`` of the grid where it does, then,
   for a leg answered on a coarser grid, ``"default_grid_other_backend"``. These improve a
-  law the plan already has, so they share a time of their own (`refinement_seconds`: as
-  long as the first answers took, at least `MIN_REFINEMENT_SECONDS`): an attempt that
+  law the plan already has, so without ``time_limit`` they share a time of their own
+  (`refinement_seconds`: as long as the first answers took, at least
+  `MIN_REFINEMENT_SECONDS`; with it, what the limit leaves): an attempt that
   would not end within it (it takes about as long as the leg's last solve) is not started
   (recorded as ``"skipped"``), and a solver that can stop stops at its end; the plan then
   keeps the law it has and reports any excess (``limits_exceeded``).
@@ -459,7 +460,7 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
                            speed_bound=model.bound, request=request)
     leg_checks = [profile.check_leg(i, leg.samples if isinstance(leg, Leg) else None)
                   for i, leg in enumerate(model.legs)]
-    window = _Window.after(record.budget.elapsed())
+    window = _Window.of(record.budget)
     stuck: set[int] = set()  # legs whose refined law did not arrive: retrying repeats it
     for _ in range(MAX_REFINEMENTS):
         if all(c.verification.ok for c in leg_checks):
@@ -547,8 +548,11 @@ class _Window:
     until: float  # a time.perf_counter() value
 
     @classmethod
-    def after(cls, first_answers: float) -> _Window:
-        seconds = refinement_seconds(first_answers)
+    def of(cls, budget: Budget) -> _Window:
+        """From now: `refinement_seconds` of the time spent, or what a caller's limit leaves."""
+        if budget.deadline is not None:
+            return cls(budget.remaining(), budget.deadline)
+        seconds = refinement_seconds(budget.elapsed())
         return cls(seconds, time.perf_counter() + seconds)
 
     def admits(self, record: Record, name: str, leg: int) -> bool:

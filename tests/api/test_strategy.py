@@ -175,6 +175,11 @@ def test_a_refinement_that_would_not_end_within_their_time_is_not_started(ungrad
     assert [o for o, _ in rounds] == ["answered", "skipped"]
     assert "would be spent before it ended" in rounds[-1][1]
     assert profile.limits_exceeded
+    # With a caller's time limit the refinements have what it leaves: all three run.
+    with pytest.warns(sp.LimitWarning):
+        profile = sp.plan(STRAIGHT, LGV, n=300, time_limit=30.0)
+    rounds = [a.outcome for a in profile.attempts if a.name == "local_refinement"]
+    assert len(rounds) == strategy.MAX_REFINEMENTS and "skipped" not in rounds
 
 
 def test_a_verified_plan_found_within_the_limit_is_returned():
