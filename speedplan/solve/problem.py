@@ -36,8 +36,9 @@ JERK_TOL_REL = JERK_TOL / 100.0
 #: ``w`` (``τ² (|w''| - J / sqrt(w))``), which shrinks with the square of the step: on a fine
 #: grid a relaxed point whose jerk exceeds a row by 14 % passed it (comfort plans of 20 000
 #: nodes, whose law then broke the jerk limit 1.14× and no refinement of the grid helped).
-#: Exact relaxed points of the latency fuzz's curved and comfort plans stay within 4e-4 of
-#: their rows (the interior-point methods' accuracy); the inexact ones were 2–14 % over.
+#: Exact relaxed points of the latency fuzz's curved, zone and comfort plans stay within
+#: 0.16 % of their rows (the interior-point methods' accuracy); the inexact ones were 2–14 %
+#: over.
 ROW_TOL_REL = 1e-2
 #: Largest excess of the friction-ellipse rows over 1 a solution may have: an interior-point
 #: method meets a cone to its own tolerance (Clarabel's answers: up to 1.5e-6, measured on an
@@ -288,8 +289,8 @@ class DiscreteProblem:
     def relative_row_excess(self, w: FloatArray) -> float:
         """Largest excess of a jerk or lateral-jerk row over its own bound, as a fraction of it.
 
-        ``|load| sqrt(w_i) / bound - 1`` over the rows with a finite positive bound (``<= 0``:
-        every row holds). Unlike `jerk_violation` it does not shrink with the grid's step.
+        ``|load| sqrt(w_i) / bound - 1`` over the rows with a finite positive bound, and 0 when
+        every row holds. Unlike `jerk_violation` it does not shrink with the grid's step.
         """
         if not self.has_jerk or self.n < 3:
             return 0.0
