@@ -161,8 +161,8 @@ def test_refinements_stop_at_their_own_time_without_a_time_limit(ungraded, monke
         ("model", "answered"), ("given_grid", "answered"), ("local_refinement", "failed")]
 
 
-def test_a_refinement_that_would_not_end_within_their_time_is_not_started(ungraded,
-                                                                          monkeypatch):
+def test_a_refinement_that_would_not_end_in_the_time_left_is_not_started(ungraded,
+                                                                         monkeypatch):
     monkeypatch.setattr(strategy, "MIN_REFINEMENT_SECONDS", 0.3)
 
     # 0.25 s each, and no better: the same uniform 300-node grid.
@@ -348,7 +348,7 @@ def test_an_outside_state_is_planned_with_the_jerk_slack_only_in_its_turn():
 @pytest.mark.parametrize("curved", [False, True])
 def test_a_braking_state_just_outside_reach_turns_with_the_slack_and_goes_on_with_j_max(curved):
     # v0 < a0²/(2 j_max): under j_max the speed would fall below 0 before the braking ends;
-    # under 1.02 j_max it turns at 0.003 m/s... above rest. The rest of the move keeps j_max.
+    # under 1.02 j_max it turns about 2 mm/s above rest. The rest of the move keeps j_max.
     path = (sp.Path.from_waypoints([[0, 0], [20, 0], [20, 15], [35, 15]]) if curved
             else sp.Path.from_segments([Line(30.0)]))
     v0, a0 = 0.247, -0.5

@@ -417,8 +417,9 @@ def test_a_row_exceeded_by_a_fraction_of_itself_is_seen_on_a_fine_grid():
 
 
 def test_a_relaxed_point_over_its_rows_by_a_fraction_is_not_called_exact(monkeypatch):
-    # A relaxation backend answering that point: 'optimal' (exact) before, although its law
-    # breaks the jerk limit 1.14x; now it is 'relaxed' (refine='never') with a warning.
+    # A relaxation backend answering that point: the paper's test alone calls it exact
+    # ('optimal'), although its law breaks the jerk limit 1.14x; it is 'relaxed'
+    # (refine='never') with a warning.
     from speedplan.solve import discrete
     from speedplan.solve.clarabel_ import RelaxationResult
 
