@@ -23,8 +23,8 @@ only when the ones before it did not answer:
 * **verify** (per leg whose continuous law exceeds a tolerance): up to
   `MAX_REFINEMENTS` rounds of ``"local_refinement"`` of the grid where it does, then,
   for a leg answered on a coarser grid, ``"default_grid_other_backend"``. These improve a
-  law the plan already has, so without ``time_limit`` they share a time of their own
-  (`refinement_seconds`: as long as the first answers took, at least
+  law the plan already has, so without ``time_limit`` each leg's have a time of their own
+  (`refinement_seconds`: as long as the leg's first answer took, at least
   `MIN_REFINEMENT_SECONDS`; with it, what the limit leaves): an attempt that
   would not end within it (it takes about as long as the leg's last solve) is not started
   (recorded as ``"skipped"``), and a solver that can stop stops at its end; the plan then
@@ -87,7 +87,7 @@ __all__ = ["ATTEMPTS", "COARSER_GRIDS", "EXCESS_GROWTH", "MAX_REFINEMENTS",
 STATE_CONSTRAINTS = ("jerk", "v_max", "length", "speed_bound")
 #: Rounds of local grid refinement where the continuous law exceeds a tolerance.
 MAX_REFINEMENTS = 3
-#: The least time the attempts that improve a plan's first answers share [s]
+#: The least time the attempts that improve a leg's first answer may take [s]
 #: (`refinement_seconds`).
 MIN_REFINEMENT_SECONDS = 1.0
 #: A refined law whose worst excess (in tolerances, `excess`) is more than this many times
@@ -460,7 +460,7 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
                            speed_bound=model.bound, request=request)
     leg_checks = [profile.check_leg(i, leg.samples if isinstance(leg, Leg) else None)
                   for i, leg in enumerate(model.legs)]
-    window = _Window.of(record.budget)
+    window = _Window.of(record)
     stuck: set[int] = set()  # legs whose refined law did not arrive: retrying repeats it
     for _ in range(MAX_REFINEMENTS):
         if all(c.verification.ok for c in leg_checks):
@@ -469,7 +469,7 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
         for i, (leg, leg_check) in enumerate(zip(model.legs, leg_checks, strict=True)):
             if leg_check.verification.ok or not isinstance(leg, Leg) or i in stuck:
                 continue
-            if not window.admits(record, "local_refinement", i):
+            if not window.admits("local_refinement", i):
                 stuck.add(i)
                 continue
             grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess, leg.anchors,
@@ -477,7 +477,7 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
             try:
                 refined = record.attempt("local_refinement", i,
                                          partial(_solve_on_grid, request, leg, grid),
-                                         until=window.until)
+                                         until=window.until(i))
             except SolverError:  # keep the verified law; its excess is reported below
                 stuck.add(i)
                 continue
@@ -503,11 +503,11 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
     # passes (seen on a zone path whose eighth grid left six steps for the last rest phase).
     for i, (leg, coarse) in enumerate(zip(model.legs, coarsened, strict=True)):
         if coarse and not leg_checks[i].verification.ok and isinstance(leg, Leg):
-            if not window.admits(record, "default_grid_other_backend", i):
+            if not window.admits("default_grid_other_backend", i):
                 continue
             with contextlib.suppress(SolverError):
                 again = record.attempt("default_grid_other_backend", i,
-                                       partial(solve_leg, leg), until=window.until)
+                                       partial(solve_leg, leg), until=window.until(i))
                 trial = replace(profile, legs=(*legs[:i], again, *legs[i + 1:]))
                 trial_check = trial.check_leg(i)
                 if trial_check.verification.ok:
@@ -540,48 +540,63 @@ def _warn_exceeded(check: Verification, record: Record) -> None:
     )
 
 
-@dataclass(frozen=True)
+@dataclass
 class _Window:
-    """The time the attempts improving a plan's first answers share (`refinement_seconds`)."""
+    """The time each leg's improving attempts may take.
 
-    seconds: float
-    until: float  # a time.perf_counter() value
+    Without a caller's limit, `refinement_seconds` of the leg's first answer, counted over
+    the attempts on that leg since the window opened; with one, what the limit leaves.
+    """
+
+    record: Record
+    opened: int  # the record's entries before the window
+    allowed: dict[int, float] = field(default_factory=dict)
 
     @classmethod
-    def of(cls, budget: Budget) -> _Window:
-        """From now: `refinement_seconds` of the time spent, or what a caller's limit leaves."""
-        if budget.deadline is not None:
-            return cls(budget.remaining(), budget.deadline)
-        seconds = refinement_seconds(budget.elapsed())
-        return cls(seconds, time.perf_counter() + seconds)
+    def of(cls, record: Record) -> _Window:
+        return cls(record, len(record.entries))
 
-    def admits(self, record: Record, name: str, leg: int) -> bool:
+    def left(self, leg: int) -> float:
+        """Seconds the leg's improvements have left."""
+        if self.record.budget.deadline is not None:
+            return self.record.budget.remaining()
+        if leg not in self.allowed:
+            self.allowed[leg] = refinement_seconds(self.record.answer_seconds(leg))
+        spent = sum(e.seconds for e in self.record.entries[self.opened:] if e.leg == leg)
+        return self.allowed[leg] - spent
+
+    def until(self, leg: int) -> float:
+        """When the leg's improvements must stop (a ``time.perf_counter()`` value)."""
+        return time.perf_counter() + self.left(leg)
+
+    def admits(self, name: str, leg: int) -> bool:
         """Whether the attempt ``name`` on ``leg`` would end in time; if not, it is skipped.
 
         It is judged to take as long as the leg's last solve.
         """
-        if time.perf_counter() + record.answer_seconds(leg) <= self.until:
+        if self.record.answer_seconds(leg) <= self.left(leg):
             return True
-        record.skip(name, leg, f"the {self.seconds:.3g} s for improving the first answers "
-                               "would be spent before it ended")
+        allowed = self.allowed.get(leg)
+        whose = ("the time limit" if allowed is None
+                 else f"the {allowed:.3g} s for improving this leg's first answer")
+        self.record.skip(name, leg, f"{whose} would be spent before it ended")
         return False
 
 
-def refinement_seconds(first_answers: float) -> float:
-    """The time the attempts improving a plan's first answers share [s].
+def refinement_seconds(first_answer: float) -> float:
+    """The time the attempts improving a leg's first answer may take [s].
 
-    As long as the first answers took (``first_answers`` seconds: model and first solves),
-    at least `MIN_REFINEMENT_SECONDS`: a plan takes about twice its first answer, not the
-    minutes a relaxation backend can spend on a refined grid it does not suit (Clarabel,
-    as the fallback of a 22 000-node comfort grid the banded kernel could not start on:
-    67 s).
+    As long as that answer took (``first_answer`` seconds), at least
+    `MIN_REFINEMENT_SECONDS`: a plan takes about twice its first answers, not the minutes a
+    relaxation backend can spend on a refined grid it does not suit (Clarabel, as the
+    fallback of a 22 000-node comfort grid the banded kernel could not start on: 67 s).
 
     Examples
     --------
     >>> refinement_seconds(0.05), refinement_seconds(2.5)
     (1.0, 2.5)
     """
-    return max(MIN_REFINEMENT_SECONDS, first_answers)
+    return max(MIN_REFINEMENT_SECONDS, first_answer)
 
 
 def _solve_on_grid(request: PlanRequest, leg: Leg, grid: FloatArray) -> LegResult:
