@@ -163,24 +163,40 @@ def _log_uniform(rng: np.random.Generator, lo: float, hi: float) -> float:
     return float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
 
 
+def draw_g2_case(rng: np.random.Generator, size: tuple[float, float]
+                 ) -> tuple[sp.Path, dict[str, float], dict[str, float | None]] | None:
+    """A random G2 waypoint path of ``size`` metres (log-uniform range) and its limits.
+
+    ``(path, plain, comfort)``: ``Limits`` keywords without and with the comfort limits
+    (``yaw_rate_max`` ``None`` in 30 % of the draws); ``None`` when the waypoints make no
+    path (the caller draws again).
+    """
+    scale = _log_uniform(rng, *size)
+    k = int(rng.integers(4, 8))
+    pts = np.cumsum(rng.uniform(-scale / 2, scale / 2, size=(k, 2)), axis=0)
+    try:
+        path = sp.Path.from_waypoints(pts, max_deviation=scale * float(rng.uniform(0.01, 0.1)))
+    except sp.InvalidInputError:
+        return None
+    v_max = _log_uniform(rng, 0.5, 30.0)
+    j_max = _log_uniform(rng, 0.2, 5.0)
+    plain = dict(v_max=v_max, a_max=_log_uniform(rng, 0.2, 3.0),
+                 a_lat_max=_log_uniform(rng, 0.3, 4.0), j_max=j_max)
+    comfort = dict(j_lat_max=j_max * _log_uniform(rng, 0.1, 1.0),
+                   yaw_rate_max=None if rng.random() < 0.3 else _log_uniform(rng, 0.2, 2.0))
+    return path, plain, comfort
+
+
 def fuzz(plans: int, seed: int, fine: int) -> None:
     rng = np.random.default_rng(seed)
     tally = Tally()
     drawn = 0
     while drawn < plans:
-        size = _log_uniform(rng, 5.0, 500.0)
-        k = int(rng.integers(4, 8))
-        pts = np.cumsum(rng.uniform(-size / 2, size / 2, size=(k, 2)), axis=0)
-        try:
-            path = sp.Path.from_waypoints(pts, max_deviation=size * float(rng.uniform(0.01, 0.1)))
-        except sp.InvalidInputError:
+        case = draw_g2_case(rng, (5.0, 500.0))
+        if case is None:
             continue
-        v_max = _log_uniform(rng, 0.5, 30.0)
-        j_max = _log_uniform(rng, 0.2, 5.0)
-        lim = sp.Limits(v_max=v_max, a_max=_log_uniform(rng, 0.2, 3.0),
-                        a_lat_max=_log_uniform(rng, 0.3, 4.0), j_max=j_max,
-                        j_lat_max=j_max * _log_uniform(rng, 0.1, 1.0),
-                        yaw_rate_max=None if rng.random() < 0.3 else _log_uniform(rng, 0.2, 2.0))
+        path, plain, comfort = case
+        lim = sp.Limits(**plain, **comfort)
         tally.add(path, lim, None, drawn < fine)
         drawn += 1
     tally.report(f"random G2 comfort plans (seed {seed})")

@@ -48,6 +48,9 @@ from speedplan.io import read_path, read_zones
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 from oracles import subdivided_default_grids  # the tests' reference: finer default grids
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_comfort import draw_g2_case  # the same random G2 draws
+
 PATHS = Path(__file__).resolve().parents[1] / "paths"
 LGV = dict(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 ROAD = dict(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0)
@@ -127,29 +130,17 @@ def sample_cases() -> list[Case]:
     return out
 
 
-def _log_uniform(rng: np.random.Generator, lo: float, hi: float) -> float:
-    return float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
-
-
 def random_cases(count: int, seed: int) -> list[Case]:
     """``count`` random G2 waypoint paths, each with plain and comfort limits."""
     rng = np.random.default_rng(seed)
     out: list[Case] = []
     drawn = 0
     while drawn < count:
-        size = _log_uniform(rng, 2.0, 2000.0)
-        k = int(rng.integers(4, 8))
-        pts = np.cumsum(rng.uniform(-size / 2, size / 2, size=(k, 2)), axis=0)
-        try:
-            path = sp.Path.from_waypoints(pts, max_deviation=size * float(rng.uniform(0.01, 0.1)))
-        except sp.InvalidInputError:
+        case = draw_g2_case(rng, (2.0, 2000.0))
+        if case is None:
             continue
-        v_max = _log_uniform(rng, 0.5, 30.0)
-        j_max = _log_uniform(rng, 0.2, 5.0)
-        plain = dict(v_max=v_max, a_max=_log_uniform(rng, 0.2, 3.0),
-                     a_lat_max=_log_uniform(rng, 0.3, 4.0), j_max=j_max)
-        comfort = dict(j_lat_max=j_max * _log_uniform(rng, 0.1, 1.0),
-                       yaw_rate_max=None if rng.random() < 0.3 else _log_uniform(rng, 0.2, 2.0))
+        path, plain, comfort = case
+        v_max = plain["v_max"]
         name = f"random {drawn:02d} ({path.length:.3g} m, v_max {v_max:.3g})"
         out.append(Case(f"{name} plain", path, sp.Limits(**plain)))
         out.append(Case(f"{name} comfort", path, sp.Limits(**plain, **comfort)))
