@@ -55,6 +55,29 @@ def test_max_jerk_start_and_stop_are_reproduced(j, length):
     assert law.kinematics(np.array([0.0, length]))[1] == pytest.approx([0.0, 0.0], abs=1e-300)
 
 
+@pytest.mark.parametrize("shortfall", [2e-4, 4e-4, 8e-4])
+def test_a_stop_slightly_under_the_max_jerk_motion_keeps_its_jerk(shortfall):
+    # A discrete stop a little under the max-jerk motion, as on a capped grid whose last
+    # jerk rows do not bind: w = K d^(4/3) (1 - c d) at distance d from rest. Its own jerk,
+    # sqrt(w) w'' / 2, is j_max at the rest and less before it (closed form below), so the
+    # law through its nodes must not exceed j_max beyond its grading. Built in w next to the
+    # rest, the law cannot follow d^(4/3): the jerk rose 12-120 % above j_max there.
+    j, h, nodes = 2.0, 1e-3, 60
+    d = h * np.arange(nodes, -1, -1.0)
+    c = shortfall / h
+    w = max_jerk_envelope(d, j) * (1.0 - c * d)
+    law = TimeLaw(d[0] - d, w, j_max=j)
+    q = np.linspace(d[0] - 30 * h, d[0], 30_001)[:-1]  # the rest itself: 0 / 0 below
+    jerk = law.kinematics(q)[3]
+    k = (j**2 / 4) * (6 / j) ** (4 / 3)
+    dq = d[0] - q
+    exact = (np.sqrt(k * dq ** (4 / 3) * (1 - c * dq))
+             * k * (4 / 9 * dq ** (-2 / 3) - c * 28 / 9 * dq ** (1 / 3)) / 2)
+    assert exact.max() <= j * (1 + 1e-12)
+    assert np.abs(jerk).max() <= j * (1 + GRADING)
+    assert jerk == pytest.approx(exact, abs=0.02 * j)
+
+
 def test_prescribed_end_accelerations_are_met_exactly():
     s = np.linspace(0, 5, 11)
     w = (1.0 + 0.1 * s) ** 2
