@@ -38,8 +38,8 @@ from .problem import GRIP_TOL, ROW_TOL_REL, DiscreteProblem
 from .refine import refine as refine_nlp
 from .solution import DiscreteSolution, RefinementInfo, RelaxationInfo, Status
 
-__all__ = ["BACKENDS", "CUT_GAP", "CUT_PAD", "REFINE_MODES", "RELAXATION_BACKENDS",
-           "solve_discrete", "solve_problem"]
+__all__ = ["BACKENDS", "CUT_GAP", "CUT_PAD", "POLISH_GAP", "REFINE_MODES",
+           "RELAXATION_BACKENDS", "solve_discrete", "solve_problem"]
 
 #: Relaxation backends by name (the names of `speedplan.core.options.RelaxationBackend`);
 #: each maps a problem in the units of `unit_scales`, boundary values checked, to a
@@ -60,6 +60,12 @@ CUT_GAP = 5e-3
 #: nodes on either side (every cut at once made the relaxation of a 1 172-node road curve
 #: stall in Clarabel; the nodes where the relaxation pays for an excess carry the bound).
 CUT_PAD = 3
+#: An exact relaxation whose own certified gap (objective against lower bound, relative) is
+#: above this was stopped short of its optimum (Clarabel's reduced accuracy, "AlmostSolved":
+#: 2.3e-6 slower than the optimum on a 27 m straight grid, with a gap of 1.5e-5); the
+#: refinement then polishes its point, so that both backends agree to this (the banded
+#: kernel accepts no stop above it, `speedplan.solve._banded_ipm.ALMOST_GAP`).
+POLISH_GAP = 1e-6
 #: Until the banded kernel is compiled (first use after installation, 20-30 s; see
 #: `kernel_ready`), ``"auto"`` answers with Clarabel below this
 #: many nodes while a background process compiles it; from this size on Clarabel would take
@@ -179,7 +185,8 @@ def solve_problem(
     w = relaxed.w
     status: Status = "optimal" if relaxed.exact else "relaxed"
     refinement: RefinementInfo | None = None
-    refined = refine == "always" or (refine == "auto" and not relaxed.exact)
+    loose = relaxed.exact and problem.travel_time(w) > relaxed.lower * (1.0 + POLISH_GAP)
+    refined = refine == "always" or (refine == "auto" and (not relaxed.exact or loose))
     if refined:
         w, status, refinement = _refined(problem, relaxed, w, status)
     elif not relaxed.exact:
@@ -309,8 +316,9 @@ def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status:
              ) -> tuple[FloatArray, Status, RefinementInfo]:
     """The nonconvex refinement from the relaxation's point: ``w`` and status it leaves.
 
-    An exact relaxation keeps its own ``w`` (the refinement is only recorded); otherwise the
-    refined point if it is feasible, else the relaxed one scaled into the jerk bounds.
+    An exact relaxation keeps its own ``w`` unless the refined point is feasible and faster
+    (a relaxation stopped short of its optimum, `POLISH_GAP`); otherwise the refined point if
+    it is feasible, else the relaxed one scaled into the jerk bounds.
     """
 
     def feasible(w_unit: FloatArray) -> bool:
@@ -327,7 +335,8 @@ def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status:
         objective=problem.travel_time(w_ref) if ref_ok else None,
     )
     if relaxed.exact:
-        return w, status, refinement
+        faster = ref_ok and problem.travel_time(w_ref) < problem.travel_time(w)
+        return (w_ref if faster else w), status, refinement
     if ref_ok:
         return w_ref, "refined", refinement
     scaled = _scale_into_jerk_bounds(problem, relaxed.w)
