@@ -33,6 +33,7 @@ from oracles import (
     ruckig_move,
     within_promise,
 )
+from shapely.geometry import box
 from shared import examples
 
 from speedplan import Limits, Path, SpanLimit, SpeedZone, plan
@@ -213,6 +214,28 @@ def test_a_grid_at_its_node_cap_keeps_the_first_transitions_at_the_ends_resolved
         assert nodes >= 0.5 * DEFAULT_PER_PHASE
     profile = plan(path, lim)
     assert profile.verification.ok and not profile.limits_exceeded
+
+
+def test_a_stop_of_micrometres_at_the_end_of_a_long_capped_leg_keeps_its_jerk() -> None:
+    # 172 m with a slow zone, jerk phases of 8.5 ms: the final stop spans 1.9 µm, where w is
+    # 1e-7 of its cruise value. The law's values gather 1e-9 over the leg's 20 000 cells; bent
+    # into the stop, that took its jerk 1.11x over j_max, which no refinement removed.
+    from speedplan.model.grid import GRADING
+
+    path = Path.from_waypoints([
+        [0.0, 0.0], [32.90716888884577, -6.692431771353052],
+        [57.84437470267518, -25.955765291856817], [72.44320142124874, -19.64020414007242],
+        [107.09552365321909, -17.778012755072474], [130.6361893417902, -39.21086907340705],
+        [154.50011197840368, -46.53012829696773]])
+    zone = SpeedZone(box(77.77066181467825, -1e4, 128.6095293996484, 1e4), 0.03916759237268164)
+    lim = Limits(v_max=3.337685311937242, a_max=0.15716401945518907,
+                 a_lat_max=1.5141606808319439, j_max=18.40764709655499)
+    profile = plan(path, lim, zones=[zone], v0=0.137224887994673, a0=0.0005480408910801183)
+    assert profile.verification.ok and not profile.limits_exceeded
+    # The acceleration sampled over the last 30 ms, finite-differenced in time.
+    t = np.linspace(profile.duration - 0.03, profile.duration, 30_001)
+    accel = profile.law.state_at(t)[3]
+    assert np.abs(np.diff(accel) / np.diff(t)).max() <= lim.j_max * (1 + GRADING) * (1 + 1e-3)
 
 
 @settings(max_examples=examples(10), deadline=None)
