@@ -18,8 +18,8 @@ from ..core.options import VLimit
 from .path import Path
 
 __all__ = ["ZONE_RESCAN", "CellSamples", "SpanLimit", "SpeedBound", "SpeedZone",
-           "bound_breakpoints",
-           "check_spans", "check_zones", "speed_bounds", "zone_intervals"]
+           "bound_breakpoints", "check_spans", "check_v_limit", "check_zones", "speed_bounds",
+           "zone_intervals"]
 
 
 @dataclass(frozen=True, init=False)
@@ -230,7 +230,7 @@ def _bounds(
             inside = shapely.intersects_xy(zone.polygon, xy[..., 0], xy[..., 1])
             w = np.where(inside, np.minimum(w, zone.v_max**2), w)
     if v_limit is not None:
-        sk, vk = _check_v_limit(v_limit)
+        sk, vk = check_v_limit(v_limit)
         v = np.interp(q, sk, vk)
         w = np.minimum(w, np.where(np.isnan(v), np.inf, v) ** 2)  # inf knots may give inf*0
     for span in span_list:
@@ -489,7 +489,14 @@ class CellSamples:
         return replace(self, s=s, points=points, curvature=out[0], bound=out[1])
 
 
-def _check_v_limit(v_limit: VLimit) -> tuple[FloatArray, FloatArray]:
+def check_v_limit(v_limit: VLimit) -> tuple[FloatArray, FloatArray]:
+    """``v_limit``'s knots and speeds as arrays; raise naming what is malformed.
+
+    Examples
+    --------
+    >>> [a.tolist() for a in check_v_limit(([0.0, 5.0], [1.0, 0.5]))]
+    [[0.0, 5.0], [1.0, 0.5]]
+    """
     try:
         sk, vk = v_limit
     except (TypeError, ValueError) as exc:
@@ -674,7 +681,7 @@ def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> 
     if isinstance(bound, SpeedBound):
         shift = bound.offset  # the bound reads the path at s + offset
         if bound.v_limit is not None:
-            parts.append(_check_v_limit(bound.v_limit)[0])
+            parts.append(check_v_limit(bound.v_limit)[0])
         parts += [np.array([span.start, span.end]) for span in bound.spans]
         if bound.zones:
             cuts = zone_intervals(bound.path, bound.zones)
