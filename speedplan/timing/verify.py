@@ -587,17 +587,13 @@ def _first_peak(parts: tuple[FloatArray, FloatArray], points: FloatArray,
         return 1, int(np.argmax(brk))
     if not locate:
         return 0, k
-    at = main == top
-    if np.count_nonzero(at) == 1:  # no tie: the usual case off the bound
+    ties = np.flatnonzero(main == top)
+    if ties.size == 1:  # the usual case off the bound
         return 0, k
-    # The first tie of each row of `cell_points` (each in the cells' order), then the first
-    # of these along the path.
-    nodes, inner = cell_rows(at)
-    n = nodes.size
-    first = np.concatenate(([np.argmax(nodes)], n + np.arange(inner.shape[0]) * (n - 1)
-                            + np.argmax(inner, axis=1)))
-    first = first[at[first]]
-    return 0, int(first[np.argmin(points[first])])
+    # The points rise along each row of `cell_points` (the nodes, then each cell's k-th
+    # point, in the cells' order): the first tie at the least point is the first along the
+    # path, and of equal points the one in the first row, as the rows' first ties would give.
+    return 0, int(ties[np.argmin(points[ties])])
 
 
 def _at(parts: tuple[FloatArray, FloatArray], where: tuple[int, int]) -> float:
