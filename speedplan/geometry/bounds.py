@@ -5,6 +5,7 @@ from __future__ import annotations
 import weakref
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import shapely
@@ -335,6 +336,15 @@ class SpeedBound:
     def _given(self, q: FloatArray, kappa: FloatArray) -> FloatArray:
         return _bounds(self.path, self.limits, q, kappa, check_zones(self.zones), self.v_limit,
                        self.spans)
+
+    @cached_property
+    def _breakpoints(self) -> FloatArray:
+        """`bound_breakpoints` on the bound's own path, computed once.
+
+        A plan reads them for its grid and again for its check (and a zone's entries and
+        exits cost a cache lookup each time); the bound is immutable, so they are its own.
+        """
+        return _computed_breakpoints(self.path, self)
 
     def given_curvature(self, s: ArrayLike, curvature: ArrayLike) -> FloatArray:
         """Bound at arc lengths ``s`` [m] where the path's ``curvature`` [1/m] is known.
@@ -676,6 +686,13 @@ def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> 
     >>> bound_breakpoints(p, SpeedBound(p, lim, v_limit=([1.0, 2.0], [2.0, 1.0]))).tolist()
     [1.0, 2.0, 5.0]
     """
+    if isinstance(bound, SpeedBound) and path is bound.path:
+        return bound._breakpoints.copy()  # a copy: the caller may write to it
+    return _computed_breakpoints(path, bound)
+
+
+def _computed_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> FloatArray:
+    """`bound_breakpoints`, computed."""
     parts = [np.asarray(path.offsets[1:-1], dtype=np.float64)]
     shift = 0.0
     if isinstance(bound, SpeedBound):
