@@ -397,11 +397,12 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
         # Without jerk (and lateral-jerk) rows nothing bounds the law's bend: on the chords.
         linear=linear,
     )
+    joins = grid_anchors(request, lo, lo + length)
+    kinks = kink_anchors(request, bound, length, breaks)
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
                backend=request.backend,
-               anchors=np.union1d(grid_anchors(request, lo, lo + length),
-                                  kink_anchors(request, bound, length, breaks)),
+               anchors=np.union1d(joins, kinks) if joins.size or kinks.size else joins,
                samples=samples)
 
 
