@@ -496,7 +496,8 @@ class CellSamples:
         idx_inner += base
         out = [np.concatenate((own, fresh))[index]
                for own, fresh in ((self.curvature, kappa), (self.bound, w))]
-        return replace(self, s=s, points=points, curvature=out[0], bound=out[1])
+        return CellSamples(s, self.offset, points, out[0], out[1], self.extra,
+                           self.extra_curvature, self.extra_bound)
 
 
 def check_v_limit(v_limit: VLimit) -> tuple[FloatArray, FloatArray]:
