@@ -101,7 +101,6 @@ def no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: flo
         own = samples.bound[:s.size]  # the bound at the nodes themselves (cell_points)
         w_max = nodes.copy()
         w_max[0], w_max[-1] = max(w_max[0], v0 * v0), max(w_max[-1], vf * vf)
-        m = s.size
         h = s[1:] - s[:-1]  # the exact no-jerk optimum on this grid (speedplan.solve.nojerk)
         w = largest_under_rates(w_max, lim.A * h, lim.A_decel * h)
         lossy = (w >= nodes * (1.0 - 1e-9)) & (nodes < (1.0 - NO_JERK_BOUND_LOSS) * own)
