@@ -5,6 +5,7 @@ from __future__ import annotations
 import weakref
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import shapely
@@ -18,8 +19,8 @@ from ..core.options import VLimit
 from .path import Path
 
 __all__ = ["ZONE_RESCAN", "CellSamples", "SpanLimit", "SpeedBound", "SpeedZone",
-           "bound_breakpoints",
-           "check_spans", "check_zones", "speed_bounds", "zone_intervals"]
+           "bound_breakpoints", "check_spans", "check_v_limit", "check_zones", "speed_bounds",
+           "zone_intervals"]
 
 
 @dataclass(frozen=True, init=False)
@@ -230,7 +231,7 @@ def _bounds(
             inside = shapely.intersects_xy(zone.polygon, xy[..., 0], xy[..., 1])
             w = np.where(inside, np.minimum(w, zone.v_max**2), w)
     if v_limit is not None:
-        sk, vk = _check_v_limit(v_limit)
+        sk, vk = check_v_limit(v_limit)
         v = np.interp(q, sk, vk)
         w = np.minimum(w, np.where(np.isnan(v), np.inf, v) ** 2)  # inf knots may give inf*0
     for span in span_list:
@@ -335,6 +336,15 @@ class SpeedBound:
     def _given(self, q: FloatArray, kappa: FloatArray) -> FloatArray:
         return _bounds(self.path, self.limits, q, kappa, check_zones(self.zones), self.v_limit,
                        self.spans)
+
+    @cached_property
+    def _breakpoints(self) -> FloatArray:
+        """`bound_breakpoints` on the bound's own path, computed once.
+
+        A plan reads them for its grid and again for its check (and a zone's entries and
+        exits cost a cache lookup each time); the bound is immutable, so they are its own.
+        """
+        return _computed_breakpoints(self.path, self)
 
     def given_curvature(self, s: ArrayLike, curvature: ArrayLike) -> FloatArray:
         """Bound at arc lengths ``s`` [m] where the path's ``curvature`` [1/m] is known.
@@ -486,10 +496,18 @@ class CellSamples:
         idx_inner += base
         out = [np.concatenate((own, fresh))[index]
                for own, fresh in ((self.curvature, kappa), (self.bound, w))]
-        return replace(self, s=s, points=points, curvature=out[0], bound=out[1])
+        return CellSamples(s, self.offset, points, out[0], out[1], self.extra,
+                           self.extra_curvature, self.extra_bound)
 
 
-def _check_v_limit(v_limit: VLimit) -> tuple[FloatArray, FloatArray]:
+def check_v_limit(v_limit: VLimit) -> tuple[FloatArray, FloatArray]:
+    """``v_limit``'s knots and speeds as arrays; raise naming what is malformed.
+
+    Examples
+    --------
+    >>> [a.tolist() for a in check_v_limit(([0.0, 5.0], [1.0, 0.5]))]
+    [[0.0, 5.0], [1.0, 0.5]]
+    """
     try:
         sk, vk = v_limit
     except (TypeError, ValueError) as exc:
@@ -669,12 +687,19 @@ def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> 
     >>> bound_breakpoints(p, SpeedBound(p, lim, v_limit=([1.0, 2.0], [2.0, 1.0]))).tolist()
     [1.0, 2.0, 5.0]
     """
+    if isinstance(bound, SpeedBound) and path is bound.path:
+        return bound._breakpoints.copy()  # a copy: the caller may write to it
+    return _computed_breakpoints(path, bound)
+
+
+def _computed_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> FloatArray:
+    """`bound_breakpoints`, computed."""
     parts = [np.asarray(path.offsets[1:-1], dtype=np.float64)]
     shift = 0.0
     if isinstance(bound, SpeedBound):
         shift = bound.offset  # the bound reads the path at s + offset
         if bound.v_limit is not None:
-            parts.append(_check_v_limit(bound.v_limit)[0])
+            parts.append(check_v_limit(bound.v_limit)[0])
         parts += [np.array([span.start, span.end]) for span in bound.spans]
         if bound.zones:
             cuts = zone_intervals(bound.path, bound.zones)

@@ -166,8 +166,9 @@ class Path:
                 )
             if lo < 0.0 or hi > L:  # within the tolerance: clipped (else already inside)
                 q = np.clip(q, 0.0, L)
-        idx = np.clip(np.searchsorted(self.offsets, q, side="right") - 1, 0, len(self.pieces) - 1)
-        return q, idx
+        # Every q >= 0 = offsets[0] is right of the first offset: only the end needs a cap.
+        return q, np.minimum(np.searchsorted(self.offsets, q, side="right") - 1,
+                             len(self.pieces) - 1)
 
     @property
     def analytic(self) -> bool:

@@ -22,6 +22,7 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError, InvalidInputError
 from ..core.options import RestReason
 from ..geometry import CellSamples, SpeedBound, bound_breakpoints
+from ..geometry.bounds import check_v_limit
 from ..solve.problem import MAX_RAMP_STEPS, DiscreteProblem, ramp_steps
 from .boundary import STATE_JERK_ROUNDING, check_reachable_states, turnaround_speed
 from .grid import MIN_NODES
@@ -396,11 +397,12 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
         # Without jerk (and lateral-jerk) rows nothing bounds the law's bend: on the chords.
         linear=linear,
     )
+    joins = grid_anchors(request, lo, lo + length)
+    kinks = kink_anchors(request, bound, length, breaks)
     return Leg(start=lo, length=length, v0=v0, a0=a0, vf=vf, af=af, bound=bound,
                problem=problem, time_law=law, limits=lim, refine=request.refine,
                backend=request.backend,
-               anchors=np.union1d(grid_anchors(request, lo, lo + length),
-                                  kink_anchors(request, bound, length, breaks)),
+               anchors=np.union1d(joins, kinks) if joins.size or kinks.size else joins,
                samples=samples)
 
 
@@ -420,6 +422,10 @@ def _end_speeds(request: PlanRequest, bound: SpeedBound, length: float) -> PlanR
     A speed above the bound by at most `STATE_ROUNDING` is
     taken at the bound (a state read off a plan: the time law's rounding).
     """
+    if request.v0 == 0.0 and request.vf == 0.0:  # at rest: under any bound, which is >= 0
+        if bound.v_limit is not None:  # refused here, as evaluating the bound would
+            check_v_limit(bound.v_limit)
+        return request
     ends = np.sqrt(bound.evaluate(np.array([0.0, length]))[1])
     v0, vf = (within_limit(name, v, float(b), "m/s", f"the speed bound at s={where:.6g} m "
                            "(v_max, lateral acceleration, a zone or v_limit)")

@@ -715,9 +715,13 @@ def subdivided_grid(s: FloatArray, cells: np.ndarray, parts: int = 4) -> FloatAr
     >>> g.size, bool(np.isin(s, g).all()), float(np.diff(g).min())
     (20, True, 0.5)
     """
-    # Each flagged cell and PAD_CELLS on each side: a window sum over the flags.
-    window = np.convolve(cells.astype(np.intp), np.ones(2 * PAD_CELLS + 1, dtype=np.intp))
-    split = window[PAD_CELLS:PAD_CELLS + cells.size] > 0
+    # Each flagged cell and PAD_CELLS on each side (shifted copies: an integer convolution
+    # costs more).
+    flags = np.asarray(cells, dtype=bool)
+    split = flags.copy()
+    for k in range(1, PAD_CELLS + 1):
+        split[k:] |= flags[:-k]
+        split[:-k] |= flags[k:]
     lo = s[:-1][split]
     width = np.diff(s)[split]
     inner = lo[:, None] + width[:, None] * (np.arange(1, parts) / parts)[None, :]

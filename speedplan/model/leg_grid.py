@@ -88,7 +88,7 @@ def no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: flo
     samples = CellSamples.of(bound, s, extra=breaks)  # the law's check reads the breakpoints too
     inside = (breaks > s[0]) & (breaks < s[-1])
     if inside.any():  # hidden_dips, from the values just evaluated
-        k = np.clip(np.searchsorted(s, breaks[inside]), 1, s.size - 1)
+        k = np.minimum(np.maximum(np.searchsorted(s, breaks[inside]), 1), s.size - 1)
         dips = dips_between(s, breaks[inside], samples.extra_bound[inside],
                             samples.bound[k - 1], samples.bound[k], cells=True)
         if dips.size:
@@ -101,17 +101,12 @@ def no_jerk_grid(request: PlanRequest, bound: SpeedBound, length: float, v0: flo
         own = samples.bound[:s.size]  # the bound at the nodes themselves (cell_points)
         w_max = nodes.copy()
         w_max[0], w_max[-1] = max(w_max[0], v0 * v0), max(w_max[-1], vf * vf)
-        m = s.size
         h = s[1:] - s[:-1]  # the exact no-jerk optimum on this grid (speedplan.solve.nojerk)
-        w = largest_under_rates(w_max, np.full(m - 1, lim.A) * h,
-                                np.full(m - 1, lim.A_decel) * h)
+        w = largest_under_rates(w_max, lim.A * h, lim.A_decel * h)
         lossy = (w >= nodes * (1.0 - 1e-9)) & (nodes < (1.0 - NO_JERK_BOUND_LOSS) * own)
         if not lossy.any():
             break
-        cells = np.zeros(m - 1, dtype=bool)
-        idx = np.flatnonzero(lossy)
-        cells[np.clip(idx - 1, 0, m - 2)] = True
-        cells[np.clip(idx, 0, m - 2)] = True
+        cells = lossy[:-1] | lossy[1:]  # the cells on either side of each lossy node
         s = subdivided_grid(s, cells, parts=4)
         samples = samples.on_grid(bound, s)
     return samples

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -166,7 +167,7 @@ class PlanRequest:
     @property
     def jerk_limited(self) -> bool:
         """Whether the limits bound the jerk."""
-        return bool(np.isfinite(self.limits.j_max))
+        return math.isfinite(self.limits.j_max)  # read many times a plan: no numpy call
 
     @property
     def moving_state_jerk(self) -> float:

@@ -486,7 +486,7 @@ def _verification(found: dict[str, tuple[float, float, float]], limits: Limits) 
                 "grip": 1.0 if limits.ellipse else np.inf}
     return Verification([LimitCheck(name, ratio=found[name][1], maximum=found[name][0],
                                     limit=float(limit_of[name]), where_s=found[name][2],
-                                    unset=not np.isfinite(limit_of[name]))
+                                    unset=not math.isfinite(limit_of[name]))
                          for name in LIMIT_NAMES if name in found])
 
 
@@ -527,7 +527,7 @@ def check_linear_law(law: TimeLaw, offset: float, path: Path,
     w_nodes[:] = w
     np.multiply((np.arange(1, CELL_POINTS) / CELL_POINTS)[:, None], dw, out=w_inner)
     w_inner += w[:-1]
-    cell = np.clip(np.searchsorted(s, local, side="right") - 1, 0, n - 2)
+    cell = np.minimum(np.maximum(np.searchsorted(s, local, side="right") - 1, 0), n - 2)
     w_b = np.maximum(w[cell] + dw[cell] * ((local - s[cell]) / h[cell]), 0.0)
     k_abs, k_abs_b = np.abs(kappa), np.abs(kappa_b)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -537,8 +537,8 @@ def check_linear_law(law: TimeLaw, offset: float, path: Path,
     accel = 0.5 * (dw / h)  # constant on each cell, both its pieces
     # Where a limit is not set only the maximum is reported: any of its points will do.
     k_v, k_lat, k_yaw = (_first_peak(x, points, locate) for x, locate in (
-        (speed2, True), (lateral, np.isfinite(limits.a_lat_max)),
-        (yaw2, np.isfinite(limits.yaw_rate_max))))
+        (speed2, True), (lateral, math.isfinite(limits.a_lat_max)),
+        (yaw2, math.isfinite(limits.yaw_rate_max))))
     if k_v is None or k_lat is None or k_yaw is None or not np.isfinite(accel).all():
         return None
     first = float(offset + points[0])
@@ -551,17 +551,16 @@ def check_linear_law(law: TimeLaw, offset: float, path: Path,
             ("lateral", _at(lateral, k_lat), k_lat, limits.a_lat_max),
             ("yaw_rate", _at((k_abs, k_abs_b), k_yaw) * float(np.sqrt(_at((w_pts, w_b), k_yaw))),
              k_yaw, limits.yaw_rate_max)):  # |κ| v where κ² w peaks
-        found[name] = ((top, top / limit, offset + _at(glob, k)) if np.isfinite(limit)
+        found[name] = ((top, top / limit, offset + _at(glob, k)) if math.isfinite(limit)
                        else (top, 0.0, first))
     for name in ("lateral_jerk", "grip"):  # not set for such a law: reported as 0
         found[name] = (0.0, 0.0, first)
     knots = law.knots
-    for name, per_cell, limit in (("accel", accel, limits.a_max),
-                                  ("decel", -accel, limits.a_decel),
-                                  ("jerk", np.zeros(n - 1), limits.j_max)):
-        i = int(np.argmax(per_cell))
-        top = float(per_cell[i])
-        found[name] = (max(top, 0.0), max(top / limit, 0.0) if np.isfinite(limit) else 0.0,
+    i_acc, i_dec = int(np.argmax(accel)), int(np.argmin(accel))  # the first of any ties
+    for name, i, top, limit in (("accel", i_acc, float(accel[i_acc]), limits.a_max),
+                                ("decel", i_dec, -float(accel[i_dec]), limits.a_decel),
+                                ("jerk", 0, 0.0, limits.j_max)):  # no jerk on the chords
+        found[name] = (max(top, 0.0), max(top / limit, 0.0) if math.isfinite(limit) else 0.0,
                        float(offset + 0.5 * (knots[2 * i] + knots[2 * i + 1])))
     check = _verification(found, limits)
     excess = np.zeros(knots.size - 1, dtype=bool)
@@ -579,23 +578,22 @@ def _first_peak(parts: tuple[FloatArray, FloatArray], points: FloatArray,
     `check_pieces`); any of them unless ``locate``. ``None`` if a value is not finite.
     """
     main, brk = parts
-    top = float(main.max())
+    k = int(np.argmax(main))  # the first largest value (a NaN is the largest)
+    top = float(main[k])
     top_b = float(brk.max()) if brk.size else -math.inf
     if not (math.isfinite(top) and (math.isfinite(top_b) or top_b == -math.inf)):
         return None
     if top_b > top:
         return 1, int(np.argmax(brk))
     if not locate:
-        return 0, int(np.argmax(main))
-    # The first tie of each row of `cell_points` (each in the cells' order), then the first
-    # of these along the path.
-    at = main == top
-    nodes, inner = cell_rows(at)
-    n = nodes.size
-    first = np.concatenate(([np.argmax(nodes)], n + np.arange(inner.shape[0]) * (n - 1)
-                            + np.argmax(inner, axis=1)))
-    first = first[at[first]]
-    return 0, int(first[np.argmin(points[first])])
+        return 0, k
+    ties = np.flatnonzero(main == top)
+    if ties.size == 1:  # the usual case off the bound
+        return 0, k
+    # The points rise along each row of `cell_points` (the nodes, then each cell's k-th
+    # point, in the cells' order): the first tie at the least point is the first along the
+    # path, and of equal points the one in the first row, as the rows' first ties would give.
+    return 0, int(ties[np.argmin(points[ties])])
 
 
 def _at(parts: tuple[FloatArray, FloatArray], where: tuple[int, int]) -> float:

@@ -21,10 +21,12 @@ from hypothesis import strategies as st
 from shared import examples
 
 import speedplan as sp
+from speedplan.core.numerics import cell_points, cell_rows
 from speedplan.geometry import CellSamples, SpeedBound
 from speedplan.timing import TimeLaw
 from speedplan.timing.verify import (
     LIMIT_NAMES,
+    _first_peak,
     bound_breakpoints,
     check_law,
     check_linear_law,
@@ -240,3 +242,27 @@ def test_a_bound_of_zero_is_left_to_the_check_of_the_pieces():
     check = check_law(law, 0.0, path, bound, lim, np.zeros(0))
     assert check.verification.ratios["speed"] == math.inf
     assert not check.verification.ok
+
+
+def _rows_first_tie(values: np.ndarray, points: np.ndarray) -> int:
+    """The first largest of ``values`` along the path: the first tie of each row of
+    `cell_points`, then the one at the least point (the first such row's)."""
+    at = values == values.max()
+    nodes, inner = cell_rows(at)
+    n = nodes.size
+    first = np.concatenate(([np.argmax(nodes)], n + np.arange(inner.shape[0]) * (n - 1)
+                            + np.argmax(inner, axis=1)))
+    first = first[at[first]]
+    return int(first[np.argmin(points[first])])
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_peak_is_the_first_tie_along_the_path(seed):
+    rng = np.random.default_rng(seed)
+    s = np.cumsum(np.concatenate(([0.0], rng.uniform(1e-3, 1.0, int(rng.integers(2, 60))))))
+    if seed % 4 == 0:  # steps of a few ulps too
+        s[1] = np.nextafter(s[0], 1.0)
+    points = cell_points(s)
+    values = rng.integers(0, 3 if seed % 2 else 40, points.size).astype(np.float64)
+    peak = _first_peak((values, np.zeros(0)), points)
+    assert peak == (0, _rows_first_tie(values, points))
