@@ -774,21 +774,35 @@ def _shift_after(x: FloatArray, c: FloatArray, g: FloatArray, y: FloatArray, p0:
 
 def _level_ends(wk: _Work, span: tuple[int, int], knots: IntArray,
                 excess: tuple[float, float]) -> None:
-    """Subtract the line through ``excess`` at the two ``knots`` from pieces of ``span``.
+    """Subtract ``excess`` at the two ``knots`` from the pieces of ``span``, smoothly.
 
     The ``w``-region's node offsets are its local terms plus one constant only up to what
     its values gather over thousands of cells (1e-9 on a 172 m leg whose largest ``w`` is
     11); next to a standstill ``w`` is that small too (4e-7 at the junction of a 1.9 µm
-    stop), and a ``u``-region bent to absorb it raised the jerk 11 % above ``j_max``. A line
-    in ``s`` leaves every curvature, so the jerk, unchanged; it changes the acceleration by
-    ``excess / (2 length)``.
+    stop), and a ``u``-region bent to absorb it raised the jerk 11 % above ``j_max``. The
+    correction is a line between two standstill sides, which leaves every curvature; next
+    to a moving end, whose value and slope are exact, a parabola flat there, which adds a
+    curvature of ``2 excess / length²`` (1e-13 here) to every piece. An ``excess`` of 0
+    marks a side kept exact.
     """
-    x, g, y = wk.x, wk.g, wk.y
+    x, c, g, y = wk.x, wk.c, wk.g, wk.y
     p0, p1 = span
-    a, b = knots
-    slope = (excess[1] - excess[0]) / (x[b] - x[a])
-    y[p0:p1 + 1] -= excess[0] + slope * (x[p0:p1 + 1] - x[a])
+    e0, e1 = excess
+    if e0 == 0.0 and e1 == 0.0:
+        return
+    x0 = x[p0] if e0 == 0.0 else x[knots[0]]  # a moving end's own knot stays exact
+    x1 = x[p1] if e1 == 0.0 else x[knots[1]]
+    length = x1 - x0
+    t = (x[p0:p1 + 1] - x0) / length
+    if e0 != 0.0 and e1 != 0.0:
+        value, slope, curv = e0 + (e1 - e0) * t, np.full(t.size, (e1 - e0) / length), 0.0
+    elif e1 != 0.0:  # flat at the start
+        value, slope, curv = e1 * t * t, 2.0 * e1 * t / length, 2.0 * e1 / length**2
+    else:  # flat at the end
+        value, slope, curv = e0 * (1 - t) ** 2, -2.0 * e0 * (1 - t) / length, 2.0 * e0 / length**2
+    y[p0:p1 + 1] -= value
     g[p0:p1 + 1] -= slope
+    c[p0:p1] -= curv
 
 
 def _convert(y: float, g: float, from_u: bool) -> tuple[float, float]:
