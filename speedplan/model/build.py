@@ -358,7 +358,10 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
     w_max[0] = max(w_max[0], v0 * v0)
     w_max[-1] = max(w_max[-1], vf * vf)
     if (w_max[1:-1] <= 0).any():
-        i = int(np.flatnonzero(w_max[1:-1] <= 0)[0]) + 1
+        zero = np.flatnonzero(w_max[1:-1] <= 0) + 1
+        # A node bound is the least over the node's cells: say where the bound itself is 0.
+        at = np.flatnonzero(bound(s[zero]) <= 0)
+        i = int(zero[at[0] if at.size else 0])
         raise InvalidInputError(
             f"the speed bound is 0 at s={lo + s[i]:.6g} m inside the path ({_zero_cause(bound)}); "
             "split the path there to plan a stop"

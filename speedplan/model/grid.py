@@ -12,11 +12,12 @@ tight curve) is resolved at its own ``λ(v)``, however short.
 Two properties the time law relies on (`speedplan.timing.law`):
 
 * **smooth grading**: neighbouring steps differ by at most `GRADING` (1 %) wherever
-  the speed may change, by `CRUISE_GRADING` (10 %) inside long stretches at a constant
+  the speed may change, by `CRUISE_GRADING` (4 %) inside long stretches at a constant
   speed bound; the law's jerk error is the local step ratio minus one;
-* **cruise is coarse**: far (``> 2 v_max t_j + 2 ℓ``) from any kink of the no-jerk profile
+* **cruise is coarse**: far (``> 2 v_max t_j + 2 ℓ``, or more than `CRUISE_MARGIN_TIME`
+  ``t_j`` in time) from any kink of the no-jerk profile
   (where it is linear in ``w``: a cruise, a constant acceleration or braking) the step grows,
-  by 10 % per node, up to `CRUISE_STEP` of the length: a long move costs about 100
+  by 4 % per node, up to `CRUISE_STEP` of the length: a long move costs a few hundred
   nodes more than a short one, and does not hit the node cap with a coarse transition.
 
 Nodes are placed by inverting the node count ``N(s) = ∫ ds / h(s)`` exactly for a step
@@ -42,7 +43,9 @@ from ..core.rates import largest_under_rates
 
 __all__ = [
     "ANCHOR_ROOM",
+    "CAPPED_GRADING",
     "CRUISE_GRADING",
+    "CRUISE_MARGIN_TIME",
     "CRUISE_STEP",
     "DEFAULT_PER_PHASE",
     "END_PER_PHASE",
@@ -100,7 +103,15 @@ ANCHOR_ROOM = 1.5
 #: most this many times finer than elsewhere to leave room for `MIN_ANCHOR_NODES`.
 KINK_REFINE = 4.0
 #: Largest relative change between neighbouring steps inside long constant-bound stretches.
-CRUISE_GRADING = 0.1
+#: Below the jerk tolerance of `speedplan.timing.verify` (5 %): where the no-jerk estimate
+#: takes a stretch for a cruise and the law still has a jerk phase there (a comfort limit
+#: the estimate does not see), the law's jerk stays within it. At 10 % such laws reached
+#: 1.10x ``j_max`` and were solved again on a refined grid (20 of 100 random comfort plans).
+CRUISE_GRADING = 0.04
+#: The cruise grading where a node cap binds (`adaptive_grid`'s ``max_nodes``, the coarser
+#: grids of `speedplan.strategy`): there the transitions keep their steps first, and a cap
+#: of a few hundred nodes leaves no room for a finer grading between them.
+CAPPED_GRADING = 0.1
 #: Nodes per boundary transient of a user grid (``n`` or ``ds``): the first jerk phase from
 #: rest (last into rest), or the first change of a moving end's acceleration. At a rest the
 #: law's jerk exceeds ``j_max`` by about ``0.4 h / ℓ`` (measured on straight moves; 12 % on
@@ -109,6 +120,11 @@ CRUISE_GRADING = 0.1
 END_PER_PHASE = 20
 #: Positions at which `adaptive_grid` evaluates the bound for the path's top speed.
 TOP_SPEED_PROBES = 2001
+#: A stretch where the no-jerk profile is linear in ``w`` is also cruise when it lies farther
+#: than this many ``t_j`` in time from any kink of that profile (besides farther than the
+#: margin in metres, which is sized at the top speed). The jerk-limited law leaves the
+#: no-jerk one within a transition of each kink (at most ``t_j`` per jerk phase).
+CRUISE_MARGIN_TIME = 3.0
 #: Largest step inside long constant-bound stretches, as a fraction of the length: nothing
 #: changes there, the steps only grow (by `CRUISE_GRADING` per node) from the fine
 #: transitions on either side.
@@ -503,6 +519,19 @@ class _StepRule:
                                                                              cells[:-1])
         flat[1:-1] = curv <= tol
         out: np.ndarray = _distance_to(~flat, sf) > self.margin
+        # The margin in metres is sized at the top speed: at a hairpin's or a zone's low
+        # speed it spans many transitions (7 m at 1 m/s with t_j = 0.27 s is 27 of them),
+        # all at fine steps. Measured in time along the no-jerk profile, a jerk-limited
+        # law leaves it only within a transition or two of a kink. There, linear means to
+        # 1e-9 of the local w: a bound curving gently at a low speed is not a cruise.
+        local = np.maximum(np.maximum(w_est[:-2], w_est[2:]), w_est[1:-1])
+        straight = np.zeros(sf.size, dtype=bool)
+        straight[1:-1] = curv <= tol - 1e-9 * top + 1e-9 * local
+        v = np.sqrt(w_est)
+        with np.errstate(divide="ignore"):
+            t = np.concatenate(([0.0], np.cumsum(2.0 * cells / (v[1:] + v[:-1]))))
+        if np.isfinite(t[-1]):
+            out |= _distance_to(~straight, t) > CRUISE_MARGIN_TIME * self.t_j
         return out
 
 
@@ -559,6 +588,7 @@ def _capped(sf: FloatArray, h: FloatArray, rate: FloatArray, length: float, max_
     if float(np.sum(_count(sf, h))) <= budget:
         return _at_least_min_nodes(sf, h)
     inside = ends[:-1] & ends[1:]
+    rate = np.maximum(rate, np.where(rate >= CRUISE_GRADING, CAPPED_GRADING, 0.0))
     kept = h
     for _ in range(8):
         cells = _count(sf, kept)
@@ -576,7 +606,7 @@ def _capped(sf: FloatArray, h: FloatArray, rate: FloatArray, length: float, max_
         if count <= budget:
             break
         h = graded_steps(sf, np.minimum(h * (count / (0.995 * budget)), h_max),
-                         np.full(sf.size, CRUISE_GRADING))
+                         np.full(sf.size, CAPPED_GRADING))
     return _at_least_min_nodes(sf, h)
 
 

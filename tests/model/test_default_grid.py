@@ -31,6 +31,7 @@ from oracles import (
     no_jerk_lower_bound,
     ruckig_duration,
     ruckig_move,
+    subdivided_default_grids,
     within_promise,
 )
 from shapely.geometry import box
@@ -195,11 +196,12 @@ def test_a_hairpin_narrower_than_a_no_jerk_grid_step_is_cut_out() -> None:
 
 def test_a_grid_at_its_node_cap_keeps_the_first_transitions_at_the_ends_resolved() -> None:
     # Jerk phases of 8 ms on a 4 m path (a_max 0.11 m/s², j_max 13.6 m/s³): the default grid
-    # wants far more than MAX_DEFAULT_NODES and grows its steps; the max-jerk start from rest
-    # (1.2 µm long) must keep its own steps, or the law's jerk at its end goes over the limit
-    # and every finer grid tried after it costs tens of seconds.
+    # wants several thousand nodes; under a cap of half of them it grows its steps, and the
+    # max-jerk start from rest (1.2 µm long) must keep its own steps, or the law's jerk at its
+    # end goes over the limit and every finer grid tried after it costs tens of seconds.
     from speedplan.model import PlanRequest, build_model
-    from speedplan.model.grid import DEFAULT_PER_PHASE, MAX_DEFAULT_NODES, rest_phase_length
+    from speedplan.model.grid import DEFAULT_PER_PHASE, rest_phase_length
+    from speedplan.model.leg_grid import default_grid
 
     path = Path.from_waypoints([
         [0, 0], [0.12426521336474784, -0.11657631877453342],
@@ -207,8 +209,11 @@ def test_a_grid_at_its_node_cap_keeps_the_first_transitions_at_the_ends_resolved
         [3.9813199879850347, 0.1445236020023441]])
     lim = Limits(v_max=16.418898422873855, a_max=0.11059941918961164,
                  a_lat_max=0.1453314309003239, j_max=13.58945597172854)
-    s = build_model(PlanRequest.create(path, lim)).legs[0].problem.s
-    assert s.size >= 0.9 * MAX_DEFAULT_NODES  # the cap binds
+    request = PlanRequest.create(path, lim)
+    leg = build_model(request).legs[0]
+    cap = leg.problem.n // 2
+    s = default_grid(request, leg.bound, 0.0, path.length, 0.0, 0.0, 0.0, 0.0, max_nodes=cap)
+    assert 0.9 * cap <= s.size <= cap  # the cap binds
     ell = rest_phase_length(lim.a_max, lim.v_max, lim.j_max)
     for nodes in (np.sum(s <= ell), np.sum(s >= s[-1] - ell)):
         assert nodes >= 0.5 * DEFAULT_PER_PHASE
@@ -268,3 +273,24 @@ def test_a_capped_default_grid_is_graded_and_keeps_its_end_transitions(length, a
             and 4 * wanted <= END_SHARE * max_nodes):
         assert np.sum(s <= ell) >= 0.9 * wanted
         assert np.sum(s >= length - ell) >= 0.9 * wanted
+
+
+def test_a_slow_stretch_is_coarse_a_few_transitions_away_from_its_kinks() -> None:
+    # 628 m through six bends, jerk phases of 0.27 s: the bends slow the vehicle to about
+    # 0.7 m/s, where the margin around a kink sized at the top speed (7.3 m) spans some 30
+    # transitions. Counted in metres it kept them all at fine steps and the grid at its node
+    # cap; counted in time (a few transitions) the grid needs a third of it, and cutting every
+    # cell in four moves the duration by less than 1e-6.
+    from speedplan.model import PlanRequest, build_model
+    from speedplan.model.grid import MAX_DEFAULT_NODES
+
+    path = Path.from_waypoints([
+        [0.0, 0.0], [115.841, 19.429], [188.241, -12.719], [289.366, -47.828],
+        [399.486, -92.515], [453.451, -38.052], [574.008, -83.844]])
+    lim = Limits(v_max=13.37, a_max=0.0985, a_lat_max=0.205, j_max=0.36)
+    assert build_model(PlanRequest.create(path, lim)).legs[0].problem.n < MAX_DEFAULT_NODES / 2
+    profile = plan(path, lim)
+    with subdivided_default_grids(4):
+        finer = plan(path, lim)
+    assert profile.verification.ok and finer.verification.ok
+    assert abs(profile.duration / finer.duration - 1.0) < 1e-6

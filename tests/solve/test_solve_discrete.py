@@ -361,9 +361,11 @@ def test_a_relaxation_stopped_short_of_its_optimum_is_polished():
     banded = sp.plan(path, limits, ds=0.01, backend="banded")
     assert ref.status == banded.status == "optimal"
     assert ref.duration == pytest.approx(banded.duration, rel=POLISH_GAP)
-    # Each certificate holds against the other backend's plan.
+    # Each certificate holds against the other backend's plan, Clarabel's within the
+    # polish's tolerance: its polished point may exceed a row by that much (measured: 1.3e-7
+    # shorter than the banded method's bound with clarabel 0.11).
     assert ref.lower_bound <= banded.solution.objective
-    assert banded.lower_bound <= ref.solution.objective * (1 + 1e-9)
+    assert banded.lower_bound <= ref.solution.objective * (1 + POLISH_GAP)
     assert ref.verify().ok
 
 
