@@ -245,6 +245,7 @@ def report(runs: list[tuple[str, dict[str, Any]]]) -> None:
         print(f"\n{label} ({data['speedplan']}):")
         print(f"  fuzz         {_stats(data['fuzz'])}")
         print(f"  all          {_stats(rows)}")
+        print(f"  over 0.5 s   {sum(r['seconds'] > 0.5 for r in rows)} of {len(rows)}")
         print(f"  over 2 s     {sum(r['seconds'] > 2.0 for r in rows)} of {len(rows)}")
         print(f"  outcomes     {_outcomes(data['fuzz'])}")
         slow = sorted(data["fuzz"], key=lambda r: -r["seconds"])[:5]

@@ -46,6 +46,11 @@ __all__ = ["KERNELS", "LATERAL_STARTS", "STARTS", "BandedNlpResult", "Start", "c
 W_FLOOR = 1e-9
 #: Relative width to which a fixed node (``w_min = w_max``) is opened so the barrier exists.
 FIXED_WIDTH = 1e-10
+#: Largest share of a node's own upper bound its lower bound takes where that bound lies under
+#: `W_FLOOR` (the nodes of a stop of micrometres, ``w_max`` of 1e-12): such a node keeps its
+#: room instead of being taken for a fixed one and opened by `FIXED_WIDTH` of the largest
+#: bound, which let ``w`` there exceed its bound 3.5-fold and the plan's jerk 35-fold.
+FLOOR_SHARE = 1e-3
 #: Scaled optimality tolerance (IPOPT's ``tol``) and the one a run stalled by round-off may
 #: stop at (IPOPT's ``acceptable_tol``); the caller checks the rows in any case.
 TOL = 1e-9
@@ -804,12 +809,16 @@ class _FastPhase(_Phase):
 
 
 def _bounds(p: DiscreteProblem) -> tuple[FloatArray, FloatArray]:
-    """Bounds on interior ``w``: ``[max(w_min, W_FLOOR), w_max]``, fixed nodes opened."""
+    """Bounds on interior ``w``: ``[max(w_min, W_FLOOR), w_max]``, fixed nodes opened.
+
+    The floor is at most `FLOOR_SHARE` of a node's own bound, and a fixed node is opened in
+    proportion to its bound: both stay relative at nodes whose bound is tiny (next to a rest).
+    """
     ub = p.w_max[1:-1].astype(np.float64)
-    lb = np.minimum(W_FLOOR * max(1.0, float(np.max(p.w_max))), ub)
+    lb = np.minimum(W_FLOOR * max(1.0, float(np.max(p.w_max))), FLOOR_SHARE * ub)
     if p.w_min is not None:
         lb = np.maximum(lb, p.w_min[1:-1])
-    width = FIXED_WIDTH * np.maximum(1.0, ub)
+    width = FIXED_WIDTH * np.maximum(ub, np.finfo(float).tiny)
     fixed = ub - lb <= width
     return np.where(fixed, np.maximum(lb - width, 0.5 * lb), lb), np.where(fixed, ub + width, ub)
 
