@@ -126,6 +126,13 @@ STANDSTILL_EXPONENT = 0.75
 #: 1-3 nodes long, and ``w``-pieces next to the rest, which cannot follow ``w ∝ s^{4/3}``,
 #: raised the jerk 12 % above ``j_max`` there.
 _ON_JERK_PHASE = 0.5
+#: Fewest nodes next to a rest whose dual cells are built in ``u``, whatever their discrete
+#: jerk. A stop softer than the max-jerk motion (a refined stop whose jerk ramps from 0.07 to
+#: 0.66 ``j_max`` over its last 80 nodes, 0.15 µm) had only its last node's cell in ``u``;
+#: the ``w``-piece next to it cannot follow ``w ∝ d^{4/3}`` and took the jerk to 1.77x
+#: ``j_max``. With two such cells it stays at 0.86x (0.79x on ``w = K d^{4/3}`` at
+#: 0.66 ``j_max``, where one cell gave 1.45x).
+_LEAST_STANDSTILL_NODES = 2
 #: Pieces over which a moving end's correction is spread (20 cells).
 _END_WINDOW = 40
 
@@ -273,8 +280,9 @@ class TimeLaw:
             # A forced stop (start), or its time reversal: the max-jerk motion to rest from a
             # moving state, where u is linear all along: all of it in u.
             return (0, n) if w[0] > 0 else (n, 0)
-        lead = max(1, run(saturated) - 1) if w[0] == 0.0 else 0
-        trail = max(1, run(saturated[::-1]) - 1) if w[-1] == 0.0 else 0
+        least = max(1, min(_LEAST_STANDSTILL_NODES, (n - 1) // 2))  # both ends fit
+        lead = max(least, run(saturated) - 1) if w[0] == 0.0 else 0
+        trail = max(least, run(saturated[::-1]) - 1) if w[-1] == 0.0 else 0
         if lead + trail > n - 1:
             lead = min(lead, n - 1 - trail) if lead else 0
             trail = n - 1 - lead if trail else 0

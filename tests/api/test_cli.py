@@ -134,19 +134,19 @@ def test_stdin_path_and_stdout_trajectory(root):
     assert res.returncode == 2 and "<stdin>" in res.stderr
 
 
-def test_strict_exits_5_on_any_verify_failure(tmp_path):
-    # 27 km with 0.2 um jerk phases, below the finest step a grid resolves: planned on the
-    # relaxation's grid (a named backend), the jerk at the ends exceeds its tolerance (the
-    # trust fuzz's case; plan() flags it).
-    f = tmp_path / "line.json"
-    f.write_text(json.dumps({"segments": [{"type": "line", "length": 27373.408073555755}]}))
-    limits = ["--v-max", "12.217721761422338", "--a-max", "0.05420259524615834",
-              "--a-lat-max", "1", "--j-max", "11.189576218503156"]
-    res = run("plan", str(f), *limits, "--backend", "banded", "--strict")
+def test_strict_exits_5_on_any_verify_failure(root, tmp_path):
+    # Comfort limits on the NURBS edge, planned on the relaxation alone (refine never): the
+    # relaxation is not exact there, and its law exceeds the jerk and lateral-jerk limits
+    # (plan() flags it, status limits_exceeded).
+    limits = ["--v-max", "2", "--a-max", "1", "--a-lat-max", "1", "--j-max", "0.5",
+              "--j-lat-max", "0.3", "--yaw-rate-max", "0.4"]
+    res = run("plan", str(root / "paths" / "nurbs_edge.json"), *limits, "--refine", "never",
+              "--strict", "-o", "t.csv", cwd=tmp_path)
     assert res.returncode == 5, res.stderr
-    # "(--strict): jerk ..." today; "status limits_exceeded; jerk ..." once the planner
-    # reports that status itself: either way exit 5 and the limit named.
     assert "limits exceeded" in res.stderr and "jerk" in res.stderr
+    ok = run("plan", str(root / "paths" / "nurbs_edge.json"), *limits, "--strict", "-o",
+             "t.csv", cwd=tmp_path)
+    assert ok.returncode == 0, ok.stderr
 
 
 def test_verbose_logs_files_to_stderr(root, tmp_path):

@@ -101,6 +101,26 @@ def test_a_stop_with_one_node_off_its_jerk_phase_keeps_its_jerk(dip, at):
     assert np.abs(jerk).max() <= j * (1 + TOLERANCES["jerk"])
 
 
+def test_a_stop_softer_than_the_max_jerk_motion_keeps_its_jerk():
+    # A refined stop of 0.15 µm whose discrete jerk falls from 0.66 j_max at the node next to
+    # the rest to 0.07 j_max 80 nodes before it (as 1 / sqrt(k)), after a constant braking:
+    # one node is near enough j_max to mark the stop's jerk phase. With only the last cell
+    # built in u, the w-piece next to it took the law's jerk to 1.45x j_max (1.77x on a
+    # 250 m comfort plan).
+    j, h, nodes = 14.7, 2.5e-9, 160
+    k = np.arange(nodes + 1)
+    jd = np.where(k <= 80, 0.66 / np.sqrt(np.maximum(k, 1)), 0.0)  # from the rest
+    w = np.zeros(nodes + 1)  # w[k] at k steps from the rest
+    w[1] = 0.66 ** (2 / 3) * float(max_jerk_envelope(np.array([h]), j)[0])
+    for i in range(1, nodes):
+        w[i + 1] = 2 * w[i] - w[i - 1] + h * h * 2 * jd[i] * j / np.sqrt(w[i])
+    d = h * k[::-1]
+    law = TimeLaw(d[0] - d, w[::-1], j_max=j)
+    q = np.linspace(d[0] - 30 * h, d[0], 30_001)[:-1]  # the rest itself: 0 / 0
+    jerk = law.kinematics(q)[3]
+    assert np.abs(jerk).max() <= j * (1 + TOLERANCES["jerk"])
+
+
 def test_prescribed_end_accelerations_are_met_exactly():
     s = np.linspace(0, 5, 11)
     w = (1.0 + 0.1 * s) ** 2
