@@ -278,3 +278,28 @@ def test_a_comfort_plan_keeps_its_jerk_in_a_final_stop_of_micrometres(name):
     dt = t[1] - t[0]
     jerk = np.diff(profile.at(t).v, 2) / dt**2
     assert np.abs(jerk).max() <= lim.j_max * (1 + PROMISED["jerk"])
+
+
+def test_a_plan_is_never_faster_than_its_own_certified_bound():
+    # A 42 m comfort plan whose relaxation met every row to within 0.2 % of its bound: its
+    # point was 1.2e-5 faster than the relaxation's certified bound (both backends), i.e. it
+    # used the rows' tolerance, and came back `optimal` with a negative gap. Such a point is
+    # refined to a feasible one: every jerk row holds and the gap is not negative.
+    from speedplan.model import PlanRequest, build_model
+    from speedplan.solve import solve_problem
+    from speedplan.solve.discrete import POLISH_GAP
+
+    path = Path.from_waypoints([
+        [0.0, 0.0], [5.843053088630176, -6.554087750020724],
+        [11.01476252902381, -6.822320033900803], [18.05009107774361, -7.785480164728721],
+        [30.714976071273668, -3.0728913916473624], [38.31706462011247, -0.49852040880524395]])
+    lim = Limits(v_max=6.1263329862193725, a_max=0.6007151722307961,
+                 a_lat_max=1.202760520676912, j_max=0.12887742409994607,
+                 j_lat_max=0.9766649105915803, yaw_rate_max=1.048973456814916)
+    (leg,) = build_model(PlanRequest.create(path, lim)).legs
+    for backend in ("banded", "clarabel"):
+        sol = solve_problem(leg.problem, backend=backend)
+        assert sol.objective >= sol.lower_bound * (1 - POLISH_GAP)
+        assert leg.problem.jerk_violation(sol.w) <= leg.problem.jerk_tol
+    profile = plan(path, lim)
+    assert profile.gap >= -POLISH_GAP and profile.verification.ok
