@@ -255,7 +255,8 @@ class TimeLaw:
 
         At an end at rest (smooth standstill), the nodes whose discrete jerk is at least
         `_ON_JERK_PHASE` ``j_max`` are the max-jerk start (stop); the ``u``-region covers them
-        but the last two, so the junction to ``w`` lies inside that phase, away from its end.
+        but the last two, so the junction to ``w`` lies inside that phase, away from its end,
+        and at least `_LEAST_STANDSTILL_NODES` nodes whatever their jerk.
         """
         w, n = np.maximum(self.w, 0.0), self.s.size
         if self.j_max is None or not np.isfinite(self.j_max) or n < 3:

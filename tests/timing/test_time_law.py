@@ -85,7 +85,8 @@ def test_a_stop_with_one_node_off_its_jerk_phase_keeps_its_jerk(dip, at):
     # A refined solution's stop of 2.4 µm: its discrete jerk sqrt(w) w'' / 2 is j_max at every
     # node of the final phase but one (a node `at` steps from the rest at `dip` j_max), after
     # a constant braking. The stop is still one jerk phase: built in w from that node on, the
-    # law reached 1.16-2.2x j_max next to the rest (1.19x on a 188 m comfort plan).
+    # law reached 1.16-2.2x j_max next to the rest with the node 3 or 4 steps from it (1.19x
+    # on a 188 m comfort plan).
     j, h, nodes = 3.9, 4e-8, 120
     jd = np.where(np.arange(nodes + 1) <= 60, 1.0, 0.0)  # discrete jerk / j_max, from the rest
     jd[at] = dip
