@@ -511,13 +511,13 @@ class _StepRule:
         # pass sums A h along the path, so it is linear (or meets a constant bound) only to
         # ~1e-16 of that sum, which on a long slow move is far above 1e-12 of the bound.
         top = max(float(np.max(wb)), 1e-300)
-        tol = 1e-9 * top + 1e-15 * 2.0 * max(self.a_max, self.a_decel) * self.length
+        rounding = 1e-15 * 2.0 * max(self.a_max, self.a_decel) * self.length
         flat = np.zeros(sf.size, dtype=bool)
         d_left, d_right = np.diff(w_est)[:-1], np.diff(w_est)[1:]
         cells = np.diff(sf)
         curv = np.abs(d_right / cells[1:] - d_left / cells[:-1]) * np.minimum(cells[1:],
                                                                              cells[:-1])
-        flat[1:-1] = curv <= tol
+        flat[1:-1] = curv <= 1e-9 * top + rounding
         out: np.ndarray = _distance_to(~flat, sf) > self.margin
         # The margin in metres is sized at the top speed: at a hairpin's or a zone's low
         # speed it spans many transitions (7 m at 1 m/s with t_j = 0.27 s is 27 of them),
@@ -526,7 +526,7 @@ class _StepRule:
         # 1e-9 of the local w: a bound curving gently at a low speed is not a cruise.
         local = np.maximum(np.maximum(w_est[:-2], w_est[2:]), w_est[1:-1])
         straight = np.zeros(sf.size, dtype=bool)
-        straight[1:-1] = curv <= tol - 1e-9 * top + 1e-9 * local
+        straight[1:-1] = curv <= 1e-9 * local + rounding
         v = np.sqrt(w_est)
         with np.errstate(divide="ignore"):
             t = np.concatenate(([0.0], np.cumsum(2.0 * cells / (v[1:] + v[:-1]))))

@@ -11,7 +11,7 @@ import pathlib
 
 import numpy as np
 import pytest
-from oracles import PROMISED, corner_reversals
+from oracles import PROMISED, corner_reversals, measure, no_jerk_lower_bound, within_promise
 
 from speedplan import Limits, Path, plan
 
@@ -285,6 +285,7 @@ def test_a_plan_is_never_faster_than_its_own_certified_bound():
     # point was 1.2e-5 faster than the relaxation's certified bound (both backends), i.e. it
     # used the rows' tolerance, and came back `optimal` with a negative gap. Such a point is
     # refined to a feasible one: every jerk row holds and the gap is not negative.
+    from speedplan.geometry import SpeedBound
     from speedplan.model import PlanRequest, build_model
     from speedplan.solve import solve_problem
     from speedplan.solve.discrete import POLISH_GAP
@@ -303,3 +304,9 @@ def test_a_plan_is_never_faster_than_its_own_certified_bound():
         assert leg.problem.jerk_violation(sol.w) <= leg.problem.jerk_tol
     profile = plan(path, lim)
     assert profile.gap >= -POLISH_GAP and profile.verification.ok
+    # Physics, independently: the sampled trajectory within every limit, and no faster than
+    # the exact optimum without a jerk limit.
+    assert within_promise(measure(profile))
+    fastest, _, _ = no_jerk_lower_bound(SpeedBound(path, lim), path.length, lim.a_max,
+                                        lim.a_decel)
+    assert profile.duration >= fastest
