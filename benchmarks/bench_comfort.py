@@ -114,9 +114,11 @@ def _finer_default_grids(factor: float):
 
     The reference converges with the default grid's own family: a uniform grid with as many
     nodes is far coarser in the jerk transitions (5e-4 short of the converged duration at
-    twice the default grid's nodes on a corner path, measured).
+    twice the default grid's nodes on a corner path, measured). The planning strategy's
+    coarser grids are off meanwhile, so that a stalled solve is not answered on a coarser grid.
     """
     import speedplan.model as model_pkg
+    from speedplan import strategy
 
     grid = importlib.import_module("speedplan.model.grid")
     original = grid.adaptive_grid
@@ -131,9 +133,11 @@ def _finer_default_grids(factor: float):
              and getattr(m, "adaptive_grid", None) is original]
     for m in users:
         m.adaptive_grid = finer
+    coarser, strategy.COARSER_GRIDS = strategy.COARSER_GRIDS, ()
     try:
         yield
     finally:
+        strategy.COARSER_GRIDS = coarser
         for m in users:
             m.adaptive_grid = original
 

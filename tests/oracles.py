@@ -287,19 +287,23 @@ def subdivided_default_grids(k: int) -> Iterator[None]:
     """``plan()``'s default grids with every cell cut into ``k`` equal steps.
 
     The reference of a convergence check: the same grid family, ``k`` times finer everywhere
-    (Richardson's extrapolation over ``k = 2, 4`` gives the converged duration).
+    (Richardson's extrapolation over ``k = 2, 4`` gives the converged duration). The planning
+    strategy's coarser grids are off meanwhile: where a solver stalls on the finer grid, the
+    other backend answers on that same grid, instead of a coarser grid that the reference
+    would silently compare with itself.
     """
+    from speedplan import strategy
     from speedplan.model import leg_grid
 
-    original = leg_grid.default_grid
+    original, coarser = leg_grid.default_grid, strategy.COARSER_GRIDS
 
     def finer(*args, **kw):
         s = original(*args, **kw)
         inner = (s[:-1, None] + np.diff(s)[:, None] * (np.arange(k) / k)[None, :]).ravel()
         return np.append(inner, s[-1])
 
-    leg_grid.default_grid = finer
+    leg_grid.default_grid, strategy.COARSER_GRIDS = finer, ()
     try:
         yield
     finally:
-        leg_grid.default_grid = original
+        leg_grid.default_grid, strategy.COARSER_GRIDS = original, coarser

@@ -59,6 +59,9 @@ __all__ = [
     "MIN_NODES",
     "MIN_RELATIVE_STEP",
     "PAD_CELLS",
+    "SHAPE_SAG",
+    "SMOOTH_ACCELERATION",
+    "SMOOTH_JERK",
     "TOP_SPEED_PROBES",
     "adaptive_grid",
     "dips_between",
@@ -125,6 +128,16 @@ TOP_SPEED_PROBES = 2001
 #: margin in metres, which is sized at the top speed). The jerk-limited law leaves the
 #: no-jerk one within a transition of each kink (at most ``t_j`` per jerk phase).
 CRUISE_MARGIN_TIME = 3.0
+#: A curved stretch of the no-jerk profile is smooth (`adaptive_grid` steps it by its shape,
+#: `SHAPE_SAG`, not by its jerk transitions) farther than `CRUISE_MARGIN_TIME` ``t_j`` in
+#: time from every point where following it takes more than this fraction of ``j_max``...
+SMOOTH_JERK = 0.25
+#: ... or more than this fraction of the acceleration limits (the law leaves the bound
+#: where following it would take more than ``a_max``).
+SMOOTH_ACCELERATION = 0.9
+#: Largest sag of a chord under a smooth stretch of the no-jerk profile, relative to ``w``:
+#: the steps there resolve the bound's shape.
+SHAPE_SAG = 1e-6
 #: Largest step inside long constant-bound stretches, as a fraction of the length: nothing
 #: changes there, the steps only grow (by `CRUISE_GRADING` per node) from the fine
 #: transitions on either side.
@@ -481,8 +494,9 @@ class _StepRule:
         lam = self.scale(np.sqrt(w_est))
         h = np.maximum(np.maximum(lam, np.where(_end_runs(lam < self.floor), self.floor, 0.0))
                        / self.per_phase, MIN_RELATIVE_STEP * length)
-        far = self._cruise(sf, w_est, wb)
+        far, smooth = self._stretches(sf, w_est, wb)
         h = np.where(far, np.maximum(h, CRUISE_STEP * length), h)
+        h = np.where(smooth, np.maximum(h, self._shape_step(sf, w_est)), h)
         if self.anchors is not None:
             # Room for MIN_ANCHOR_NODES steps between neighbouring anchors, so that each one
             # is a node (`nodes_from_steps` skips an anchor closer than that to the last).
@@ -504,21 +518,34 @@ class _StepRule:
         return largest_under_rates(wb, np.full(sf.size - 1, 2 * self.a_max) * hf,
                                    np.full(sf.size - 1, 2 * self.a_decel) * hf)
 
-    def _cruise(self, sf: FloatArray, w_est: FloatArray, wb: FloatArray) -> np.ndarray:
-        """Where ``sf`` lies farther than ``margin`` from any kink of the no-jerk profile."""
-        # Long stretches where the no-jerk optimum is linear in w (a cruise, a constant
-        # acceleration or braking) hold nothing to resolve: coarse, graded faster. The no-jerk
-        # pass sums A h along the path, so it is linear (or meets a constant bound) only to
-        # ~1e-16 of that sum, which on a long slow move is far above 1e-12 of the bound.
+    def _stretches(self, sf: FloatArray, w_est: FloatArray, wb: FloatArray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """Cruise and smooth stretches of ``sf``: far from every kink of the no-jerk profile.
+
+        *Cruise*: where the profile is linear in ``w`` (a cruise, a constant acceleration
+        or braking) farther than ``margin`` in metres, or `CRUISE_MARGIN_TIME` ``t_j`` in
+        time, from where it is not. *Smooth*: not cruise, and farther than
+        `CRUISE_MARGIN_TIME` ``t_j`` in time from every point where following the profile
+        asks for more than `SMOOTH_JERK` ``j_max`` or `SMOOTH_ACCELERATION` of the
+        acceleration limits (a bound the law follows: a clothoid at its yaw-rate or
+        lateral limit).
+        """
+        # The no-jerk pass sums A h along the path, so it is linear (or meets a constant
+        # bound) only to ~1e-16 of that sum, which on a long slow move is far above 1e-12 of
+        # the bound.
         top = max(float(np.max(wb)), 1e-300)
         rounding = 1e-15 * 2.0 * max(self.a_max, self.a_decel) * self.length
-        flat = np.zeros(sf.size, dtype=bool)
-        d_left, d_right = np.diff(w_est)[:-1], np.diff(w_est)[1:]
         cells = np.diff(sf)
-        curv = np.abs(d_right / cells[1:] - d_left / cells[:-1]) * np.minimum(cells[1:],
-                                                                             cells[:-1])
-        flat[1:-1] = curv <= 1e-9 * top + rounding
-        out: np.ndarray = _distance_to(~flat, sf) > self.margin
+        slope = np.diff(w_est) / cells
+        bend = np.abs(np.diff(slope)) * np.minimum(cells[1:], cells[:-1])
+        flat = np.zeros(sf.size, dtype=bool)
+        flat[1:-1] = bend <= 1e-9 * top + rounding
+        cruise: np.ndarray = _distance_to(~flat, sf) > self.margin
+        v = np.sqrt(w_est)
+        with np.errstate(divide="ignore"):
+            t = np.concatenate(([0.0], np.cumsum(2.0 * cells / (v[1:] + v[:-1]))))
+        if not np.isfinite(t[-1]):
+            return cruise, np.zeros(sf.size, dtype=bool)
         # The margin in metres is sized at the top speed: at a hairpin's or a zone's low
         # speed it spans many transitions (7 m at 1 m/s with t_j = 0.27 s is 27 of them),
         # all at fine steps. Measured in time along the no-jerk profile, a jerk-limited
@@ -526,12 +553,36 @@ class _StepRule:
         # 1e-9 of the local w: a bound curving gently at a low speed is not a cruise.
         local = np.maximum(np.maximum(w_est[:-2], w_est[2:]), w_est[1:-1])
         straight = np.zeros(sf.size, dtype=bool)
-        straight[1:-1] = curv <= 1e-9 * local + rounding
-        v = np.sqrt(w_est)
+        straight[1:-1] = bend <= 1e-9 * local + rounding
+        margin = CRUISE_MARGIN_TIME * self.t_j
+        cruise |= _distance_to(~straight, t) > margin
+        # Following a curved bound needs a jerk (v w'' / 2) and an acceleration (w' / 2):
+        # where both lie well inside the limits, the law follows it too, and its jerk
+        # phases lie at the kinks, where either is large or the bound is left.
+        accel = 0.5 * np.concatenate(([slope[0]], np.maximum(np.abs(slope[:-1]),
+                                                               np.abs(slope[1:])), [slope[-1]]))
+        limit = np.where(np.concatenate(([slope[0]], slope[:-1] + slope[1:], [slope[-1]])) > 0,
+                         self.a_max, self.a_decel)
+        jerk = np.zeros(sf.size)
+        jerk[1:-1] = 0.5 * np.abs(np.diff(slope)) * v[1:-1] / (0.5 * (cells[1:] + cells[:-1]))
+        gentle = (jerk <= SMOOTH_JERK * self.j_max) & (np.abs(accel) <= SMOOTH_ACCELERATION * limit)
+        gentle[[0, -1]] = False
+        smooth = ~cruise & (_distance_to(~(straight | gentle), t) > margin)
+        return cruise, smooth
+
+    def _shape_step(self, sf: FloatArray, w_est: FloatArray) -> FloatArray:
+        """Steps whose chords sag at most `SHAPE_SAG` of ``w`` below a curved ``w``.
+
+        ``h² |w''| / 8 <= SHAPE_SAG w``, and at most `CRUISE_STEP` of the length.
+        """
+        cells = np.diff(sf)
+        slope = np.diff(w_est) / cells
+        curve = np.zeros(sf.size)
+        curve[1:-1] = np.abs(np.diff(slope)) / (0.5 * (cells[1:] + cells[:-1]))
+        curve[0], curve[-1] = curve[1], curve[-2]
         with np.errstate(divide="ignore"):
-            t = np.concatenate(([0.0], np.cumsum(2.0 * cells / (v[1:] + v[:-1]))))
-        if np.isfinite(t[-1]):
-            out |= _distance_to(~straight, t) > CRUISE_MARGIN_TIME * self.t_j
+            step = np.sqrt(8.0 * SHAPE_SAG * w_est / curve)
+        out: FloatArray = np.minimum(step, CRUISE_STEP * self.length)
         return out
 
 

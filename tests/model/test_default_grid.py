@@ -280,7 +280,7 @@ def test_a_slow_stretch_is_coarse_a_few_transitions_away_from_its_kinks() -> Non
     # 0.7 m/s, where the margin around a kink sized at the top speed (7.3 m) spans some 30
     # transitions. Counted in metres it kept them all at fine steps and the grid at its node
     # cap; counted in time (a few transitions) the grid needs a third of it, and cutting every
-    # cell in four moves the duration by less than 1e-6.
+    # cell in two moves the duration by less than 1e-6.
     from speedplan.model import PlanRequest, build_model
     from speedplan.model.grid import MAX_DEFAULT_NODES
 
@@ -290,7 +290,27 @@ def test_a_slow_stretch_is_coarse_a_few_transitions_away_from_its_kinks() -> Non
     lim = Limits(v_max=13.37, a_max=0.0985, a_lat_max=0.205, j_max=0.36)
     assert build_model(PlanRequest.create(path, lim)).legs[0].problem.n < MAX_DEFAULT_NODES / 2
     profile = plan(path, lim)
-    with subdivided_default_grids(4):
+    with subdivided_default_grids(2):
         finer = plan(path, lim)
+    assert finer.legs[0].s.size > 1.9 * profile.legs[0].s.size  # answered on the finer grid
+    assert profile.verification.ok and finer.verification.ok
+    assert abs(profile.duration / finer.duration - 1.0) < 1e-6
+
+
+def test_a_bound_followed_with_little_jerk_is_stepped_by_its_shape() -> None:
+    # A right-angle corner at a yaw rate of 0.3 rad/s: along its clothoids the speed follows
+    # the bound ω/κ(s) down to 0.17 m/s, which takes 1–10 % of j_max = 20 m/s³. Its jerk
+    # phases (25 ms) span millimetres there; stepped by them along the whole bound, the grid
+    # had 10 486 nodes. Stepped by the bound's shape a few phases away from its kinks it needs
+    # far fewer, and cutting every cell in two moves the duration by less than 1e-6.
+    from speedplan.model import PlanRequest, build_model
+
+    path = Path.from_waypoints([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])
+    lim = Limits(v_max=5.0, a_max=0.5, a_lat_max=1.0, j_max=20.0, yaw_rate_max=0.3)
+    assert build_model(PlanRequest.create(path, lim)).legs[0].problem.n < 8_000
+    profile = plan(path, lim)
+    with subdivided_default_grids(2):
+        finer = plan(path, lim)
+    assert finer.legs[0].s.size > 1.9 * profile.legs[0].s.size  # answered on the finer grid
     assert profile.verification.ok and finer.verification.ok
     assert abs(profile.duration / finer.duration - 1.0) < 1e-6
