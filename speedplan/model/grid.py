@@ -59,6 +59,8 @@ __all__ = [
     "MIN_NODES",
     "MIN_RELATIVE_STEP",
     "PAD_CELLS",
+    "PRE_GRID_APART",
+    "PRE_GRID_POINTS",
     "SHAPE_SAG",
     "SMOOTH_ACCELERATION",
     "SMOOTH_JERK",
@@ -138,6 +140,11 @@ SMOOTH_ACCELERATION = 0.9
 #: Largest sag of a chord under a smooth stretch of the no-jerk profile, relative to ``w``:
 #: the steps there resolve the bound's shape.
 SHAPE_SAG = 1e-6
+#: Most points of the uniform part of the pre-grid on which `adaptive_grid` evaluates its
+#: steps (four per end transition ``ℓ`` where that is fewer), before refining it where the
+#: steps are finer than its cells. Evaluating the steps on 200 001 points took 0.4 s of a
+#: 0.6 s plan with 6 600 nodes; on 20 001 and refined, the grid has the same steps to 0.1 %.
+PRE_GRID_POINTS = 20_001
 #: Largest step inside long constant-bound stretches, as a fraction of the length: nothing
 #: changes there, the steps only grow (by `CRUISE_GRADING` per node) from the fine
 #: transitions on either side.
@@ -431,9 +438,11 @@ def adaptive_grid(
     extra = extra[(extra > 0.0) & (extra < length)]
     if extra.size:
         rule = replace(rule, kinks=np.concatenate(([0.0], np.sort(extra), [length])))
-    sf = _pre_grid(length, rule.floor, np.union1d(inner_anchors, extra))
+    kept = np.union1d(inner_anchors, extra)
+    sf = _pre_grid(length, rule.floor, kept)
     if breakpoints is not None:
         sf = np.union1d(sf, hidden_dips(sf, np.asarray(breakpoints, dtype=np.float64), w_bound))
+    sf = _apart(sf, kept)
     sf, h, rate = _followed(sf, rule)
     if rule.anchors is not None and float(np.sum(_count(sf, h))) > max_nodes - 1:
         # At the node cap the room for every anchor takes nodes from the jerk transitions: the
@@ -448,7 +457,6 @@ def adaptive_grid(
     zone = 2.0 * rule.floor if 2.0 * rule.floor <= END_ZONE * length else 0.0
     ends = (sf <= zone) | (sf >= length - zone)
     h = _capped(sf, h, rate, length, max_nodes, ends)
-    kept = np.union1d(inner_anchors, extra)
     grid = nodes_from_steps(sf, h, kept if kept.size else None)
     grid_size("n", grid.size)
     return grid
@@ -589,13 +597,37 @@ class _StepRule:
 def _pre_grid(length: float, floor: float, anchors: FloatArray) -> FloatArray:
     """Uniform, with geometric clusters at both ends and the anchors.
 
-    The ends are where the standstill and the boundary states put the shortest transitions.
+    The ends are where the standstill and the boundary states put the shortest transitions;
+    elsewhere `_followed` refines the pre-grid where the steps need it.
     """
-    n_pre = int(np.clip(4 * length / max(floor, 1e-12), 2001, 200_001))
+    n_pre = int(np.clip(4 * length / max(floor, 1e-12), 2001, PRE_GRID_POINTS))
     ends = np.geomspace(max(floor / 8.0, 1e-12 * length), 0.5 * length, 200)
     sf = np.unique(np.concatenate((np.linspace(0.0, length, n_pre), ends, length - ends,
                                    anchors)))
     out: FloatArray = sf[(sf >= 0.0) & (sf <= length)]
+    return out
+
+
+#: Points of a pre-grid closer than this fraction of the length are one point (see `_apart`).
+PRE_GRID_APART = 1e-13
+
+
+def _apart(sf: FloatArray, kept: FloatArray) -> FloatArray:
+    """The sorted pre-grid ``sf`` without points a few ulps from the one before.
+
+    The uniform points, the end clusters, the anchors and the breakpoints can meet at one
+    position (the middle of a symmetric path) within a few ulps. On the cell between such
+    points the profile's slope is rounding, and a kink of the no-jerk profile there passed
+    for linear: its jerk transition was stepped as a cruise. Of two such points the one in
+    ``kept`` (anchors: they must stay points) and the ends stay.
+    """
+    close = np.flatnonzero(np.diff(sf) <= PRE_GRID_APART * float(sf[-1] - sf[0]))
+    if close.size == 0:
+        return sf
+    special = np.isin(sf, kept)
+    special[[0, -1]] = True
+    drop = np.where(special[close + 1], close, close + 1)
+    out: FloatArray = np.delete(sf, drop[~special[drop]])
     return out
 
 

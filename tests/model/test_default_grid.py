@@ -314,3 +314,24 @@ def test_a_bound_followed_with_little_jerk_is_stepped_by_its_shape() -> None:
     assert finer.legs[0].s.size > 1.9 * profile.legs[0].s.size  # answered on the finer grid
     assert profile.verification.ok and finer.verification.ok
     assert abs(profile.duration / finer.duration - 1.0) < 1e-6
+
+
+@pytest.mark.parametrize("points", [20_001, 200_001])
+def test_a_kink_on_points_a_few_ulps_apart_is_stepped_as_a_kink(monkeypatch, points) -> None:
+    # A symmetric move peaks at its middle, where the uniform points and both end clusters of
+    # the pre-grid meet within a few ulps. The no-jerk profile's kink on that 1e-16 m cell
+    # passed for linear, and the top-speed transition (jerk phases of 6.6 ms, 2.3 mm at
+    # 0.345 m/s) got a cruise step of 18 mm (3.9e-6 of the duration) with 200 001 points.
+    from speedplan.model import PlanRequest, build_model, grid
+
+    monkeypatch.setattr(grid, "PRE_GRID_POINTS", points)
+    path = Path.from_waypoints([[0.0, 0.0], [0.9, 0.05], [1.8, 0.0]])
+    lim = Limits(v_max=0.9, a_max=0.0648, a_lat_max=0.1566, j_max=9.77)
+    profile = plan(path, lim)
+    s = profile.legs[0].s
+    w = profile.legs[0].solution.w
+    top = int(np.argmax(w))
+    v = float(np.sqrt(w[top]))
+    transition = v * min(lim.a_max / lim.j_max, np.sqrt(v / lim.j_max))
+    assert np.diff(s)[top - 1:top + 1].max() < 4 * transition / grid.DEFAULT_PER_PHASE
+    assert build_model(PlanRequest.create(path, lim)).legs[0].problem.n == s.size
