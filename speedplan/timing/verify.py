@@ -473,8 +473,8 @@ def check_pieces(law: SpeedLaw, offset: float, path: Path,
 
 def _local_breaks(breaks: FloatArray, offset: float, length: float) -> FloatArray:
     """The breakpoints inside ``[offset, offset + length]``, in the leg's arc length."""
-    out: FloatArray = np.clip(breaks[(breaks >= offset) & (breaks <= offset + length)] - offset,
-                              0.0, length)
+    inside = breaks[(breaks >= offset) & (breaks <= offset + length)] - offset
+    out: FloatArray = np.minimum(np.maximum(inside, 0.0), length)  # np.clip, without its dispatch
     return out
 
 
@@ -506,10 +506,66 @@ def check_linear_law(law: TimeLaw, offset: float, path: Path,
     first along the path is reported, as there. A piece is flagged for refinement when it
     holds a point beyond a tolerance, as there. ``None`` where a value is not finite (a bound
     of 0, a NaN): `check_pieces` reports it.
+
+    Each quantity is one array over the points followed by the breakpoints (the order in
+    which ties are resolved), so that a plan of a few nodes pays few numpy calls; the scalars
+    read at the peaks are Python floats (the same IEEE operations as on numpy scalars).
     """
     s, w = law.s, np.maximum(law.w, 0.0)
-    n = s.size
     local = _local_breaks(breaks, offset, law.length)
+    points, kappa, wb = _linear_samples(s, local, offset, path, bound, samples)
+    m = points.size  # the points come first in every array below, then the breakpoints
+    dw, h = w[1:] - w[:-1], s[1:] - s[:-1]
+    w_all = _chord_values(s, w, dw, h, local)
+    k_abs = np.abs(kappa)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        speed2 = w_all / wb
+    lateral = k_abs * w_all
+    yaw2 = k_abs * lateral
+    accel = 0.5 * (dw / h)  # constant on each cell, both its pieces
+    # Where a limit is not set only the maximum is reported: any of its points will do.
+    k_v = _first_peak(speed2, m, points)
+    k_lat = _first_peak(lateral, m, points if math.isfinite(limits.a_lat_max) else None)
+    k_yaw = _first_peak(yaw2, m, points if math.isfinite(limits.yaw_rate_max) else None)
+    if k_v is None or k_lat is None or k_yaw is None or not np.isfinite(accel).all():
+        return None
+    glob = np.concatenate((points, local)) if local.size else points
+    first = offset + float(points[0])
+    found = {"speed": (math.sqrt(float(w_all.max())),
+                       math.sqrt(float(w_all[k_v])) / math.sqrt(float(wb[k_v])),
+                       offset + float(glob[k_v]))}
+    for name, top, k, limit in (
+            ("lateral", float(lateral[k_lat]), k_lat, limits.a_lat_max),
+            ("yaw_rate", float(k_abs[k_yaw]) * math.sqrt(float(w_all[k_yaw])), k_yaw,
+             limits.yaw_rate_max)):  # |κ| v where κ² w peaks
+        found[name] = ((top, top / limit, offset + float(glob[k])) if math.isfinite(limit)
+                       else (top, 0.0, first))
+    for name in ("lateral_jerk", "grip"):  # not set for such a law: reported as 0
+        found[name] = (0.0, 0.0, first)
+    knots = law.knots
+    i_acc, i_dec = int(accel.argmax()), int(accel.argmin())  # the first of any ties
+    for name, i, top, limit in (("accel", i_acc, float(accel[i_acc]), limits.a_max),
+                                ("decel", i_dec, -float(accel[i_dec]), limits.a_decel),
+                                ("jerk", 0, 0.0, limits.j_max)):  # no jerk on the chords
+        found[name] = (max(top, 0.0), max(top / limit, 0.0) if math.isfinite(limit) else 0.0,
+                       offset + 0.5 * (float(knots[2 * i]) + float(knots[2 * i + 1])))
+    check = _verification(found, limits)
+    excess = np.zeros(knots.size - 1, dtype=bool)
+    if not check.ok:
+        _flag_linear(excess, knots, local, accel, limits,
+                     (np.sqrt(speed2[:m]), np.sqrt(speed2[m:])), (lateral[:m], lateral[m:]),
+                     (yaw2[:m], yaw2[m:]))
+    return LegCheck(check, excess, knots)
+
+
+def _linear_samples(s: FloatArray, local: FloatArray, offset: float, path: Path,
+                    bound: Callable[[FloatArray], FloatArray], samples: CellSamples | None
+                    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The `cell_points` of ``s``, and the curvature and bound there and at ``local``.
+
+    The curvature and the bound are one array each: the points, then the breakpoints
+    ``local``. From ``samples`` where they hold them (evaluated by the model), else computed.
+    """
     if (samples is not None and samples.offset == offset
             and (samples.s is s or np.array_equal(samples.s, s))):
         points, kappa, wb = samples.points, samples.curvature, samples.bound
@@ -517,87 +573,56 @@ def check_linear_law(law: TimeLaw, offset: float, path: Path,
         samples = None
         points = cell_points(s)
         kappa, wb = _path_values(offset + points, path, bound)
+    if not local.size:
+        return points, kappa, wb
     if samples is not None and np.array_equal(samples.extra, local):
         kappa_b, wb_b = samples.extra_curvature, samples.extra_bound
     else:
         kappa_b, wb_b = _path_values(offset + local, path, bound)
-    dw, h = w[1:] - w[:-1], s[1:] - s[:-1]
-    w_pts = np.empty(points.size)  # w on the chords, in the order of cell_points
-    w_nodes, w_inner = cell_rows(w_pts)
+    return points, np.concatenate((kappa, kappa_b)), np.concatenate((wb, wb_b))
+
+
+def _chord_values(s: FloatArray, w: FloatArray, dw: FloatArray, h: FloatArray,
+                  local: FloatArray) -> FloatArray:
+    """``w`` on the chords at the `cell_points` of ``s``, then at the breakpoints ``local``."""
+    n, m = s.size, CELL_POINTS * (s.size - 1) + 1
+    out = np.empty(m + local.size)
+    w_nodes, w_inner = cell_rows(out[:m])
     w_nodes[:] = w
-    np.multiply((np.arange(1, CELL_POINTS) / CELL_POINTS)[:, None], dw, out=w_inner)
+    np.multiply(_CHORD_FRACTIONS, dw, out=w_inner)
     w_inner += w[:-1]
-    cell = np.minimum(np.maximum(np.searchsorted(s, local, side="right") - 1, 0), n - 2)
-    w_b = np.maximum(w[cell] + dw[cell] * ((local - s[cell]) / h[cell]), 0.0)
-    k_abs, k_abs_b = np.abs(kappa), np.abs(kappa_b)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        speed2 = (w_pts / wb, w_b / wb_b)
-    lateral = (k_abs * w_pts, k_abs_b * w_b)
-    yaw2 = (k_abs * lateral[0], k_abs_b * lateral[1])
-    accel = 0.5 * (dw / h)  # constant on each cell, both its pieces
-    # Where a limit is not set only the maximum is reported: any of its points will do.
-    k_v, k_lat, k_yaw = (_first_peak(x, points, locate) for x, locate in (
-        (speed2, True), (lateral, math.isfinite(limits.a_lat_max)),
-        (yaw2, math.isfinite(limits.yaw_rate_max))))
-    if k_v is None or k_lat is None or k_yaw is None or not np.isfinite(accel).all():
-        return None
-    first = float(offset + points[0])
-    glob = (points, local)  # leg arc length: `offset` added where read
-    top_w = max(float(w_pts.max()), float(w_b.max()) if w_b.size else 0.0)
-    found = {"speed": (float(np.sqrt(top_w)),
-                       float(np.sqrt(_at((w_pts, w_b), k_v)) / np.sqrt(_at((wb, wb_b), k_v))),
-                       offset + _at(glob, k_v))}
-    for name, top, k, limit in (
-            ("lateral", _at(lateral, k_lat), k_lat, limits.a_lat_max),
-            ("yaw_rate", _at((k_abs, k_abs_b), k_yaw) * float(np.sqrt(_at((w_pts, w_b), k_yaw))),
-             k_yaw, limits.yaw_rate_max)):  # |κ| v where κ² w peaks
-        found[name] = ((top, top / limit, offset + _at(glob, k)) if math.isfinite(limit)
-                       else (top, 0.0, first))
-    for name in ("lateral_jerk", "grip"):  # not set for such a law: reported as 0
-        found[name] = (0.0, 0.0, first)
-    knots = law.knots
-    i_acc, i_dec = int(np.argmax(accel)), int(np.argmin(accel))  # the first of any ties
-    for name, i, top, limit in (("accel", i_acc, float(accel[i_acc]), limits.a_max),
-                                ("decel", i_dec, -float(accel[i_dec]), limits.a_decel),
-                                ("jerk", 0, 0.0, limits.j_max)):  # no jerk on the chords
-        found[name] = (max(top, 0.0), max(top / limit, 0.0) if math.isfinite(limit) else 0.0,
-                       float(offset + 0.5 * (knots[2 * i] + knots[2 * i + 1])))
-    check = _verification(found, limits)
-    excess = np.zeros(knots.size - 1, dtype=bool)
-    if not check.ok:
-        _flag_linear(excess, knots, local, accel, limits,
-                     (np.sqrt(speed2[0]), np.sqrt(speed2[1])), lateral, yaw2)
-    return LegCheck(check, excess, knots)
+    if local.size:
+        cell = np.minimum(np.maximum(np.searchsorted(s, local, side="right") - 1, 0), n - 2)
+        np.maximum(w[cell] + dw[cell] * ((local - s[cell]) / h[cell]), 0.0, out=out[m:])
+    return out
 
 
-def _first_peak(parts: tuple[FloatArray, FloatArray], points: FloatArray,
-                locate: bool = True) -> tuple[int, int] | None:
-    """Where the largest value lies: ``(0, i)`` at ``points[i]``, ``(1, i)`` at breakpoint ``i``.
+#: The fractions ``k / CELL_POINTS`` of a cell at its inner points, one row each.
+_CHORD_FRACTIONS = (np.arange(1, CELL_POINTS) / CELL_POINTS)[:, None]
+_CHORD_FRACTIONS.flags.writeable = False
 
-    Among equal values the first along the path, points before breakpoints (the order of
-    `check_pieces`); any of them unless ``locate``. ``None`` if a value is not finite.
+
+def _first_peak(values: FloatArray, m: int, points: FloatArray | None) -> int | None:
+    """Where the largest of ``values`` lies (points ``[:m]``, then breakpoints), or ``None``.
+
+    Among equal values the first along the path (``points``, their positions), points
+    before breakpoints (the order of `check_pieces`); any of them when ``points`` is
+    ``None``. ``None`` if a value is not finite.
     """
-    main, brk = parts
-    k = int(np.argmax(main))  # the first largest value (a NaN is the largest)
-    top = float(main[k])
-    top_b = float(brk.max()) if brk.size else -math.inf
-    if not (math.isfinite(top) and (math.isfinite(top_b) or top_b == -math.inf)):
+    k = int(values.argmax())  # the first largest value (a NaN is the largest)
+    top = float(values[k])
+    if not math.isfinite(top):
         return None
-    if top_b > top:
-        return 1, int(np.argmax(brk))
-    if not locate:
-        return 0, k
+    if k >= m or points is None:
+        return k
+    main = values[:m]
     ties = np.flatnonzero(main == top)
     if ties.size == 1:  # the usual case off the bound
-        return 0, k
+        return k
     # The points rise along each row of `cell_points` (the nodes, then each cell's k-th
     # point, in the cells' order): the first tie at the least point is the first along the
     # path, and of equal points the one in the first row, as the rows' first ties would give.
-    return 0, int(ties[np.argmin(points[ties])])
-
-
-def _at(parts: tuple[FloatArray, FloatArray], where: tuple[int, int]) -> float:
-    return float(parts[where[0]][where[1]])
+    return int(ties[np.argmin(points[ties])])
 
 
 def _flag_linear(excess: np.ndarray, knots: FloatArray, local: FloatArray, accel: FloatArray,
