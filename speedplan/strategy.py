@@ -522,9 +522,10 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
             raise record.timeout()
         _warn_exceeded(check, record)
     # The bound's memo (every position evaluated while planning) stays with the plan, not
-    # with the profile a caller keeps.
+    # with the profile a caller keeps (a bound without one is kept as it is).
+    bound = model.bound if model.bound.memo is None else replace(model.bound, memo=None)
     return replace(profile, verification=check, limits_exceeded=not check.ok,
-                   speed_bound=replace(model.bound, memo=None), attempts=tuple(record.entries))
+                   speed_bound=bound, attempts=tuple(record.entries))
 
 
 def _warn_exceeded(check: Verification, record: Record) -> None:

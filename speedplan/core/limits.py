@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -138,7 +139,7 @@ class Limits:
         for name in ("v_max", "a_max", "a_lat_max", "j_max", "a_decel", "j_lat_max",
                      "yaw_rate_max", "yaw_acc_max", "yaw_jerk_max"):
             value = getattr(self, name)
-            if np.isfinite(value) and not LIMIT_RANGE[0] <= value <= LIMIT_RANGE[1]:
+            if math.isfinite(value) and not LIMIT_RANGE[0] <= value <= LIMIT_RANGE[1]:
                 raise InvalidInputError(
                     f"`{name}`={value!r} is outside [{LIMIT_RANGE[0]:g}, {LIMIT_RANGE[1]:g}], "
                     "the range of finite limits planned for (SI units); pass inf for no "

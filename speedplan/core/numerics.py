@@ -96,9 +96,21 @@ def cell_points(s: FloatArray, per_cell: int = CELL_POINTS) -> FloatArray:
     out = np.empty(per_cell * (n - 1) + 1)
     out[:n] = s
     rows = out[n:].reshape(per_cell - 1, n - 1)
-    np.multiply((np.arange(1, per_cell) / per_cell)[:, None], s[1:] - s[:-1], out=rows)
+    fractions = _CELL_FRACTIONS if per_cell == CELL_POINTS else _fractions(per_cell)
+    np.multiply(fractions, s[1:] - s[:-1], out=rows)
     rows += s[:-1]
     return out
+
+
+def _fractions(per_cell: int) -> FloatArray:
+    """``k / per_cell`` for ``k = 1 .. per_cell - 1``, as a column (one row per point)."""
+    out: FloatArray = (np.arange(1, per_cell) / per_cell)[:, None]
+    return out
+
+
+#: `_fractions` of `CELL_POINTS`, made once: every plan builds cell points several times.
+_CELL_FRACTIONS = _fractions(CELL_POINTS)
+_CELL_FRACTIONS.flags.writeable = False
 
 
 def cell_rows(values: npt.NDArray[_Scalar], per_cell: int = CELL_POINTS

@@ -28,13 +28,13 @@ def cumulative(step: FloatArray) -> FloatArray:
     """
     out: FloatArray = np.empty(step.size + 1)
     out[0] = 0.0
-    np.cumsum(step, out=out[1:])
+    np.add.accumulate(step, out=out[1:])  # np.cumsum's loop, without its dispatch
     return out
 
 
 def _forward(bound: FloatArray, up: FloatArray) -> FloatArray:
     c = cumulative(up)
-    out: FloatArray = bound - c
+    out: FloatArray = np.subtract(bound, c)
     np.minimum.accumulate(out, out=out)
     out += c
     return np.minimum(out, bound, out=out)
