@@ -264,5 +264,12 @@ def test_the_peak_is_the_first_tie_along_the_path(seed):
         s[1] = np.nextafter(s[0], 1.0)
     points = cell_points(s)
     values = rng.integers(0, 3 if seed % 2 else 40, points.size).astype(np.float64)
-    peak = _first_peak((values, np.zeros(0)), points)
-    assert peak == (0, _rows_first_tie(values, points))
+    peak = _first_peak(values, values.size, points)
+    assert peak == _rows_first_tie(values, points)
+    # The breakpoints follow the points: one that ties with the peak does not move it, the
+    # first of those above it is the peak.
+    top = float(values.max())
+    m = values.size
+    assert _first_peak(np.concatenate((values, [top])), m, points) == peak
+    assert _first_peak(np.concatenate((values, [top, top + 1.0, top + 1.0])), m, points) == m + 1
+    assert _first_peak(np.concatenate((values, [np.nan])), m, points) is None
