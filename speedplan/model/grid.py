@@ -588,9 +588,10 @@ class _StepRule:
         curve = np.zeros(sf.size)
         curve[1:-1] = np.abs(np.diff(slope)) / (0.5 * (cells[1:] + cells[:-1]))
         curve[0], curve[-1] = curve[1], curve[-2]
-        with np.errstate(divide="ignore"):
-            step = np.sqrt(8.0 * SHAPE_SAG * w_est / curve)
-        out: FloatArray = np.minimum(step, CRUISE_STEP * self.length)
+        step = np.full(sf.size, CRUISE_STEP * self.length)
+        bent = curve > 0.0
+        step[bent] = np.minimum(step[bent], np.sqrt(8.0 * SHAPE_SAG * w_est[bent] / curve[bent]))
+        out: FloatArray = step
         return out
 
 
