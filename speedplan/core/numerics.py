@@ -12,8 +12,9 @@ import numpy.typing as npt
 
 from .checks import FloatArray
 
-__all__ = ["CELL_POINTS", "GAUSS_NODES", "GAUSS_WEIGHTS", "SHORT_NODES", "SHORT_WEIGHTS",
-           "cell_points", "cell_rows", "gauss_legendre", "wrap_angle", "wrap_heading"]
+__all__ = ["CELL_FRACTIONS", "CELL_POINTS", "GAUSS_NODES", "GAUSS_WEIGHTS", "SHORT_NODES",
+           "SHORT_WEIGHTS", "cell_points", "cell_rows", "gauss_legendre", "wrap_angle",
+           "wrap_heading"]
 
 
 def gauss_legendre(points: int) -> tuple[np.ndarray, np.ndarray]:
@@ -96,7 +97,7 @@ def cell_points(s: FloatArray, per_cell: int = CELL_POINTS) -> FloatArray:
     out = np.empty(per_cell * (n - 1) + 1)
     out[:n] = s
     rows = out[n:].reshape(per_cell - 1, n - 1)
-    fractions = _CELL_FRACTIONS if per_cell == CELL_POINTS else _fractions(per_cell)
+    fractions = CELL_FRACTIONS if per_cell == CELL_POINTS else _fractions(per_cell)
     np.multiply(fractions, s[1:] - s[:-1], out=rows)
     rows += s[:-1]
     return out
@@ -108,9 +109,10 @@ def _fractions(per_cell: int) -> FloatArray:
     return out
 
 
-#: `_fractions` of `CELL_POINTS`, made once: every plan builds cell points several times.
-_CELL_FRACTIONS = _fractions(CELL_POINTS)
-_CELL_FRACTIONS.flags.writeable = False
+#: The fractions ``k / CELL_POINTS`` of a cell at its inner points, a column (one row per
+#: point of `cell_rows`), made once: every plan builds cell points several times.
+CELL_FRACTIONS = _fractions(CELL_POINTS)
+CELL_FRACTIONS.flags.writeable = False
 
 
 def cell_rows(values: npt.NDArray[_Scalar], per_cell: int = CELL_POINTS

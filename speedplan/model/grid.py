@@ -9,7 +9,7 @@ Where ``λ(v)`` falls below ``ℓ`` on the stretches next to the ends (the speed
 rest), the steps stay at ``ℓ / per_phase``; a slow stretch farther inside (a slow zone, a
 tight curve) is resolved at its own ``λ(v)``, however short.
 
-Two properties the time law relies on (`speedplan.timing.law`):
+Its properties (the time law, `speedplan.timing.law`, relies on the first):
 
 * **smooth grading**: neighbouring steps differ by at most `GRADING` (1 %) wherever
   the speed may change, by `CRUISE_GRADING` (4 %) inside long stretches at a constant
@@ -18,7 +18,12 @@ Two properties the time law relies on (`speedplan.timing.law`):
   ``t_j`` in time) from any kink of the no-jerk profile
   (where it is linear in ``w``: a cruise, a constant acceleration or braking) the step grows,
   by 4 % per node, up to `CRUISE_STEP` of the length: a long move costs a few hundred
-  nodes more than a short one, and does not hit the node cap with a coarse transition.
+  nodes more than a short one, and does not hit the node cap with a coarse transition;
+* **a followed bound is stepped by its shape**: where the no-jerk profile follows a curved
+  bound (a clothoid at its yaw-rate or lateral limit) with a jerk and an acceleration well
+  inside the limits, the law follows it too; more than `CRUISE_MARGIN_TIME` ``t_j`` from
+  where either is large, the steps resolve the bound's shape (`SHAPE_SAG`), not its jerk
+  transitions.
 
 Nodes are placed by inverting the node count ``N(s) = ∫ ds / h(s)`` exactly for a step
 ``h(s)`` piecewise linear on a fine pre-grid: consecutive steps follow ``h(s)``, with no jump
@@ -567,13 +572,14 @@ class _StepRule:
         # Following a curved bound needs a jerk (v w'' / 2) and an acceleration (w' / 2):
         # where both lie well inside the limits, the law follows it too, and its jerk
         # phases lie at the kinks, where either is large or the bound is left.
-        accel = 0.5 * np.concatenate(([slope[0]], np.maximum(np.abs(slope[:-1]),
-                                                               np.abs(slope[1:])), [slope[-1]]))
+        accel = 0.5 * np.abs(np.concatenate(([slope[0]], np.maximum(np.abs(slope[:-1]),
+                                                                      np.abs(slope[1:])),
+                                             [slope[-1]])))
         limit = np.where(np.concatenate(([slope[0]], slope[:-1] + slope[1:], [slope[-1]])) > 0,
                          self.a_max, self.a_decel)
         jerk = np.zeros(sf.size)
         jerk[1:-1] = 0.5 * np.abs(np.diff(slope)) * v[1:-1] / (0.5 * (cells[1:] + cells[:-1]))
-        gentle = (jerk <= SMOOTH_JERK * self.j_max) & (np.abs(accel) <= SMOOTH_ACCELERATION * limit)
+        gentle = (jerk <= SMOOTH_JERK * self.j_max) & (accel <= SMOOTH_ACCELERATION * limit)
         gentle[[0, -1]] = False
         smooth = ~cruise & (_distance_to(~(straight | gentle), t) > margin)
         return cruise, smooth

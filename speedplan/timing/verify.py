@@ -25,7 +25,7 @@ from ..core import kinematics
 from ..core.checks import FloatArray, IntArray
 from ..core.forward import Forwarded
 from ..core.limits import Limits
-from ..core.numerics import CELL_POINTS, cell_points, cell_rows
+from ..core.numerics import CELL_FRACTIONS, CELL_POINTS, cell_points, cell_rows
 from ..geometry import CellSamples, Path, SpeedBound
 from ..geometry.bounds import bound_breakpoints
 from .law import PieceExtremes, SpeedLaw, TimeLaw
@@ -589,17 +589,13 @@ def _chord_values(s: FloatArray, w: FloatArray, dw: FloatArray, h: FloatArray,
     out = np.empty(m + local.size)
     w_nodes, w_inner = cell_rows(out[:m])
     w_nodes[:] = w
-    np.multiply(_CHORD_FRACTIONS, dw, out=w_inner)
+    np.multiply(CELL_FRACTIONS, dw, out=w_inner)
     w_inner += w[:-1]
     if local.size:
         cell = np.minimum(np.maximum(np.searchsorted(s, local, side="right") - 1, 0), n - 2)
         np.maximum(w[cell] + dw[cell] * ((local - s[cell]) / h[cell]), 0.0, out=out[m:])
     return out
 
-
-#: The fractions ``k / CELL_POINTS`` of a cell at its inner points, one row each.
-_CHORD_FRACTIONS = (np.arange(1, CELL_POINTS) / CELL_POINTS)[:, None]
-_CHORD_FRACTIONS.flags.writeable = False
 
 
 def _first_peak(values: FloatArray, m: int, points: FloatArray | None) -> int | None:

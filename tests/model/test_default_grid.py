@@ -275,6 +275,16 @@ def test_a_capped_default_grid_is_graded_and_keeps_its_end_transitions(length, a
         assert np.sum(s >= length - ell) >= 0.9 * wanted
 
 
+def _agrees_with_its_grid_cut_in_two(path: Path, lim: Limits) -> None:
+    """The default grid's plan is verified and within 1e-6 of the same grid cut in two."""
+    profile = plan(path, lim)
+    with subdivided_default_grids(2):
+        finer = plan(path, lim)
+    assert finer.legs[0].s.size > 1.9 * profile.legs[0].s.size  # answered on the finer grid
+    assert profile.verification.ok and finer.verification.ok
+    assert abs(profile.duration / finer.duration - 1.0) < 1e-6
+
+
 def test_a_slow_stretch_is_coarse_a_few_transitions_away_from_its_kinks() -> None:
     # 628 m through six bends, jerk phases of 0.27 s: the bends slow the vehicle to about
     # 0.7 m/s, where the margin around a kink sized at the top speed (7.3 m) spans some 30
@@ -289,12 +299,7 @@ def test_a_slow_stretch_is_coarse_a_few_transitions_away_from_its_kinks() -> Non
         [399.486, -92.515], [453.451, -38.052], [574.008, -83.844]])
     lim = Limits(v_max=13.37, a_max=0.0985, a_lat_max=0.205, j_max=0.36)
     assert build_model(PlanRequest.create(path, lim)).legs[0].problem.n < MAX_DEFAULT_NODES / 2
-    profile = plan(path, lim)
-    with subdivided_default_grids(2):
-        finer = plan(path, lim)
-    assert finer.legs[0].s.size > 1.9 * profile.legs[0].s.size  # answered on the finer grid
-    assert profile.verification.ok and finer.verification.ok
-    assert abs(profile.duration / finer.duration - 1.0) < 1e-6
+    _agrees_with_its_grid_cut_in_two(path, lim)
 
 
 def test_a_bound_followed_with_little_jerk_is_stepped_by_its_shape() -> None:
@@ -308,12 +313,7 @@ def test_a_bound_followed_with_little_jerk_is_stepped_by_its_shape() -> None:
     path = Path.from_waypoints([[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]])
     lim = Limits(v_max=5.0, a_max=0.5, a_lat_max=1.0, j_max=20.0, yaw_rate_max=0.3)
     assert build_model(PlanRequest.create(path, lim)).legs[0].problem.n < 8_000
-    profile = plan(path, lim)
-    with subdivided_default_grids(2):
-        finer = plan(path, lim)
-    assert finer.legs[0].s.size > 1.9 * profile.legs[0].s.size  # answered on the finer grid
-    assert profile.verification.ok and finer.verification.ok
-    assert abs(profile.duration / finer.duration - 1.0) < 1e-6
+    _agrees_with_its_grid_cut_in_two(path, lim)
 
 
 @pytest.mark.parametrize("points", [20_001, 200_001])
