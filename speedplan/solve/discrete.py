@@ -287,6 +287,7 @@ class _Relaxed(NamedTuple):
     lower: float  # certified lower bound on the travel time [s]
     exact: bool
     info: RelaxationInfo
+    time_scale: float  # seconds per unit of the travel time in the solver's units
 
 
 def _relaxed(problem: DiscreteProblem, backend: str, fallback: bool) -> _Relaxed:
@@ -313,7 +314,7 @@ def _relaxed(problem: DiscreteProblem, backend: str, fallback: bool) -> _Relaxed
         time=relax.solve_time + relax.setup_time, w=w_relaxed,
         jerk_violation=relaxed_violation, fallback=fallback_reason,
     )
-    return _Relaxed(unit, relax.w, w_scale, w_relaxed, lower, exact, info)
+    return _Relaxed(unit, relax.w, w_scale, w_relaxed, lower, exact, info, time_scale)
 
 
 def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status: Status
@@ -331,7 +332,9 @@ def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status:
                     and problem.jerk_violation(w_ref) <= problem.jerk_tol
                     and problem.grip_violation(w_ref) <= GRIP_TOL)
 
-    ref = refine_nlp(relaxed.unit, relaxed.w_unit, accept=feasible)
+    # A polish of an exact relaxation runs every start: it is there to reach POLISH_GAP.
+    lower = None if relaxed.exact else relaxed.lower / relaxed.time_scale
+    ref = refine_nlp(relaxed.unit, relaxed.w_unit, accept=feasible, lower_bound=lower)
     w_ref = np.clip(ref.w * relaxed.w_scale, 0.0, problem.w_max)
     ref_ok = ref.success and feasible(ref.w)
     refinement = RefinementInfo(

@@ -330,6 +330,26 @@ def test_lateral_problems_try_the_scaled_starts_first_and_keep_the_best():
     assert p.travel_time(res.w) <= min(accepted) * (1 + refine_module.AGREE)
 
 
+def test_a_start_within_the_enough_gap_of_a_certified_bound_ends_the_starts():
+    # No start can be faster than the relaxation's certified lower bound, so one within
+    # ENOUGH_GAP of it leaves at most that to gain: the other starts are not run.
+    p = _unit(_paper(("pw lin", "cnst", "logrnd"), 300, 1, lateral=True))
+    relax = solve_relaxation(p)
+    lower = min(relax.dual_objective, relax.primal_objective)
+    first = banded_nlp.solve_banded_nlp(p, relax.w, banded_nlp.LATERAL_STARTS[0])
+    assert first.success and _feasible(p, first.w)
+    gap = p.travel_time(first.w) / lower - 1.0
+    assert 0.0 <= gap <= refine_module.ENOUGH_GAP  # the case this test is about
+    res = refine(p, relax.w, lower_bound=lower)
+    assert res.iterations == first.iterations  # the first start alone
+    assert p.travel_time(res.w) == p.travel_time(first.w)
+    full = refine(p, relax.w)  # without the bound: the starts until two agree
+    assert full.iterations > first.iterations
+    assert p.travel_time(res.w) <= p.travel_time(full.w) * (1.0 + refine_module.ENOUGH_GAP)
+    # A bound far below every start's time ends nothing.
+    assert refine(p, relax.w, lower_bound=0.5 * lower).iterations == full.iterations
+
+
 def test_lateral_jerk_rows_are_refined():
     p = _unit(_paper(("pw lin", "rnd", "logrnd"), 300, 0, lateral=True))
     relax = solve_relaxation(p)
