@@ -6,7 +6,9 @@ acceptance test passes; only when none passes does it run IPOPT
 (`refine_ipopt`). The problem is nonconvex, so different starts
 can end in different local optima (up to 3 % apart on the benchmark corpus): the best of the
 starts is the safeguard. Each run costs a few milliseconds per thousand nodes, and the last
-start is skipped when the first two agree. Problems with lateral-jerk rows run
+start is skipped when the first two agree; given the relaxation's certified lower bound, the
+starts end at the first accepted point within `ENOUGH_GAP` of it. Problems with lateral-jerk
+rows run
 `LATERAL_STARTS` instead (the scaled starts first).
 """
 
