@@ -8,8 +8,7 @@ can end in different local optima (up to 3 % apart on the benchmark corpus): the
 starts is the safeguard. Each run costs a few milliseconds per thousand nodes, and the last
 start is skipped when the first two agree; given the relaxation's certified lower bound, the
 starts end at the first accepted point within `ENOUGH_GAP` of it. Problems with lateral-jerk
-rows run
-`LATERAL_STARTS` instead (the scaled starts first).
+rows run `LATERAL_STARTS` instead (the scaled starts first).
 """
 
 from __future__ import annotations
