@@ -276,8 +276,13 @@ def test_a_capped_default_grid_is_graded_and_keeps_its_end_transitions(length, a
 
 
 def _agrees_with_its_grid_cut_in_two(path: Path, lim: Limits) -> None:
-    """The default grid's plan is verified and within 1e-6 of the same grid cut in two."""
+    """The default grid's plan within every limit, finite-differenced, no faster than the
+    exact optimum without jerk limit, and within 1e-6 of the same grid cut in two."""
     profile = plan(path, lim)
+    assert within_promise(measure(profile))
+    fastest, _, _ = no_jerk_lower_bound(SpeedBound(path, lim), path.length, lim.a_max,
+                                        lim.a_decel)
+    assert profile.duration >= fastest
     with subdivided_default_grids(2):
         finer = plan(path, lim)
     assert finer.legs[0].s.size > 1.9 * profile.legs[0].s.size  # answered on the finer grid
@@ -335,3 +340,4 @@ def test_a_kink_on_points_a_few_ulps_apart_is_stepped_as_a_kink(monkeypatch, poi
     transition = v * min(lim.a_max / lim.j_max, np.sqrt(v / lim.j_max))
     assert np.diff(s)[top - 1:top + 1].max() < 4 * transition / grid.DEFAULT_PER_PHASE
     assert build_model(PlanRequest.create(path, lim)).legs[0].problem.n == s.size
+    assert within_promise(measure(profile))
