@@ -44,10 +44,22 @@ tolerate_stale_indexes()  # before any kernel below is loaded from the cache
 
 _T = TypeVar("_T")
 
-#: Fraction of the step to the cone boundary taken per iteration.
+#: Fraction of the step to the cone boundary taken per iteration, by the primal and the dual
+#: variables each (their steps are taken apart, see `step`).
 STEP = 0.99
 #: Exponent of Mehrotra's centring heuristic ``σ = (1 - α_affine)^3``.
 SIGMA_EXPONENT = 3.0
+#: The corrector's second-order term ``(W⁻¹Δs_a) ∘ (WΔy_a)`` is weighted by
+#: ``α_affine ** SECOND_ORDER_EXPONENT``. Mehrotra's full term predicts the complementarity
+#: after a full affine step; where only a short one is possible it is far larger than what
+#: any step realises, and it blocks the next step: on fine grids along a curved speed bound
+#: the method advanced one node per iteration with steps of 0.01-0.08 and stopped with
+#: NoProgress (a right-angle corner at a yaw-rate limit on uniform 2-3 mm grids). Salahi,
+#: Peng and Terlaky's modified corrector weights the term by the affine step itself; its
+#: square root did best here (exponents 0.25-2 tried), and with the separate primal and dual
+#: steps of `step` it solved those grids and cut the iterations of 7 000-18 000-node comfort
+#: grids by a median 20 % (docs/banded-ipm.md).
+SECOND_ORDER_EXPONENT = 0.5
 #: Relative gap below which each Newton solve is checked for iterative refinement.
 REFINE_BELOW = 1e-3
 #: The check refines when the solve's residual in ``G'Δy = bx``, relative like the dual
@@ -71,7 +83,7 @@ NO_PROGRESS_ITERATIONS = 20
 ADJ_SET, ADJ_SUBTRACT, ADJ_ADD, ADJ_DUAL_RESIDUAL = 0, 1, 2, 3
 
 #: Columns of `iterate`'s log, one row per iteration.
-LOG_COLUMNS = ("pcost", "dcost", "relgap", "pres", "dres", "sigma", "step")
+LOG_COLUMNS = ("pcost", "dcost", "relgap", "pres", "dres", "sigma", "step", "dual_step")
 
 #: Status codes returned by `iterate`.
 SOLVED, MAX_ITERATIONS, STALLED, NUMERICAL_ERROR, NO_PROGRESS = 0, 1, 2, 3, 4
@@ -559,15 +571,19 @@ def _interior(u0: float, u1: float, u2: float) -> bool:
 
 
 @inner
-def _interior_after_step(pt: Point, alpha: float, dn: Direction) -> bool:
-    """Whether every cone of ``s`` and of ``y`` is strictly interior after the step ``α``."""
+def _interior_after_step(pt: Point, alpha: float, alpha_dual: float, dn: Direction) -> bool:
+    """Whether every cone of ``s`` and of ``y`` is strictly interior after the steps.
+
+    ``s`` moves by ``α`` (``alpha``), ``y`` by ``alpha_dual``.
+    """
     for c in range(pt.ys.shape[1]):
         s0, s1, s2 = _cone_s(pt.w, pt.t, pt.z, c)
         d0, d1, d2 = _cone_ds(dn.dw, dn.dt, dn.dz, c)
         if not _interior(s0 + alpha * d0, s1 + alpha * d1, s2 + alpha * d2):
             return False
-        if not _interior(pt.ys[0, c] + alpha * dn.dys[0, c], pt.ys[1, c] + alpha * dn.dys[1, c],
-                         pt.ys[2, c] + alpha * dn.dys[2, c]):
+        if not _interior(pt.ys[0, c] + alpha_dual * dn.dys[0, c],
+                         pt.ys[1, c] + alpha_dual * dn.dys[1, c],
+                         pt.ys[2, c] + alpha_dual * dn.dys[2, c]):
             return False
     return True
 
@@ -781,20 +797,22 @@ def solve_normal_inplace(
 
 @inlined
 def _v_into(
-    sc: Scaling, pt: Point, rp: float, corrector: bool, sigma_mu: float, dn: Direction
+    sc: Scaling, pt: Point, rp: float, corrector: bool, sigma_mu: float, second_order: float,
+    dn: Direction,
 ) -> None:
     """``v = H by - W⁻¹ u`` with ``λ ∘ u = bs``, into ``(dn.dyl, dn.dys)``.
 
     ``by`` is ``rp`` on the linear rows and zero on the cones; ``H = y / s`` on the linear
     rows. ``bs = -λ ∘ λ`` (the predictor), or with ``corrector`` Mehrotra's
-    ``-λ ∘ λ - (W⁻¹Δs) ∘ (WΔy) + σ μ e`` for the predictor's direction, which ``dn`` holds on
-    entry and which is overwritten entry by entry as it is read.
+    ``-λ ∘ λ - η (W⁻¹Δs) ∘ (WΔy) + σ μ e`` (``η`` = ``second_order``, see
+    `SECOND_ORDER_EXPONENT`) for the predictor's direction, which ``dn`` holds on entry and
+    which is overwritten entry by entry as it is read.
     """
     sl, yl, dsl, dyl = pt.sl, pt.yl, dn.dsl, dn.dyl
     for j in range(sl.size):
         bsl = -sl[j] * yl[j]  # λ∘λ = s y on the linear rows
         if corrector:
-            bsl += sigma_mu - dsl[j] * dyl[j]
+            bsl += sigma_mu - second_order * dsl[j] * dyl[j]
         dyl[j] = yl[j] / sl[j] * rp - bsl / sl[j]
     dys = dn.dys
     for c in range(dys.shape[1]):
@@ -804,9 +822,9 @@ def _v_into(
             e0, e1, e2 = _cone_ds(dn.dw, dn.dt, dn.dz, c)
             a0, a1, a2 = _apply_winv(sc, e0, e1, e2, c)
             f0, f1, f2 = _apply_w(sc, dys[0, c], dys[1, c], dys[2, c], c)
-            b0 += -(a0 * f0 + a1 * f1 + a2 * f2) + sigma_mu
-            b1 += -(a0 * f1 + f0 * a1)
-            b2 += -(a0 * f2 + f0 * a2)
+            b0 += sigma_mu - second_order * (a0 * f0 + a1 * f1 + a2 * f2)
+            b1 -= second_order * (a0 * f1 + f0 * a1)
+            b2 -= second_order * (a0 * f2 + f0 * a2)
         u0, u1, u2 = _jordan_solve(l0, l1, l2, b0, b1, b2)
         w0, w1, w2 = _apply_winv(sc, u0, u1, u2, c)
         dys[0, c], dys[1, c], dys[2, c] = -w0, -w1, -w2
@@ -815,16 +833,18 @@ def _v_into(
 @inner
 def _v_predictor_into(sc: Scaling, pt: Point, rp: float, dn: Direction) -> None:
     """`_v_into` of the predictor (``bs = -λ ∘ λ``)."""
-    _v_into(sc, pt, rp, False, 0.0, dn)
+    _v_into(sc, pt, rp, False, 0.0, 0.0, dn)
 
 
 @inner
-def _v_corrector_into(sc: Scaling, pt: Point, rp: float, sigma_mu: float, dn: Direction) -> None:
+def _v_corrector_into(
+    sc: Scaling, pt: Point, rp: float, sigma_mu: float, second_order: float, dn: Direction
+) -> None:
     """`_v_into` of the corrector: compiled apart, so that neither loop tests ``corrector``.
 
     One kernel for both, testing it on every entry, made the whole iteration 10 % slower.
     """
-    _v_into(sc, pt, rp, True, sigma_mu, dn)
+    _v_into(sc, pt, rp, True, sigma_mu, second_order, dn)
 
 
 @inner
@@ -863,21 +883,22 @@ def _ds_dy_into(d: Data, sc: Scaling, pt: Point, rp: float, dn: Direction) -> No
 @inlined
 def newton_into(
     d: Data, sc: Scaling, fac: Factor, pt: Point, res: Residual, rp: float,
-    corrector: bool, sigma_mu: float, refine_above: float, dn: Direction,
+    corrector: bool, sigma_mu: float, second_order: float, refine_above: float,
+    dn: Direction,
 ) -> None:
     """Solve ``G'Δy = bx``, ``GΔx + Δs = by``, ``λ ∘ (WΔy + W⁻¹Δs) = bs`` into ``dn``.
 
     ``bx`` is the residual ``res``, which must be the iterate's (`dual_residual_into`:
     the refinement forms its own right-hand side in ``res``, then forms ``bx`` again from
     ``pt``), ``by`` is ``rp`` on the linear rows and zero on the cones,
-    ``bs`` as `_v_into` says (``corrector``, ``sigma_mu``; the corrector reads the
+    ``bs`` as `_v_into` says (``corrector``, ``sigma_mu``, ``second_order``; the corrector reads the
     predictor's direction from ``dn``). One round of iterative refinement follows if the
     2-norm of the residual ``bx - G'Δy`` exceeds ``refine_above`` (``inf``: no refinement,
     and the residual is not computed).
     """
     # With v = H by - W⁻¹ u (λ ∘ u = bs): (G'HG) Δx = bx + G' v and Δy = H G Δx - v.
     if corrector:
-        _v_corrector_into(sc, pt, rp, sigma_mu, dn)
+        _v_corrector_into(sc, pt, rp, sigma_mu, second_order, dn)
     else:
         _v_predictor_into(sc, pt, rp, dn)
     for i in range(dn.dw.size):  # loops, not slice assignments: they cost seconds to compile
@@ -1051,38 +1072,47 @@ def residuals_into(
 
 
 @inlined
-def _max_step(pt: Point, dn: Direction) -> float:
-    """Largest step along ``dn`` keeping ``s`` and ``y`` in their cones."""
-    return min(max_step_lin(pt.sl, dn.dsl), max_step_lin(pt.yl, dn.dyl),
-               max_step_slack_soc(pt, dn), max_step_soc(pt.ys, dn.dys))
+def _max_steps(pt: Point, dn: Direction) -> tuple[float, float]:
+    """Largest steps along ``dn`` keeping ``s`` (primal) and ``y`` (dual) in their cones."""
+    return (min(max_step_lin(pt.sl, dn.dsl), max_step_slack_soc(pt, dn)),
+            min(max_step_lin(pt.yl, dn.dyl), max_step_soc(pt.ys, dn.dys)))
 
 
 @inlined
-def step(pt: Point, dn: Direction) -> float:
-    """Move ``pt`` a fraction ``STEP`` of the way to the cone boundary along ``dn``.
+def step(pt: Point, dn: Direction) -> tuple[float, float]:
+    """Move ``pt`` along ``dn``: the primal and the dual variables each a fraction ``STEP``.
 
-    The closed-form step to the boundary can be off by rounding for nearly degenerate cones;
-    the step is halved until every cone is strictly interior. Returns the step taken, or 0
-    (nothing moved) if no such step was found.
+    Each goes that fraction of the way to its cones' boundary (at most a full step); returns
+    the two steps ``(α_primal, α_dual)``. Taking them apart, as SDPT3 does, keeps one side's
+    nearest boundary from holding back the other: ``(x, s)`` move by ``α_primal`` (so the
+    linear rows' primal residual shrinks by ``1 - α_primal``), the multipliers ``y`` by
+    ``α_dual``; the dual residual is formed from the iterate at every iteration. On plan()
+    grids it saved about a tenth of the iterations on top of the corrector's weighting
+    (`SECOND_ORDER_EXPONENT`, docs/banded-ipm.md). The closed-form step to the boundary can
+    be off by rounding for nearly degenerate cones; both steps are halved until every cone
+    is strictly interior. Returns ``(0, 0)`` (nothing moved) if no such steps were found.
     """
-    alpha = min(1.0, STEP * _max_step(pt, dn))
-    if not (math.isfinite(alpha) and alpha > 0.0):
-        return 0.0
+    to_primal, to_dual = _max_steps(pt, dn)
+    alpha, alpha_dual = min(1.0, STEP * to_primal), min(1.0, STEP * to_dual)
+    if not (math.isfinite(alpha) and alpha > 0.0 and math.isfinite(alpha_dual)
+            and alpha_dual > 0.0):
+        return 0.0, 0.0
     inside = False
     for _ in range(30):
-        if _interior_after_step(pt, alpha, dn):
+        if _interior_after_step(pt, alpha, alpha_dual, dn):
             inside = True
             break
         alpha *= 0.5
+        alpha_dual *= 0.5
     if not inside:
-        return 0.0
-    _axpy2(alpha, dn.dys, pt.ys)
+        return 0.0, 0.0
+    _axpy2(alpha_dual, dn.dys, pt.ys)
     _axpy(alpha, dn.dw, pt.w)
     _axpy(alpha, dn.dt, pt.t)
     _axpy(alpha, dn.dz, pt.z)
     _axpy(alpha, dn.dsl, pt.sl)
-    _axpy(alpha, dn.dyl, pt.yl)
-    return alpha
+    _axpy(alpha_dual, dn.dyl, pt.yl)
+    return alpha, alpha_dual
 
 
 @inner
@@ -1168,17 +1198,22 @@ def iterate(
         # only where the solve's own residual could show in the dual residual's test.
         refine_above = REFINE_RESIDUAL * tol * res_x0 if relgap < REFINE_BELOW else np.inf
         # Predictor: the affine-scaling direction (right-hand side -λ∘λ), whose largest step
-        # sets Mehrotra's σ; then the corrector: its second-order term and centring σ μ.
+        # sets Mehrotra's σ and the weight of the corrector's second-order term; then the
+        # corrector: that term and centring σ μ.
         # One call in a loop: numba inlines newton_into, and one copy compiles faster.
-        sigma = sigma_mu = 0.0
+        sigma = sigma_mu = second_order = 0.0
         for corrector in range(2):
-            newton_into(d, sc, fac, pt, res, rp, corrector == 1, sigma_mu, refine_above, dn)
+            newton_into(d, sc, fac, pt, res, rp, corrector == 1, sigma_mu, second_order,
+                        refine_above, dn)
             if corrector == 0:
-                sigma = (1.0 - min(1.0, _max_step(pt, dn))) ** SIGMA_EXPONENT
+                to_primal, to_dual = _max_steps(pt, dn)
+                reach = min(1.0, to_primal, to_dual)
+                sigma = (1.0 - reach) ** SIGMA_EXPONENT
                 sigma_mu = sigma * (gap / nu)
-        alpha = step(pt, dn)
-        rp *= 1.0 - alpha  # G Δx + Δs = by: the step removes the fraction α of it
-        log[it, 5], log[it, 6] = sigma, alpha
+                second_order = reach ** SECOND_ORDER_EXPONENT
+        alpha, alpha_dual = step(pt, dn)
+        rp *= 1.0 - alpha  # G Δx + Δs = by: the primal step removes the fraction α of it
+        log[it, 5], log[it, 6], log[it, 7] = sigma, alpha, alpha_dual
         if alpha == 0.0:
             status = NUMERICAL_ERROR
             break
@@ -1218,12 +1253,12 @@ def signatures() -> dict[str, tuple[Any, ...]]:
         "g_lin_into": (d, v, v, v), "g_soc_into": (v, v, v, mat),
         "g_adjoint_into": (d, v, mat, v, v, v, i), "_cone_step": (x, x, x, x, x, x),
         "max_step_soc": (mat, mat), "max_step_slack_soc": (pt, dn), "max_step_lin": (v, v),
-        "_interior": (x, x, x), "_interior_after_step": (pt, x, dn),
+        "_interior": (x, x, x), "_interior_after_step": (pt, x, x, dn),
         "cone_scaling_into": (sc, i, x, x, x, x, x, x), "scaling_into": (pt, sc),
         "_lambda": (sc, mat, i), "_eliminate_tz": (d, sc, v, v, fac, i),
         "factor_into": (d, sc, v, v, fac), "solve_banded_inplace": (fac, v),
         "solve_normal_inplace": (d, fac, v, v, v), "_v_predictor_into": (sc, pt, x, dn),
-        "_v_corrector_into": (sc, pt, x, x, dn),
+        "_v_corrector_into": (sc, pt, x, x, x, dn),
         "_recover_v_into": (sc, pt, x, dn), "_ds_dy_into": (d, sc, pt, x, dn),
         "_dot": (v, v), "_dot2": (mat, mat), "_axpy": (x, v, v), "_axpy2": (x, mat, mat),
         "_shift": (x, x), "_shift_into_cone": (v, mat),

@@ -204,6 +204,25 @@ def test_the_slow_4m_g2_path_answers_within_its_time_limit():
     assert time.perf_counter() - t0 < 15.0
 
 
+@pytest.mark.parametrize("n", [6000, 10000])
+def test_a_fine_given_grid_along_a_yaw_rate_bound_is_answered_by_its_first_solve(n):
+    # A right-angle corner at a yaw-rate limit on a uniform grid of 2-3 mm: the banded
+    # method used to advance one node per iteration and stop with NoProgress, and Clarabel
+    # then took 400 iterations (43 s) on the same grid.
+    path = sp.Path.from_waypoints([[0, 0], [10, 0], [10, 10]])
+    lim = sp.Limits(v_max=5.0, a_max=0.5, a_lat_max=1.0, j_max=20.0, yaw_rate_max=0.3)
+    profile = sp.plan(path, lim, n=n, backend="banded")
+    assert [a.name for a in profile.attempts] == ["model", "given_grid"]
+    assert profile.legs[0].solution.relaxation.backend == "banded"
+    assert profile.status == "optimal" and profile.verification.ok
+    assert within_promise(measure(profile))
+    # The yaw rate, from the sampled speed and the path's curvature.
+    t = np.linspace(0.0, profile.duration, 20_001)
+    state = profile.at(t)
+    yaw = np.abs(state.v * path.curvature(state.s))
+    assert yaw.max() <= lim.yaw_rate_max * (1 + 1e-3)
+
+
 def test_the_deadline_stops_clarabel():
     n = 4000
     problem = DiscreteProblem(s=np.linspace(0.0, 100.0, n), w_max=np.full(n, 4.0),

@@ -236,8 +236,8 @@ def test_newton_refines_only_above_its_residual_threshold(seed):
     def direction(refine_above):
         dn = ipm.empty(ipm.Direction, lay)
         bx = [a.copy() for a in res]
-        _py(ipm.newton_into)(d, sc, fac, pt, res, rp, False, 0.0,
-                        refine_above, dn)
+        _py(ipm.newton_into)(d, sc, fac, pt, res, rp, False, 0.0, 0.0,
+                             refine_above, dn)
         # The refinement forms its right-hand side in res and puts bx back, bit for bit.
         for a, b in zip(res, bx, strict=True):
             np.testing.assert_array_equal(a, b)

@@ -295,19 +295,21 @@ def _jordan(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 def test_newton_direction_solves_the_full_kkt_system(seed, refine_above, corrector):
     # G'Δy = bx, GΔx + Δs = by, λ ∘ (WΔy + W⁻¹Δs) = bs, solved densely. by is the scalar rp
     # on the linear rows and 0 on the cones; bs is -λ∘λ (predictor) or Mehrotra's
-    # -λ∘λ - (W⁻¹Δs_a) ∘ (WΔy_a) + σμ e for a given predictor direction (corrector).
+    # -λ∘λ - η (W⁻¹Δs_a) ∘ (WΔy_a) + σμ e for a given predictor direction and weight η of
+    # the second-order term (corrector).
     d, pt, sc, fac, g_lin, g_soc, _, rng = _random_state(seed)
     lay = d.lay
     m, nl, nc = lay.m, lay.n_lin, lay.nc
     res = ipm.empty(ipm.Residual, lay)
     _py(ipm.dual_residual_into)(d, pt, res)  # newton_into's bx is the iterate's dual residual
     rp, sigma_mu = float(rng.normal()), float(10.0 ** rng.uniform(-2, 0))
+    second_order = float(rng.uniform(0.1, 1.0))
     dn = ipm.empty(ipm.Direction, lay)
     for arr in dn:  # the predictor's direction, read by the corrector
         arr[:] = rng.normal(size=arr.shape)
     pred = [np.copy(a) for a in dn]
-    _py(ipm.newton_into)(d, sc, fac, pt, res, rp, corrector, sigma_mu,
-                    refine_above, dn)
+    _py(ipm.newton_into)(d, sc, fac, pt, res, rp, corrector, sigma_mu, second_order,
+                         refine_above, dn)
     # Unknowns: Δx (3m), Δs_lin (nl), Δs_soc (3 nc, cone-major), Δy_lin, Δy_soc.
     g_cones = np.concatenate([g_soc[:, c, :] for c in range(nc)])
     nx, ns = 3 * m, nl + 3 * nc
@@ -325,7 +327,7 @@ def test_newton_direction_solves_the_full_kkt_system(seed, refine_above, correct
     kkt[row : row + nl, nx + ns : nx + ns + nl] = np.diag(pt.sl)
     rhs_vec[row : row + nl] = -pt.sl * pt.yl
     if corrector:
-        rhs_vec[row : row + nl] += sigma_mu - pred[3] * pred[4]
+        rhs_vec[row : row + nl] += sigma_mu - second_order * pred[3] * pred[4]
     ds_pred = -(g_soc @ np.concatenate(pred[:3]))
     for c in range(nc):
         w = _w_matrix(sc, c)
@@ -335,8 +337,8 @@ def test_newton_direction_solves_the_full_kkt_system(seed, refine_above, correct
         kkt[r0 : r0 + 3, nx + ns + nl + 3 * c : nx + ns + nl + 3 * c + 3] = _arrow(lam) @ w
         rhs_vec[r0 : r0 + 3] = -_jordan(lam, lam)
         if corrector:
-            rhs_vec[r0 : r0 + 3] += sigma_mu * np.array([1.0, 0.0, 0.0]) - _jordan(
-                np.linalg.solve(w, ds_pred[:, c]), w @ pred[5][:, c])
+            rhs_vec[r0 : r0 + 3] += sigma_mu * np.array([1.0, 0.0, 0.0]) - second_order * (
+                _jordan(np.linalg.solve(w, ds_pred[:, c]), w @ pred[5][:, c]))
     sol = np.linalg.solve(kkt, rhs_vec)
     dx = np.concatenate((dn.dw, dn.dt, dn.dz))
     ds_soc = -(g_soc @ dx)  # the kernel's implied Δs of the cones
