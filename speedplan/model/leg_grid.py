@@ -36,6 +36,15 @@ __all__ = ["KINK_PROBE", "NO_JERK_BOUND_LOSS", "NO_JERK_NODES", "NO_JERK_REFINEM
 NO_JERK_NODES = 1001
 
 
+#: A moving end's acceleration whose removal at ``j_max`` takes less than this fraction of
+#: the end's jerk transition gets no steps of its own (`boundary_transient`): a first step
+#: of the transition's (1 / `speedplan.model.grid.END_PER_PHASE` of it) absorbs it for at
+#: most 1 % of ``j_max``. Sized by removal time instead, a state read with a rounding-level
+#: acceleration (1e-12 of ``a_max``, or a subnormal 1e-311) graded a user grid's end to
+#: steps of 1e-11 of the move (`speedplan.model.grid.MIN_RELATIVE_STEP`, 1.6 nm on 161 m),
+#: where ``w`` changes by 1e-16 from node to node and the law's jerk (1.08-1.45 of
+#: ``j_max``) depended on the relaxation's last digits.
+NEGLIGIBLE_REMOVAL = 5e-4
 #: Rounds in which the default no-jerk grid is refined (steps / 4) where the optimum rides a
 #: node bound more than `NO_JERK_BOUND_LOSS` below the bound at the node itself: the
 #: minimum over the adjacent cells (`node_bounds`) costs time there, like ``O(h)``.
@@ -203,7 +212,8 @@ def boundary_transient(request: PlanRequest, v: float, a: float, a_limit: float,
     distance covered while its acceleration is brought to 0, a jerk transition
     ``v min(t_j, √(v / j))`` at the lowest speed it passes (the default grid's scale) and,
     braking, the distance ``v² / (2 |a|)`` to rest at that deceleration. The phases are
-    those under ``v_top``, the leg's top speed (`top_speed`).
+    those under ``v_top``, the leg's top speed (`top_speed`). An acceleration removed in
+    less than `NEGLIGIBLE_REMOVAL` of the jerk transition's time counts as none.
     """
     j = request.limits.j_max
     if v == 0.0 and a == 0.0:
@@ -212,8 +222,9 @@ def boundary_transient(request: PlanRequest, v: float, a: float, a_limit: float,
     low = turnaround_speed(v, a, j) if a < 0 else v
     speed = low if low > 0 else v
     t_j = min(a_limit / j, float(np.sqrt(v_top / j)))
-    scale = speed * min(t_j, float(np.sqrt(speed / j)))
-    if a != 0.0:
+    transition = min(t_j, float(np.sqrt(speed / j)))
+    scale = speed * transition
+    if abs(a) / j >= NEGLIGIBLE_REMOVAL * transition:
         t = abs(a) / j
         removal = v * t + 0.5 * a * t * t - float(np.sign(a)) * j * t**3 / 6.0
         if removal > 0.0:
