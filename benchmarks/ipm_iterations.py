@@ -99,6 +99,7 @@ def solve_all(problems_file: str) -> list[Row]:
 
 
 def summary(label: str, rows: list[Row]) -> None:
+    """Print one checkout's failures, iteration counts, largest certified gap and times."""
     its = np.array([r[3] for r in rows if r[3] >= 0])
     gaps = np.array([(r[5] - r[6]) / r[5] for r in rows if r[3] >= 0])
     failed = [f"{r[0]} ({r[1]} nodes): {r[2]}" for r in rows if r[3] < 0]
@@ -115,6 +116,7 @@ def summary(label: str, rows: list[Row]) -> None:
 
 
 def main() -> None:
+    """Collect the problems, solve them here (and in ``--baseline``), print both."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--plans", type=int, default=400, help="fuzzed plans (a quarter straight, "
                     "which have no grid legs to solve)")
@@ -128,9 +130,10 @@ def main() -> None:
         print(json.dumps(solve_all(args.solve)))
         return
     problems = collect(args.plans, args.seed, args.min_nodes)
-    print(f"{len(problems) - 4} grid legs of {args.plans} fuzzed plans (seed {args.seed}"
+    corners = sum(name.startswith("corner") for name, _ in problems)
+    print(f"{len(problems) - corners} grid legs of {args.plans} fuzzed plans (seed {args.seed}"
           f"{f', at least {args.min_nodes} nodes' if args.min_nodes else ''}) and "
-          f"4 corner grids; sizes median {np.median([p.n for _, p in problems]):.0f}, "
+          f"{corners} corner grids; sizes median {np.median([p.n for _, p in problems]):.0f}, "
           f"max {max(p.n for _, p in problems)} nodes")
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "problems.pkl")

@@ -40,10 +40,13 @@ NO_JERK_NODES = 1001
 #: the end's jerk transition gets no steps of its own (`boundary_transient`): a first step
 #: of the transition's (1 / `speedplan.model.grid.END_PER_PHASE` of it) absorbs it for at
 #: most 1 % of ``j_max``. Sized by removal time instead, a state read with a rounding-level
-#: acceleration (1e-12 of ``a_max``, or a subnormal 1e-311) graded a user grid's end to
+#: acceleration (1e-12 of ``a_max``, or a subnormal 1e-311) would grade a user grid's end to
 #: steps of 1e-11 of the move (`speedplan.model.grid.MIN_RELATIVE_STEP`, 1.6 nm on 161 m),
 #: where ``w`` changes by 1e-16 from node to node and the law's jerk (1.08-1.45 of
-#: ``j_max``) depended on the relaxation's last digits.
+#: ``j_max``) depends on the relaxation's last digits. At the threshold the grading switches:
+#: just above it the end's first step is the removal's (2000 times finer on a 161 m move
+#: from 0.026 m/s) and the grid has more nodes; both sides keep the law within 2 % of
+#: ``j_max``.
 NEGLIGIBLE_REMOVAL = 5e-4
 #: Rounds in which the default no-jerk grid is refined (steps / 4) where the optimum rides a
 #: node bound more than `NO_JERK_BOUND_LOSS` below the bound at the node itself: the

@@ -53,12 +53,12 @@ SIGMA_EXPONENT = 3.0
 #: ``α_affine ** SECOND_ORDER_EXPONENT``. Mehrotra's full term predicts the complementarity
 #: after a full affine step; where only a short one is possible it is far larger than what
 #: any step realises, and it blocks the next step: on fine grids along a curved speed bound
-#: the method advanced one node per iteration with steps of 0.01-0.08 and stopped with
-#: NoProgress (a right-angle corner at a yaw-rate limit on uniform 2-3 mm grids). Salahi,
-#: Peng and Terlaky's modified corrector weights the term by the affine step itself; its
-#: square root did best here (exponents 0.25-2 tried), and with the separate primal and dual
-#: steps of `step` it solved those grids and cut the iterations of 7 000-18 000-node comfort
-#: grids by a median 20 % (docs/banded-ipm.md).
+#: the full term makes the method advance one node per iteration, with steps of 0.01-0.08,
+#: and stop with NoProgress (a right-angle corner at a yaw-rate limit on uniform grids of
+#: 2-3.3 mm). Salahi, Peng and Terlaky's modified corrector weights the term by the affine
+#: step itself; its square root does as well as any exponent tried (0.25-2), and with the
+#: separate primal and dual steps of `step` it solves those grids and takes a median 20 %
+#: fewer iterations on 7 000-18 000-node comfort grids (docs/banded-ipm.md).
 SECOND_ORDER_EXPONENT = 0.5
 #: Relative gap below which each Newton solve is checked for iterative refinement.
 REFINE_BELOW = 1e-3
@@ -83,7 +83,8 @@ NO_PROGRESS_ITERATIONS = 20
 ADJ_SET, ADJ_SUBTRACT, ADJ_ADD, ADJ_DUAL_RESIDUAL = 0, 1, 2, 3
 
 #: Columns of `iterate`'s log, one row per iteration.
-LOG_COLUMNS = ("pcost", "dcost", "relgap", "pres", "dres", "sigma", "step", "dual_step")
+LOG_COLUMNS = ("pcost", "dcost", "relgap", "pres", "dres", "sigma", "primal_step",
+               "dual_step")
 
 #: Status codes returned by `iterate`.
 SOLVED, MAX_ITERATIONS, STALLED, NUMERICAL_ERROR, NO_PROGRESS = 0, 1, 2, 3, 4
@@ -207,7 +208,7 @@ class Residual(NamedTuple):
     """The dual residual, negated: ``-(G'y + c)``.
 
     The primal residual of the linear rows is the same number on every row (the start's
-    shift, scaled by ``1 - α`` at each step), carried as a scalar ``rp``; the cone rows
+    shift, scaled by ``1 - α_primal`` at each step), carried as a scalar ``rp``; the cone rows
     have none (see `Point`).
     """
 

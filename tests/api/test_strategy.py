@@ -206,9 +206,10 @@ def test_the_slow_4m_g2_path_answers_within_its_time_limit():
 
 @pytest.mark.parametrize("n", [6000, 10000])
 def test_a_fine_given_grid_along_a_yaw_rate_bound_is_answered_by_its_first_solve(n):
-    # A right-angle corner at a yaw-rate limit on a uniform grid of 2-3 mm: the banded
-    # method used to advance one node per iteration and stop with NoProgress, and Clarabel
-    # then took 400 iterations (43 s) on the same grid.
+    # A right-angle corner at a yaw-rate limit on a uniform grid of 2-3.3 mm: with
+    # Mehrotra's full second-order term and one step for both sides the banded method
+    # advances one node per iteration and stops with NoProgress, and Clarabel needs 400
+    # iterations (43 s) on the same grid (docs/banded-ipm.md).
     path = sp.Path.from_waypoints([[0, 0], [10, 0], [10, 10]])
     lim = sp.Limits(v_max=5.0, a_max=0.5, a_lat_max=1.0, j_max=20.0, yaw_rate_max=0.3)
     profile = sp.plan(path, lim, n=n, backend="banded")

@@ -350,22 +350,32 @@ def test_newton_direction_solves_the_full_kkt_system(seed, refine_above, correct
 @pytest.mark.parametrize("iterations", [1, 3])
 def test_linear_rows_primal_residual_stays_one_number(seed, iterations):
     # The kernel carries the linear rows' primal residual b - G x - s as one scalar: the
-    # start's shift is the same on every row and each step removes the same fraction of it.
-    # Forced here by a start above a speed bound; checked against the dense G.
+    # start's shift is the same on every row and each step removes the fraction α_primal of
+    # it (log column "primal_step"). Forced here by a start above a speed bound; checked
+    # against the dense G.
     from speedplan.solve.banded import _kernel_args
 
     unit, d = _setup(seed)
     lay = d.lay
-    args = _kernel_args(unit, d)
-    pt = args[1]
-    pt.w[3] = 3.0 * unit.w_max[4] / d.cw[3]  # z² < w and t z > 1 still hold
-    log = np.full((iterations + 1, len(ipm.LOG_COLUMNS)), np.nan)
-    ipm.iterate(*args, log, 1e-8, iterations)
     g_lin, _ = _dense_g(unit, d)
     b = d.rhs_lin()
-    r = b - g_lin @ np.concatenate((pt.w, pt.t, pt.z)) - pt.sl
+
+    def run(iters):
+        args = _kernel_args(unit, d)
+        pt = args[1]
+        pt.w[3] = 3.0 * unit.w_max[4] / d.cw[3]  # z² < w and t z > 1 still hold
+        log = np.full((iters + 1, len(ipm.LOG_COLUMNS)), np.nan)
+        ipm.iterate(*args, log, 1e-8, iters)
+        return pt, log, b - g_lin @ np.concatenate((pt.w, pt.t, pt.z)) - pt.sl
+
+    _, _, r0 = run(0)  # the start's residual: no step taken
+    pt, log, r = run(iterations)
     assert np.abs(r).max() > 1e-6  # the shift is not yet gone
     assert np.ptp(r) <= 1e-12 * max(1.0, float(np.abs(b).max()))
+    primal = log[:iterations, ipm.LOG_COLUMNS.index("primal_step")]
+    dual = log[:iterations, ipm.LOG_COLUMNS.index("dual_step")]
+    assert np.all((primal > 0) & (dual > 0))
+    assert r.mean() == pytest.approx(r0.mean() * np.prod(1.0 - primal), rel=1e-9)
     # The logged primal residual of the last iteration is that of the iterate.
     _, _, _, ry2, _ = _py(ipm.residuals_into)(d, pt, ipm.empty(ipm.Residual, lay),
                                               np.zeros(lay.n_lin))
