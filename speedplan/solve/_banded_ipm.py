@@ -1093,7 +1093,7 @@ def step(pt: Point, dn: Direction) -> tuple[float, float]:
     nearest boundary from holding back the other: ``(x, s)`` move by ``α_primal`` (so the
     linear rows' primal residual shrinks by ``1 - α_primal``), the multipliers ``y`` by
     ``α_dual``; the dual residual is formed from the iterate at every iteration. On plan()
-    grids it saved about a tenth of the iterations on top of the corrector's weighting
+    grids it saves about a tenth of the iterations on top of the corrector's weighting
     (`SECOND_ORDER_EXPONENT`, docs/banded-ipm.md). The closed-form step to the boundary can
     be off by rounding for nearly degenerate cones; a side's step is halved until its cones
     are strictly interior. Returns ``(0, 0)`` (nothing moved) if no such steps were found.
