@@ -42,7 +42,7 @@ NO_JERK_NODES = 1001
 #: most 1 % of ``j_max``. Sized by removal time instead, a state read with a rounding-level
 #: acceleration (1e-12 of ``a_max``, or a subnormal 1e-311) would grade a user grid's end to
 #: steps of 1e-11 of the move (`speedplan.model.grid.MIN_RELATIVE_STEP`, 1.6 nm on 161 m),
-#: where ``w`` changes by 1e-16 from node to node and the law's jerk (1.08-1.45 of
+#: where ``w`` changes by 1e-16 from node to node and the law's jerk (1.08-1.57 of
 #: ``j_max``) depends on the relaxation's last digits. At the threshold the grading switches:
 #: just above it the end's first step is the removal's (2000 times finer on a 161 m move
 #: from 0.026 m/s) and the grid has more nodes; both sides keep the law within 2 % of

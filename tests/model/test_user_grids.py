@@ -107,7 +107,7 @@ def test_straight_moves_on_user_grids_meet_the_limits_and_ruckig(length, v_max, 
 def test_a_rounding_level_start_acceleration_grades_a_user_grid_as_none(fraction):
     # A moving start read with an acceleration of rounding size. Sized by the time to remove
     # it, the grid's first steps would be 1.6 nm (1e-11 of the move), where w changes by
-    # 1e-16 per node and the law's jerk (1.08-1.45 of j_max) depends on the relaxation's last
+    # 1e-16 per node and the law's jerk (1.08-1.57 of j_max) depends on the relaxation's last
     # digits. Removing it takes no time worth a step of its own.
     lim = sp.Limits(v_max=0.4641588833612779, a_max=0.15482828285804393, a_lat_max=1.0,
                     j_max=1.0)
