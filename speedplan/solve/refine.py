@@ -8,7 +8,8 @@ can end in different local optima (up to 3 % apart on the benchmark corpus): the
 starts is the safeguard. Each run costs a few milliseconds per thousand nodes, and the last
 start is skipped when the first two agree; given the relaxation's certified lower bound, the
 starts end at the first accepted point within `ENOUGH_GAP` of it. Problems with lateral-jerk
-rows run `LATERAL_STARTS` instead (the scaled starts first).
+rows run `LATERAL_STARTS` instead, and end at the first accepted one (the best of the starts
+there on every refinement measured).
 """
 
 from __future__ import annotations
@@ -31,11 +32,8 @@ __all__ = ["AGREE", "ENOUGH_GAP", "refine"]
 #: 124 and never lost a better optimum; agreeing runs differ by about 1e-8 (their tolerance).
 AGREE = 1e-7
 #: An accepted run whose travel time lies within this (relative) of a certified lower bound
-#: ends the starts: no other start can be faster by more. Over the 131 refinements of 1 000
-#: random curved and comfort plans (`benchmarks/bench_latency.py --plans 2000 --seed 11`),
-#: 77 of the first accepted runs are that close. On the others the later starts run, and on
-#: one of them a later start is 1.03e-4 faster than the first: a wider threshold (1e-3 would
-#: end 128 of the 131) would give that up. Each start costs 0.2-0.5 s on 10 000 nodes.
+#: ends the starts: no other start can be faster by more. (Problems with lateral rows end at
+#: their first accepted start anyway, see `LATERAL_STARTS`.)
 ENOUGH_GAP = 1e-4
 
 
@@ -66,7 +64,7 @@ def refine(
     RefineResult
         The accepted candidate of least travel time, ``success=True`` (the starts are run in
         order until two accepted ones agree to `AGREE`, or one lies within `ENOUGH_GAP` of
-        ``lower_bound``); if none is accepted, the last
+        ``lower_bound``; with lateral rows, until one is accepted); if none is accepted, the last
         candidate with ``success=False``. ``status`` names the solver and its start,
         ``iterations`` and ``solve_time`` cover every run.
 
@@ -92,6 +90,7 @@ def refine(
     found: list[float] = []
     # The banded method holds no friction-ellipse rows: IPOPT refines those problems.
     starts = () if problem.has_grip else LATERAL_STARTS if problem.has_lateral else STARTS
+    first_wins = problem.has_lateral
     for start in starts:
         if iterations and passed():  # the plan's deadline (speedplan.core.deadline): stop
             break
@@ -103,6 +102,8 @@ def refine(
             objective = problem.travel_time(res.w)
             if best is None or objective < best[0]:
                 best = (objective, res.w, status)
+            if first_wins:
+                break
             if lower_bound is not None and objective <= lower_bound * (1.0 + ENOUGH_GAP):
                 break  # certified within ENOUGH_GAP: no start can gain more
             if any(abs(objective - f) <= AGREE * f for f in found):

@@ -310,3 +310,28 @@ def test_a_plan_is_never_faster_than_its_own_certified_bound():
     fastest, _, _ = no_jerk_lower_bound(SpeedBound(path, lim), path.length, lim.a_max,
                                         lim.a_decel)
     assert profile.duration >= fastest
+
+
+def test_a_comfort_plan_is_refined_to_the_local_optimum_next_to_its_relaxation():
+    # A 250 m corner started at 5 cm/s. Next to a stop the travel time's gradient is 2e10
+    # times its median; scaled as IPOPT scales an objective (its largest gradient entry to
+    # 100), the refinement's objective was divided by 3e7, its barrier outweighed it, its
+    # iterates left the relaxed point, and the plan ended in a local optimum 1.3e-3 (0.19 s)
+    # above the relaxation's certified lower bound; the one next to the relaxed point is
+    # 1.2e-7 above it. (IPOPT on the plain formulation, the other oracle at hand, stops at
+    # "infeasible problem detected" on this grid.)
+    from speedplan.geometry import SpeedBound
+
+    path = Path.from_waypoints([[0.0, 0.0], [113.38235734017698, 8.749957855774369],
+                                [234.0445076283548, 71.52871606833898]])
+    lim = Limits(v_max=12.027445314993807, a_max=0.05766831099292436,
+                 a_lat_max=0.8511906239752254, j_max=14.6601905484736,
+                 j_lat_max=0.2086658984788041, yaw_rate_max=0.2512549495004922)
+    start = {"v0": 0.0547170655868091, "a0": 0.004650246484588454}
+    profile = plan(path, lim, **start)
+    assert profile.status == "refined"
+    assert 0.0 <= profile.gap <= 1e-5
+    assert within_promise(measure(profile))
+    fastest, _, _ = no_jerk_lower_bound(SpeedBound(path, lim), path.length, lim.a_max,
+                                        lim.a_decel, v0=start["v0"])
+    assert profile.duration >= fastest
