@@ -330,6 +330,31 @@ def test_lateral_problems_end_at_their_first_accepted_start_the_best_of_all():
     assert p.travel_time(res.w) <= min(accepted) * (1 + refine_module.AGREE)
 
 
+def test_a_run_that_creeps_after_an_acceptable_point_ends_there(monkeypatch):
+    # The refinement of a 250 m comfort corner: after an acceptable point the run crept on
+    # with steps under 1 % of the Newton step until its limit of 200 iterations, and returned
+    # that point. It now ends ten such steps later (74 iterations), with the same point.
+    path = sp.Path.from_waypoints([[0.0, 0.0], [113.38235734017698, 8.749957855774369],
+                                   [234.0445076283548, 71.52871606833898]])
+    lim = sp.Limits(v_max=12.027445314993807, a_max=0.05766831099292436,
+                    a_lat_max=0.8511906239752254, j_max=14.6601905484736,
+                    j_lat_max=0.2086658984788041, yaw_rate_max=0.2512549495004922)
+    (leg,) = build_model(PlanRequest.create(path, lim, v0=0.0547170655868091,
+                                            a0=0.004650246484588454)).legs
+    from speedplan.solve.banded import solve_unit_relaxation, unit_scales
+
+    p = leg.problem.scaled(*unit_scales(leg.problem))  # as the plan refines it
+    w0 = solve_unit_relaxation(p).w
+    start = banded_nlp.LATERAL_STARTS[0]
+    ended = banded_nlp.solve_banded_nlp(p, w0, start)
+    monkeypatch.setattr(banded_nlp, "STALL_ITERATIONS", banded_nlp.MAX_ITER + 1)
+    crept = banded_nlp.solve_banded_nlp(p, w0, start)
+    assert crept.iterations == banded_nlp.MAX_ITER  # the case this test is about
+    assert ended.success and ended.iterations < 100
+    np.testing.assert_array_equal(ended.w, crept.w)
+    assert _feasible(p, ended.w)
+
+
 def test_a_start_within_the_enough_gap_of_a_certified_bound_ends_the_starts():
     # No start can be faster than the relaxation's certified lower bound, so one within
     # ENOUGH_GAP of it leaves at most that to gain: the other starts are not run.
