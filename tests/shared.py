@@ -13,6 +13,16 @@ LGV = Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5)
 #: :data:`LGV` as ``speedplan plan`` flags.
 LGV_ARGS = ["--v-max", "2", "--a-max", "1", "--a-lat-max", "1", "--j-max", "0.5"]
 
+#: A 250 m road corner with comfort limits, started at 5 cm/s (a draw of
+#: ``benchmarks/bench_latency.py``): its refinement is not exact, and next to its stop the
+#: travel time's gradient is 2e10 times its median. Waypoints, limits, boundary state.
+CRAWL_CORNER = [[0.0, 0.0], [113.38235734017698, 8.749957855774369],
+                [234.0445076283548, 71.52871606833898]]
+CRAWL_CORNER_LIMITS = Limits(v_max=12.027445314993807, a_max=0.05766831099292436,
+                             a_lat_max=0.8511906239752254, j_max=14.6601905484736,
+                             j_lat_max=0.2086658984788041, yaw_rate_max=0.2512549495004922)
+CRAWL_CORNER_START = {"v0": 0.0547170655868091, "a0": 0.004650246484588454}
+
 #: The hypothesis profile of this run (registered in ``conftest.py``).
 HYPOTHESIS_PROFILE = os.environ.get("SPEEDPLAN_HYPOTHESIS", "ci")
 if HYPOTHESIS_PROFILE not in ("ci", "dev", "deep"):

@@ -12,6 +12,7 @@ import pathlib
 import numpy as np
 import pytest
 from oracles import PROMISED, corner_reversals, measure, no_jerk_lower_bound, within_promise
+from shared import CRAWL_CORNER, CRAWL_CORNER_LIMITS, CRAWL_CORNER_START
 
 from speedplan import Limits, Path, plan
 
@@ -322,12 +323,7 @@ def test_a_comfort_plan_is_refined_to_the_local_optimum_next_to_its_relaxation()
     # "infeasible problem detected" on this grid.)
     from speedplan.geometry import SpeedBound
 
-    path = Path.from_waypoints([[0.0, 0.0], [113.38235734017698, 8.749957855774369],
-                                [234.0445076283548, 71.52871606833898]])
-    lim = Limits(v_max=12.027445314993807, a_max=0.05766831099292436,
-                 a_lat_max=0.8511906239752254, j_max=14.6601905484736,
-                 j_lat_max=0.2086658984788041, yaw_rate_max=0.2512549495004922)
-    start = {"v0": 0.0547170655868091, "a0": 0.004650246484588454}
+    path, lim, start = Path.from_waypoints(CRAWL_CORNER), CRAWL_CORNER_LIMITS, CRAWL_CORNER_START
     profile = plan(path, lim, **start)
     assert profile.status == "refined"
     assert 0.0 <= profile.gap <= 1e-5

@@ -15,6 +15,7 @@ import casadi as ca
 import numpy as np
 import pytest
 from oracles import ipopt_plain
+from shared import CRAWL_CORNER, CRAWL_CORNER_LIMITS, CRAWL_CORNER_START
 
 import speedplan as sp
 from speedplan.core.errors import SolverError
@@ -334,13 +335,8 @@ def test_a_run_that_creeps_after_an_acceptable_point_ends_there(monkeypatch):
     # The refinement of a 250 m comfort corner: after an acceptable point the run crept on
     # with steps under 1 % of the Newton step until its limit of 200 iterations, and returned
     # that point. It now ends ten such steps later (74 iterations), with the same point.
-    path = sp.Path.from_waypoints([[0.0, 0.0], [113.38235734017698, 8.749957855774369],
-                                   [234.0445076283548, 71.52871606833898]])
-    lim = sp.Limits(v_max=12.027445314993807, a_max=0.05766831099292436,
-                    a_lat_max=0.8511906239752254, j_max=14.6601905484736,
-                    j_lat_max=0.2086658984788041, yaw_rate_max=0.2512549495004922)
-    (leg,) = build_model(PlanRequest.create(path, lim, v0=0.0547170655868091,
-                                            a0=0.004650246484588454)).legs
+    (leg,) = build_model(PlanRequest.create(sp.Path.from_waypoints(CRAWL_CORNER),
+                                            CRAWL_CORNER_LIMITS, **CRAWL_CORNER_START)).legs
     from speedplan.solve.banded import solve_unit_relaxation, unit_scales
 
     p = leg.problem.scaled(*unit_scales(leg.problem))  # as the plan refines it
