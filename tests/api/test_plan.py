@@ -146,10 +146,13 @@ def test_limit_ratios_and_duration_converge_as_the_grid_is_refined(ungraded):
     jerk = [check.ratios["jerk"] for check, _ in results]
     assert jerk[0] > 1.05 and all(b < a for a, b in itertools.pairwise(jerk))
     assert jerk[-1] <= 1.01
-    reference = ruckig_duration(30.0, LGV)
-    errors = [abs(d / reference - 1) for _, d in results]
-    assert all(b < a for a, b in itertools.pairwise(errors))
-    assert errors[-1] < 1e-5
+    # The durations settle (each refinement moves them less) onto ruckig's exact optimum. Not
+    # every error is smaller than the last: the discretisation's error (the law faster than
+    # the optimum by O(h²)) crosses the few 1e-6 above it that the finest grids keep.
+    durations = [d for _, d in results]
+    moves = [abs(b - a) for a, b in itertools.pairwise(durations)]
+    assert all(b < a / 2 for a, b in itertools.pairwise(moves))
+    assert durations[-1] == pytest.approx(ruckig_duration(30.0, LGV), rel=1e-5)
 
 
 def test_coarse_grid_is_refined_where_the_limits_are_exceeded(ungraded):
