@@ -698,7 +698,9 @@ def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> 
     """Arc lengths [m] where the speed bound ``bound`` may have a kink, a step or a dip.
 
     The joins of the path's pieces (where the curvature may jump or change its law: the
-    extremes of a clothoid chain's curvature lie there) and, for a `SpeedBound`, the
+    extremes of a clothoid chain's curvature lie there), the knots inside its spline and
+    NURBS pieces (where the curvature rate jumps: `Path.rate_joins`) and, for a
+    `SpeedBound`, the
     knots of its ``v_limit`` (piecewise linear: its minimum over any stretch is at a knot or
     an end), the ends of its spans and the entries and exits of its zones
     (`zone_intervals`, located to 1e-9 m on the inside). In the bound's own arc length
@@ -720,7 +722,7 @@ def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> 
 
 def _computed_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> FloatArray:
     """`bound_breakpoints`, computed."""
-    parts = [np.asarray(path.offsets[1:-1], dtype=np.float64)]
+    parts = [path.rate_joins]
     shift = 0.0
     if isinstance(bound, SpeedBound):
         shift = bound.offset  # the bound reads the path at s + offset

@@ -369,6 +369,46 @@ class Path:
         """
         return self._dispatch(s, "curvature_rate")
 
+    def curvature_rate_before(self, s: ArrayLike) -> FloatArray:
+        """`curvature_rate` on the side before ``s`` [1/m²].
+
+        Where the rate jumps (a join of pieces, a knot of a spline or NURBS piece:
+        `rate_joins`), the rate the stretch before ``s`` ends with.
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Clothoid, Line, Path
+        >>> p = Path.from_segments([Clothoid(2.0, 0.0, 0.5), Line(1.0)])
+        >>> p.curvature_rate([2.0]).tolist(), p.curvature_rate_before([2.0]).tolist()
+        ([0.0], [0.25])
+        """
+        q, _ = self._locate(s)
+        idx = np.maximum(np.searchsorted(self.offsets, q, side="left") - 1, 0)
+        idx = np.minimum(idx, len(self.pieces) - 1)
+        return self._by_piece(q, idx, "curvature_rate_before")
+
+    @cached_property
+    def rate_joins(self) -> FloatArray:
+        """Arc lengths [m] inside the path where the curvature rate may jump, sorted.
+
+        The joins of its pieces (`offsets`) and the knots inside its spline and NURBS pieces,
+        where a cubic curve is C²: the curvature goes on, its rate jumps, and so does the
+        lateral jerk at a given speed. A lateral-jerk limit is held on both sides of each
+        (`curvature_rate`, `curvature_rate_before`).
+
+        Examples
+        --------
+        >>> from speedplan.geometry import Path
+        >>> p = Path.from_nurbs(3, [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
+        ...                     [[0, 0], [2, 0], [4, 1], [5, 3], [5, 5]])
+        >>> p.rate_joins.size, bool(0 < p.rate_joins[0] < p.length)
+        (1, True)
+        """
+        parts = [self.offsets[1:-1]]
+        parts += [self.offsets[k] + piece.rate_breaks for k, piece in enumerate(self.pieces)]
+        out: FloatArray = np.unique(np.concatenate(parts))
+        return out
+
     def curvature_jumps(self, tol: float = 1e-9) -> tuple[FloatArray, FloatArray]:
         """Joins of pieces where the curvature jumps: ``(s [m], jump [1/m])``.
 

@@ -19,7 +19,7 @@ ones.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Literal, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -34,6 +34,9 @@ __all__ = ["GAUSS_NODES", "GAUSS_WEIGHTS", "CurvePiece", "ParametricCurve", "Pie
 
 #: Sub-intervals per polynomial piece in the arc-length table of a `CurvePiece`.
 _TABLE_SPLIT = 8
+#: Distance [of a curve piece's length] within which a point is on a break of the curve (the
+#: rate of its curvature is read on one side of it).
+_BREAK_SNAP = 1e-12
 #: At most this many rounds of halving the table cells where the arc length is not resolved.
 _TABLE_HALVINGS = 40
 #: At most this many safeguarded Newton steps per arc-length inversion (2-3 in practice; 60
@@ -153,6 +156,23 @@ class Piece:
         out: FloatArray = (self.curvature(hi) - self.curvature(lo)) / (hi - lo)
         return out
 
+    def curvature_rate_before(self, u: FloatArray) -> FloatArray:
+        """``dκ/du`` [1/m²] on the side before ``u``.
+
+        At a `rate_breaks` point, the rate the stretch before it ends with
+        (`curvature_rate` gives the one after it).
+        """
+        return self.curvature_rate(u)
+
+    @property
+    def rate_breaks(self) -> FloatArray:
+        """Local arc lengths [m] inside the piece where the curvature rate may jump.
+
+        None for a line, an arc or a clothoid; the knots of a spline or NURBS piece (a cubic
+        one is C² there: its curvature is continuous, its rate is not).
+        """
+        return np.zeros(0)
+
     def evaluate(self, u: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """``(point, heading, curvature)`` at once (pieces share work where they can)."""
         return self.point(u), self.heading(u), self.curvature(u)
@@ -227,6 +247,8 @@ class CurvePiece(Piece):
     # cell) and whether each is accurate (else the curve is evaluated per query).
     _kappa_coef: FloatArray = field(init=False, repr=False)
     _kappa_ok: npt.NDArray[np.bool_] = field(init=False, repr=False)
+    # Arc lengths of the curve's interior breaks (`rate_breaks`).
+    _breaks_u: FloatArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "direction", as_direction("direction", self.direction))
@@ -259,6 +281,8 @@ class CurvePiece(Piece):
         set_(self, "_theta", theta)
         set_(self, "_dtau", 1.0 / np.maximum(speed, 1e-300))  # dτ/du at the table nodes
         set_(self, "length", float(arc[-1]))
+        inner = b[1:-1]  # the table holds every break as a node: their arc lengths are exact
+        set_(self, "_breaks_u", arc[np.searchsorted(tau, inner)] if inner.size else np.zeros(0))
         self._interpolate()
 
     def _interpolate(self) -> None:
@@ -548,11 +572,34 @@ class CurvePiece(Piece):
         _, d1, d2 = self._derivatives(tau)
         return _signed_curvature(d1, d2)
 
+    @property
+    def rate_breaks(self) -> FloatArray:
+        """The arc lengths [m] of the curve's interior breaks (knots)."""
+        return self._breaks_u.copy()
+
     def curvature_rate(self, u: FloatArray) -> FloatArray:
-        """The central difference of `Piece.curvature_rate`, both sides in one query."""
+        """The central difference of `Piece.curvature_rate`, within the polynomial piece.
+
+        The difference does not straddle a break, where the rate jumps: at a break it is the
+        piece's after it (`curvature_rate_before` gives the one before).
+        """
+        return self._rate(u, side="right")
+
+    def curvature_rate_before(self, u: FloatArray) -> FloatArray:
+        """`curvature_rate`, but at a break the polynomial piece's before it."""
+        return self._rate(u, side="left")
+
+    def _rate(self, u: FloatArray, side: Literal["left", "right"]) -> FloatArray:
         u = np.clip(np.asarray(u, dtype=np.float64), 0.0, self.length)
+        edges = np.concatenate(([0.0], self._breaks_u, [self.length]))
+        # A break reached through other arithmetic (a reversed or shifted piece's L - (L - b))
+        # lies a few ulps off: within _BREAK_SNAP of the length it is the break.
+        near = np.clip(np.searchsorted(edges, u), 1, edges.size - 1)
+        near = np.where(u - edges[near - 1] < edges[near] - u, near - 1, near)
+        u = np.where(np.abs(u - edges[near]) <= _BREAK_SNAP * self.length, edges[near], u)
+        k = np.clip(np.searchsorted(edges, u, side=side) - 1, 0, edges.size - 2)
         step = 1e-5 * self.length
-        lo, hi = np.maximum(u - step, 0.0), np.minimum(u + step, self.length)
+        lo, hi = np.maximum(u - step, edges[k]), np.minimum(u + step, edges[k + 1])
         kappa = self.curvature(np.concatenate((lo.ravel(), hi.ravel())))
         out: FloatArray = ((kappa[lo.size:] - kappa[:lo.size]).reshape(u.shape) / (hi - lo))
         return out
@@ -607,8 +654,18 @@ class ReversedPiece(Piece):
         return out
 
     def curvature_rate(self, u: FloatArray) -> FloatArray:
-        """``d(-κ(L - u))/du = κ'(L - u)`` [1/m²]."""
+        """``d(-κ(L - u))/du = κ'(L - u)`` [1/m²]; after ``u`` is before ``L - u``."""
+        return self.piece.curvature_rate_before(self._mirror(u))
+
+    def curvature_rate_before(self, u: FloatArray) -> FloatArray:
+        """`curvature_rate` on the side before ``u``: after ``L - u`` on the piece."""
         return self.piece.curvature_rate(self._mirror(u))
+
+    @property
+    def rate_breaks(self) -> FloatArray:
+        """The piece's breaks, mirrored [m]."""
+        out: FloatArray = (self.piece.length - self.piece.rate_breaks)[::-1]
+        return out
 
     @property
     def straight(self) -> bool:
@@ -667,5 +724,26 @@ class SubPiece(Piece):
         return self.piece.curvature(self._shift(u))
 
     def curvature_rate(self, u: FloatArray) -> FloatArray:
-        """``dκ/du`` [1/m²]."""
-        return self.piece.curvature_rate(self._shift(u))
+        """``dκ/du`` [1/m²]; at the stretch's end, the rate before it."""
+        q = self._shift(u)
+        out = self.piece.curvature_rate(q)
+        end = q >= self.lo + self.sub_length
+        if np.any(end):  # the piece may go on with another rate after a break there
+            out = np.where(end, self.piece.curvature_rate_before(q), out)
+        return out
+
+    def curvature_rate_before(self, u: FloatArray) -> FloatArray:
+        """``dκ/du`` [1/m²] on the side before ``u``; at the stretch's start, after it."""
+        q = self._shift(u)
+        out = self.piece.curvature_rate_before(q)
+        start = q <= self.lo
+        if np.any(start):
+            out = np.where(start, self.piece.curvature_rate(q), out)
+        return out
+
+    @property
+    def rate_breaks(self) -> FloatArray:
+        """The piece's breaks inside the stretch, in its own arc length [m]."""
+        b = self.piece.rate_breaks - self.lo
+        out: FloatArray = b[(b > 0.0) & (b < self.sub_length)]
+        return out

@@ -238,14 +238,15 @@ def boundary_transient(request: PlanRequest, v: float, a: float, a_limit: float,
 
 
 def grid_anchors(request: PlanRequest, lo: float, hi: float) -> FloatArray:
-    """Where a leg's default grids put nodes: joins of path pieces inside ``(lo, hi)``.
+    """Where a leg's default grids put nodes: the path's `rate_joins` inside ``(lo, hi)``.
 
     In the leg's arc length, and only with a lateral-jerk limit: the curvature rate jumps
-    there, and with a node on the join its two one-sided lateral-jerk rows hold the jump.
+    there (joins of pieces, knots of spline and NURBS pieces), and with a node on the join
+    its two one-sided lateral-jerk rows hold the jump.
     """
     if not np.isfinite(request.limits.j_lat_max):
         return np.zeros(0)
-    joins = request.path.offsets[1:-1]
+    joins = request.path.rate_joins
     out: FloatArray = joins[(joins > lo) & (joins < hi)] - lo
     return out
 

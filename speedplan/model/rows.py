@@ -293,21 +293,23 @@ def _join_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float) -> list[S
     lateral jerk jumps at the join (``κ'`` does) and neither the node nor the midpoint rows
     see the side they are not on (a law 1.13× over ``j_lat_max`` next to such a join). Two
     families hold each such join's row with the rate before and after it, at the node whose
-    dual cell holds the join (one join per dual cell: a second one there gets no row).
+    dual cell holds the join; a second join in the same dual cell (the ends of a line of a
+    few millimetres between two clothoids) has two families of its own: without them its
+    rate after it was not held, and the law reached 1.012× ``j_lat_max`` there.
     ``w'`` is the time law's (`speedplan.timing.TimeLaw`: the cell's secant slope at its
     midpoint, bent by the second difference of the node on the join's side of it, split by
     the step ratio), a stencil around that node; ``w`` the cell's linear interpolation.
     """
-    joins = path.offsets[1:-1]
+    joins = path.rate_joins
     if joins.size == 0 or s.size < 4:
         return []
     at = lo + s
     margin = 1e-12 * max(float(path.length), 1.0)
     h = np.diff(s)
     n = s.size
-    coefs = [np.zeros((n - 2, 3)), np.zeros((n - 2, 3))]
-    bound = np.full(n - 2, np.inf)
-    for j, x in enumerate(joins):
+    coefs: list[list[FloatArray]] = []  # per slot (k-th join of a dual cell): two families
+    bounds: list[FloatArray] = []
+    for x in joins:
         c = int(np.searchsorted(at, x)) - 1  # the cell [at[c], at[c + 1]] holding x
         if not (0 <= c < n - 1 and at[c] + margin < x < at[c + 1] - margin):
             continue  # a node, or outside the leg
@@ -315,8 +317,13 @@ def _join_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float) -> list[S
         offset = x - 0.5 * (at[c] + at[c + 1])
         # The node whose dual cell holds x, and its second difference's weights.
         node = c + 1 if offset >= 0.0 else c
-        if not 1 <= node <= n - 2 or np.isfinite(bound[node - 1]):
-            continue  # next to the leg's end, or a second join in the same dual cell
+        if not 1 <= node <= n - 2:
+            continue  # next to the leg's end
+        slot = next((k for k, b in enumerate(bounds) if not np.isfinite(b[node - 1])),
+                    len(bounds))
+        if slot == len(bounds):
+            coefs.append([np.zeros((n - 2, 3)), np.zeros((n - 2, 3))])
+            bounds.append(np.full(n - 2, np.inf))
         h0, h1 = h[node - 1], h[node]
         d2 = np.array([2.0 / (h0 * (h0 + h1)), -2.0 / (h0 * h1), 2.0 / (h1 * (h0 + h1))])
         split = h1 / h0 if node == c + 1 else h0 / h1  # the law's curvature on x's side
@@ -327,16 +334,14 @@ def _join_rows(path: Path, lo: float, s: FloatArray, j_lat_max: float) -> list[S
             value = np.array([0.0, 1.0 - theta, theta])
             secant = np.array([0.0, -1.0, 1.0]) / h[c]
         slope = secant + offset * split * d2
-        piece = path.pieces[j]  # the piece ending at the join
         kappa = float(path.curvature(np.array([x]))[0])
         for family, rate in ((0, float(path.curvature_rate(np.array([x]))[0])),
-                             (1, float(piece.curvature_rate(np.array(piece.length))))):
-            coefs[family][node - 1] = lateral_rate_weights(
+                             (1, float(path.curvature_rate_before(np.array([x]))[0]))):
+            coefs[slot][family][node - 1] = lateral_rate_weights(
                 np.array([kappa]), np.array([rate]), value, slope)[0]
-        bound[node - 1] = j_lat_max
-    if not np.isfinite(bound).any():
-        return []
-    return [StencilRows(coef=coefs[0], bound=bound), StencilRows(coef=coefs[1], bound=bound)]
+        bounds[slot][node - 1] = j_lat_max
+    return [StencilRows(coef=coef, bound=bound)
+            for pair, bound in zip(coefs, bounds, strict=True) for coef in pair]
 
 
 def curvature_at_nodes(path: Path, lo: float, s: FloatArray) -> NodeCurvature:
@@ -345,14 +350,14 @@ def curvature_at_nodes(path: Path, lo: float, s: FloatArray) -> NodeCurvature:
     kappa = np.asarray(path.curvature(q), dtype=np.float64)
     after = np.asarray(path.curvature_rate(q), dtype=np.float64)
     before = after.copy()
-    joins = path.offsets[1:-1]
+    joins = path.rate_joins
     if joins.size:
         k = np.searchsorted(joins, q)  # nearest join to each node
+        on = np.zeros(q.size, dtype=bool)
         for cand in (np.clip(k - 1, 0, joins.size - 1), np.clip(k, 0, joins.size - 1)):
-            on = np.abs(joins[cand] - q) <= 1e-12 * max(float(path.length), 1.0)
-            for i in np.flatnonzero(on):
-                piece = path.pieces[int(cand[i])]  # the piece ending at that join
-                before[i] = float(piece.curvature_rate(np.array(piece.length)))
+            on |= np.abs(joins[cand] - q) <= 1e-12 * max(float(path.length), 1.0)
+        if on.any():
+            before[on] = path.curvature_rate_before(q[on])
     return kappa, after, before
 
 

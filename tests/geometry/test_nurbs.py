@@ -342,3 +342,30 @@ def test_control_points_off_the_chord_or_out_of_order_are_not_a_line():
     assert straight_chord(np.array([[0.0, 0.0], [2.0, 1e-6], [4.0, 0.0]])) is None
     p = Path.from_nurbs(2, [0, 0, 0, 1, 1, 1], [[0, 0], [2, 1e-6], [4, 0]])
     assert not p.straight_between(0.0, p.length)
+
+
+def test_the_curvature_rate_jumps_at_the_knots_and_is_read_on_each_side():
+    # A cubic B-spline is C² at a simple knot: the curvature goes on, its rate jumps. The
+    # oracle: one-sided differences of the curvature itself, a few micrometres either side.
+    path = Path.from_nurbs(3, [0, 0, 0, 0, 0.4, 0.7, 1, 1, 1, 1],
+                           [[0, 0], [3, 0], [6, 0.5], [8, 2.5], [9, 5], [9, 8]],
+                           [1, 1, 1.2, 1, 1, 1])
+    knots = path.rate_joins
+    assert knots.size == 2 and np.all((knots > 0) & (knots < path.length))
+    d = 1e-4
+    for x in knots:
+        left = (path.curvature([x])[0] - path.curvature([x - d])[0]) / d
+        right = (path.curvature([x + d])[0] - path.curvature([x])[0]) / d
+        assert abs(right - left) > 0.02  # the jump is there
+        assert path.curvature_rate([x])[0] == pytest.approx(right, rel=1e-3)
+        assert path.curvature_rate_before([x])[0] == pytest.approx(left, rel=1e-3)
+    # Driven backwards the sides swap; a stretch starting on a knot reads the rate after it.
+    back = path.reversed()
+    x = path.length - knots[0]
+    assert back.rate_joins == pytest.approx(path.length - knots[::-1])
+    assert back.curvature_rate([x])[0] == pytest.approx(path.curvature_rate_before([knots[0]])[0])
+    assert back.curvature_rate_before([x])[0] == pytest.approx(path.curvature_rate([knots[0]])[0])
+    part = path.sub(float(knots[0]), float(knots[1]))
+    assert part.rate_joins.size == 0
+    assert part.curvature_rate([0.0, part.length]) == pytest.approx(
+        [path.curvature_rate([knots[0]])[0], path.curvature_rate_before([knots[1]])[0]])

@@ -71,17 +71,27 @@ COMFORT = sp.Limits(v_max=2.0, a_max=1.0, a_lat_max=1.0, j_max=0.5, j_lat_max=0.
                     yaw_rate_max=0.4)
 
 
+#: A road's comfort limits: the lateral-jerk limit binds at the joins of its clothoids.
+ROAD_COMFORT = sp.Limits(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0, j_lat_max=0.3,
+                         yaw_rate_max=0.4)
+
+
 @pytest.mark.filterwarnings("ignore:the path.s curvature jumps")  # aisle_corners.csv: stops
 @pytest.mark.parametrize(("name", "lim"), [
     ("u_turn.json", LGV), ("warehouse_loop.json", LGV), ("aisle_corners.csv", LGV),
     ("slow_zone.json", LGV), ("nurbs_edge.json", LGV), ("u_turn.json", COMFORT),
-    ("warehouse_loop.json", COMFORT), ("aisle_corners.csv", COMFORT)],
+    ("warehouse_loop.json", COMFORT), ("aisle_corners.csv", COMFORT),
+    ("nurbs_edge.json", COMFORT), ("road_s_curve.csv", ROAD_COMFORT)],
     ids=lambda x: x if isinstance(x, str) else "comfort" if x.j_lat_max < np.inf else "plain")
 def test_sample_paths_plan_within_1e4_of_the_converged_duration(name, lim):
     # Before: 3.4e-4 (u_turn), 3.3e-4 (warehouse_loop), 9.8e-4 (aisle_corners), 2.8e-4
     # (slow_zone) above it: the node bounds took the least bound over both cells, O(h) where
     # it falls, and a kink of the bound (a clothoid onto an arc, a zone's edge) fell inside a
-    # cell, at a place that changed with the grid.
+    # cell, at a place that changed with the grid. With comfort limits, the rate of the
+    # curvature jumps at the NURBS's knots and at both ends of the millimetre lines between
+    # the road's clothoids; where the lateral-jerk rows did not hold both sides of each, the
+    # plans used the difference, by an amount that changed with the grid (nurbs_edge: grids
+    # cut in 2 and 4 5.4e-4 apart; road_s_curve: the default grid 3e-4 under them).
     path = read_path(os.path.join(PATHS, name))
     zones = read_zones(os.path.join(PATHS, name)) or None
     duration = sp.plan(path, lim, zones=zones).duration
@@ -107,3 +117,18 @@ def test_a_first_jerk_phase_of_a_few_nodes_plans_within_1e4_of_the_converged_dur
     converged, spread = _converged(path, lim, None)
     assert spread < ACCURACY / 4
     assert duration == pytest.approx(converged, rel=ACCURACY)
+
+
+def test_a_nurbs_plan_replans_from_its_own_states_to_the_same_arrival():
+    # The rest of the path planned from a state read off the plan arrives when the plan does.
+    # Before, 7.4e-4 and 1.1e-3 of the duration earlier from the first two states: the plan
+    # let its lateral jerk straddle the NURBS's knots, where the curvature rate jumps, at
+    # places that depend on the grid.
+    path = read_path(os.path.join(PATHS, "nurbs_edge.json"))
+    first = sp.plan(path, COMFORT)
+    for t in np.linspace(0.1, 0.5, 3) * first.duration:
+        state = first.at(t)
+        again = sp.plan(path.sub(float(state.s[0])), COMFORT, v0=float(state.v[0]),
+                        a0=float(state.a[0]))
+        assert again.verification.ok
+        assert t + again.duration == pytest.approx(first.duration, rel=ACCURACY), t
