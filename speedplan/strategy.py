@@ -17,7 +17,10 @@ only when the ones before it did not answer:
 * **solve** (per leg): ``"forced_motion"`` for a leg with no freedom left; ``"closed_form"``
   for a straight leg whose minimum-time motion is known exactly (`StraightLeg`); ``"given_grid"``
   for the caller's grid (``n`` or ``ds``: both relaxation backends, never another grid);
-  otherwise ``"default_grid"`` with the request's backend, then ``"coarser_grid_1/2"``,
+  otherwise ``"default_grid"`` with the request's backend, then, for a leg that starts or
+  ends at a moving state, ``"state_rounding_on_grid"``: the same grid with ``j_max (1 +
+  STATE_JERK_PINNED)`` in its rows (a state on the edge of what ``j_max`` reaches further
+  on leaves the problem no interior; silent), then ``"coarser_grid_1/2"``,
   ``"coarser_grid_1/4"``, ``"coarser_grid_1/8"`` (`COARSER_GRIDS`) with it, then
   ``"other_backend"`` on each of these grids in turn.
 * **verify** (per leg whose continuous law exceeds a tolerance): up to
@@ -62,7 +65,12 @@ from .core.errors import (
 )
 from .core.options import RelaxationBackend
 from .model import ForcedLeg, Leg, Model, ModelLeg, PlanRequest, StraightLeg, TurnLeg, build_model
-from .model.boundary import STATE_JERK_ROUNDING, STATE_JERK_SLACK, state_jerk
+from .model.boundary import (
+    STATE_JERK_PINNED,
+    STATE_JERK_ROUNDING,
+    STATE_JERK_SLACK,
+    state_jerk,
+)
 from .model.build import leg_on_grid
 from .model.grid import MIN_NODES, refined_grid
 from .model.leg_grid import default_grid
@@ -104,7 +112,7 @@ COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
 ATTEMPTS: tuple[str, ...] = (
     "model", "exact_reach", "state_rounding", "exact_reach_state_rounding", "jerk_slack",
     "exact_reach_jerk_slack", "jerk_slack_whole_move", "exact_reach_jerk_slack_whole_move",
-    "forced_motion", "closed_form", "given_grid", "default_grid",
+    "forced_motion", "closed_form", "given_grid", "default_grid", "state_rounding_on_grid",
     *(f"coarser_grid_1/{round(1 / f)}" for f in COARSER_GRIDS),
     "other_backend", "local_refinement", "default_grid_other_backend",
 )
@@ -399,6 +407,11 @@ def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
         return record.attempt("default_grid", i, partial(solve_leg, leg, fallback=False)), False
     except SolverError as exc:
         failures = [exc]
+    pinned = _state_rounded(request, leg)
+    if pinned is not None:
+        with contextlib.suppress(SolverError):
+            return record.attempt("state_rounding_on_grid", i,
+                                  partial(solve_leg, pinned, fallback=False)), False
     for factor in COARSER_GRIDS:
         try:
             result = record.attempt(f"coarser_grid_1/{round(1 / factor)}", i,
@@ -423,6 +436,21 @@ def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
                     f"{failed}; {exc.backend}: {exc}), and on its coarser grids",
                     backend=f"{failed.backend},{exc.backend}", status=exc.status)
     raise failure
+
+
+def _state_rounded(request: PlanRequest, leg: Leg) -> Leg | None:
+    """``leg`` on its grid with ``j_max (1 + STATE_JERK_PINNED)`` in its rows, or ``None``.
+
+    Only for a leg that starts or ends at a moving state of a request planned with
+    ``j_max``: such a state may sit on the edge of what ``j_max`` reaches further on
+    (`speedplan.model.boundary.STATE_JERK_PINNED`).
+    """
+    moving = leg.v0 > 0.0 or leg.a0 != 0.0 or leg.vf > 0.0 or leg.af != 0.0
+    if not moving or request.state_jerk is not None or request.turn_jerk is not None:
+        return None
+    looser = replace(request, state_jerk=request.limits.j_max * (1.0 + STATE_JERK_PINNED))
+    return leg_on_grid(looser, leg.bound, leg.problem.s, leg.start, leg.v0, leg.a0, leg.vf,
+                       leg.af)
 
 
 def _other_backend(failed: str) -> RelaxationBackend:

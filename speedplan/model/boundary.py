@@ -34,6 +34,7 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
 
 __all__ = [
+    "STATE_JERK_PINNED",
     "STATE_JERK_ROUNDING",
     "STATE_JERK_SLACK",
     "Phase",
@@ -60,6 +61,14 @@ STATE_JERK_SLACK = 0.02
 #: ``j_max`` reaches (the time-optimal motion rides its limits) and the law's rounding puts
 #: it a hair outside (measured: the U-turn's state at t = 3 s needs 2.6e-5 more jerk).
 STATE_JERK_ROUNDING = 1e-4
+#: A moving state on the edge of what ``j_max`` reaches downstream (its slowest motion, at
+#: ``-j_max``, is the only one that meets a cap further on: a state read off a road's plan
+#: braking into the lateral-jerk caps of the next clothoid joins) leaves its discrete problem
+#: no interior: the refinement finds no feasible point. The leg is solved again on its grid
+#: with ``j_max (1 + STATE_JERK_PINNED)`` in its rows (`speedplan.strategy`, attempt
+#: ``"state_rounding_on_grid"``, silent; the plan is verified against ``j_max``). Measured on
+#: that state: 1e-4 leaves the refinement infeasible, 1e-3 solves it in 0.06 s.
+STATE_JERK_PINNED = 1e-3
 
 
 def state_jerk(j_max: float) -> float:

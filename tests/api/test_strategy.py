@@ -319,6 +319,33 @@ def test_states_read_off_a_plan_replan_without_a_warning():
     assert rounded > 0  # the case is exercised
 
 
+def test_a_state_on_the_edge_of_its_reach_replans_on_its_default_grid():
+    # On the road S-curve with comfort limits, 0.1 of the way through, the plan brakes its
+    # acceleration at -j_max: the slowest motion from there is the only one that meets the
+    # lateral-jerk caps of the clothoid joins 50 m on, and the replan's problem has no
+    # interior (its refinement: "Infeasible_Problem_Detected"). Before, the strategy's
+    # coarser grids answered after 3.6 s, limits_exceeded (jerk 1.08x).
+    from speedplan.io import read_path
+
+    path = read_path(os.path.join(os.path.dirname(__file__), "..", "..", "paths",
+                                  "road_s_curve.csv"))
+    lim = sp.Limits(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0, j_lat_max=0.3,
+                    yaw_rate_max=0.4)
+    first = sp.plan(path, lim)
+    t = 0.1 * first.duration
+    state = first.at(t)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        again = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
+                        a0=float(state.a[0]))
+    outcomes = {a.name: a.outcome for a in again.attempts}
+    assert outcomes.get("default_grid") == "failed"  # the case is exercised
+    assert outcomes.get("state_rounding_on_grid") == "answered"
+    assert again.status in ("optimal", "refined") and again.verification.ok
+    assert within_promise(measure(again, samples=3_000))
+    assert t + again.duration == pytest.approx(first.duration, rel=1e-4)
+
+
 def test_states_read_off_a_plans_final_stop_replan_to_rest():
     # In the final max-jerk stop a state needs a little more jerk than j_max (the law's
     # rounding), and its own stop ends a hair before or past the path's end: that stop spans
