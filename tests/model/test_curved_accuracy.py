@@ -132,3 +132,19 @@ def test_a_nurbs_plan_replans_from_its_own_states_to_the_same_arrival():
                         a0=float(state.a[0]))
         assert again.verification.ok
         assert t + again.duration == pytest.approx(first.duration, rel=ACCURACY), t
+
+
+def test_a_spline_through_many_waypoints_plans_within_1e4_of_the_converged_duration():
+    # The curvature rate jumps at every knot of a cubic spline, and the speed bound kinks
+    # there. Before the knots were breakpoints of the bound, they fell inside cells, whose
+    # node bounds lose O(h) of a kink: 5.8e-4 above the converged duration here.
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 1.0, 100)
+    xy = np.column_stack((200.0 * t, 10.0 * np.sin(12.0 * t) + rng.normal(0.0, 0.05, t.size)))
+    path = sp.Path.from_waypoints(xy, kind="spline")
+    lim = sp.Limits(v_max=3.0, a_max=1.0, a_lat_max=1.0, j_max=1.0)
+    assert path.rate_joins.size == t.size - 2
+    duration = sp.plan(path, lim).duration
+    converged, spread = _converged(path, lim, None)
+    assert spread < ACCURACY / 4
+    assert duration == pytest.approx(converged, rel=ACCURACY)
