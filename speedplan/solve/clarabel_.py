@@ -21,7 +21,7 @@ import clarabel
 import numpy as np
 
 from ..core.checks import FloatArray, IntArray
-from ..core.deadline import remaining
+from ..core.deadline import MIN_SOLVER_TIME, remaining
 from ..core.errors import InfeasibleError, SolverError
 from .cuts import SecantCuts
 from .problem import DiscreteProblem
@@ -267,31 +267,46 @@ def _run(P: sp.csc_matrix, q: FloatArray, A: sp.csc_matrix, b: FloatArray, cones
 
 def solve_relaxation(
     problem: DiscreteProblem, settings: clarabel.DefaultSettings | None = None,
-    cuts: SecantCuts | None = None,
+    cuts: SecantCuts | None = None, *, time_limit: float | None = None,
 ) -> RelaxationResult:
-    """Solve the SOCP relaxation (with ``cuts``, if given); raise on infeasibility or failure."""
+    """Solve the SOCP relaxation (with ``cuts``, if given); raise on infeasibility or failure.
+
+    ``time_limit`` [s]: Clarabel stops there and its last iterate is returned with status
+    ``"MaxTime"`` (its multipliers still give a valid bound by weak duality) instead of
+    raising.
+    """
     import scipy.sparse as sp
 
     t0 = time.perf_counter()
     A, b, q, cones = build_socp(problem, cuts)
     P = sp.csc_matrix((q.size, q.size))
     t1 = time.perf_counter()
+    end = None if time_limit is None else t1 + time_limit
+
+    def limited(s: clarabel.DefaultSettings) -> clarabel.DefaultSettings:
+        s = _within_deadline(s)
+        if end is not None:
+            s.time_limit = min(float(s.time_limit),
+                               max(end - time.perf_counter(), MIN_SOLVER_TIME))
+        return s
+
     first = settings or default_settings()
-    sol = _run(P, q, A, b, cones, _within_deadline(first))
+    sol = _run(P, q, A, b, cones, limited(first))
     status = str(sol.status)
     if status in _STALLED and settings is None:
         # Measured on fuzzed instances (long graded grids with lower bounds): Clarabel's
         # equilibration can stall the iteration; without it the same problem solves.
-        sol = _run(P, q, A, b, cones, _within_deadline(retry_settings()))
+        sol = _run(P, q, A, b, cones, limited(retry_settings()))
         status = str(sol.status)
     t2 = time.perf_counter()
+    stopped = time_limit is not None and status == "MaxTime"
     if status in _INFEASIBLE:
         raise InfeasibleError(
             "the relaxation is infeasible: no speed law meets the boundary values together "
             "with the acceleration and jerk bounds",
             constraint="jerk",
         )
-    if status not in _SOLVED | _ALMOST:
+    if status not in _SOLVED | _ALMOST and not stopped:
         raise SolverError(
             f"Clarabel stopped with status {status} after {sol.iterations} iterations",
             backend="clarabel",

@@ -132,3 +132,30 @@ def test_the_cut_bound_of_a_comfort_plan_is_below_every_point_multistart_ipopt_f
                 found.append(p.travel_time(answer.w) * (1 + answer.violation_price))
     assert len(found) >= 3
     assert solution.lower_bound <= min(found) * (1 + 1e-9)
+
+
+def test_a_cut_solve_stopped_early_still_bounds_the_plan_from_below():
+    # Clarabel gets at most CUT_SECONDS (or as long as the solve before it) for the cuts; its
+    # last iterate's multipliers then give the bound (weak duality). Whatever the iterate, a
+    # bound must stay below every feasible travel time: the plan's own refined point.
+    from speedplan.model import PlanRequest, build_model
+    from speedplan.solve.clarabel_ import solve_relaxation
+
+    path = sp.io.read_path(os.path.join(PATHS, "nurbs_edge.json"))
+    lim = sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5, j_lat_max=0.3, yaw_rate_max=0.4)
+    (leg,) = build_model(PlanRequest.create(path, lim)).legs
+    p = leg.problem
+    solution = solve_problem(p)
+    relaxed = discrete._relaxed(p, "banded", True)
+    cuts = secant_cuts(relaxed.unit).near(
+        discrete._violating_nodes(relaxed.unit, relaxed.w_unit), discrete.CUT_PAD)
+    stopped = solve_relaxation(relaxed.unit, cuts=cuts, time_limit=1e-3)
+    assert stopped.status == "MaxTime"  # the case is exercised
+    bounds = []
+    for seconds in (1e-3, 3e-3, 1e-2, 3e-2, 10.0):
+        cut = discrete._with_cuts(p, relaxed, solution.objective, seconds)
+        assert cut.lower >= relaxed.lower
+        assert cut.info.cut_bound is not None
+        assert cut.info.cut_bound <= solution.objective * (1 + 1e-9), seconds
+        bounds.append(cut.lower)
+    assert bounds[-1] > relaxed.lower * (1 + 1e-3)  # solved to the end, the cuts bite
