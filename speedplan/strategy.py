@@ -18,9 +18,10 @@ only when the ones before it did not answer:
   for a straight leg whose minimum-time motion is known exactly (`StraightLeg`); ``"given_grid"``
   for the caller's grid (``n`` or ``ds``: both relaxation backends, never another grid);
   otherwise ``"default_grid"`` with the request's backend, then, for a leg that starts or
-  ends at a moving state, ``"state_rounding_on_grid"``: the same grid with ``j_max (1 +
-  STATE_JERK_PINNED)`` in its rows (a state on the edge of what ``j_max`` reaches further
-  on leaves the problem no interior; silent), then ``"coarser_grid_1/2"``,
+  ends at a moving state and whose refinement found no feasible point,
+  ``"state_rounding_on_grid"``: the same grid with ``j_max (1 + STATE_JERK_PINNED)`` in its
+  rows (a state on the edge of what ``j_max`` reaches further on leaves the problem no
+  interior; silent), then ``"coarser_grid_1/2"``,
   ``"coarser_grid_1/4"``, ``"coarser_grid_1/8"`` (`COARSER_GRIDS`) with it, then
   ``"other_backend"`` on each of these grids in turn.
 * **verify** (per leg whose continuous law exceeds a tolerance): up to
@@ -407,11 +408,13 @@ def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
         return record.attempt("default_grid", i, partial(solve_leg, leg, fallback=False)), False
     except SolverError as exc:
         failures = [exc]
-    pinned = _state_rounded(request, leg)
-    if pinned is not None:
-        with contextlib.suppress(SolverError):
+    # Only where the relaxation answered and the refinement found no feasible point: a stalled
+    # backend would stall again on the same grid, where the coarser grids answer.
+    if failures[0].backend == "ipopt" and _moving_state_at_j_max(request, leg):
+        with contextlib.suppress(SolverError, InfeasibleError):
             return record.attempt("state_rounding_on_grid", i,
-                                  partial(solve_leg, pinned, fallback=False)), False
+                                  partial(_solve_state_rounded, request, leg),
+                                  catch=(SolverError, InfeasibleError)), False
     for factor in COARSER_GRIDS:
         try:
             result = record.attempt(f"coarser_grid_1/{round(1 / factor)}", i,
@@ -438,19 +441,22 @@ def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
     raise failure
 
 
-def _state_rounded(request: PlanRequest, leg: Leg) -> Leg | None:
-    """``leg`` on its grid with ``j_max (1 + STATE_JERK_PINNED)`` in its rows, or ``None``.
+def _moving_state_at_j_max(request: PlanRequest, leg: Leg) -> bool:
+    """Whether ``leg`` starts or ends at a moving state of a request planned with ``j_max``.
 
-    Only for a leg that starts or ends at a moving state of a request planned with
-    ``j_max``: such a state may sit on the edge of what ``j_max`` reaches further on
+    Such a state may sit on the edge of what ``j_max`` reaches further on
     (`speedplan.model.boundary.STATE_JERK_PINNED`).
     """
     moving = leg.v0 > 0.0 or leg.a0 != 0.0 or leg.vf > 0.0 or leg.af != 0.0
-    if not moving or request.state_jerk is not None or request.turn_jerk is not None:
-        return None
+    return moving and request.state_jerk is None and request.turn_jerk is None
+
+
+def _solve_state_rounded(request: PlanRequest, leg: Leg) -> LegResult:
+    """``leg`` on its own grid with ``j_max (1 + STATE_JERK_PINNED)`` in its rows, solved."""
     looser = replace(request, state_jerk=request.limits.j_max * (1.0 + STATE_JERK_PINNED))
-    return leg_on_grid(looser, leg.bound, leg.problem.s, leg.start, leg.v0, leg.a0, leg.vf,
-                       leg.af)
+    rounded = leg_on_grid(looser, leg.bound, leg.problem.s, leg.start, leg.v0, leg.a0, leg.vf,
+                          leg.af)
+    return solve_leg(rounded, fallback=False)
 
 
 def _other_backend(failed: str) -> RelaxationBackend:

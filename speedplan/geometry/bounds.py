@@ -700,10 +700,9 @@ def bound_breakpoints(path: Path, bound: Callable[[FloatArray], FloatArray]) -> 
     The joins of the path's pieces (where the curvature may jump or change its law: the
     extremes of a clothoid chain's curvature lie there), the knots inside its spline and
     NURBS pieces (where the curvature rate jumps: `Path.rate_joins`) and, for a
-    `SpeedBound`, the
-    knots of its ``v_limit`` (piecewise linear: its minimum over any stretch is at a knot or
-    an end), the ends of its spans and the entries and exits of its zones
-    (`zone_intervals`, located to 1e-9 m on the inside). In the bound's own arc length
+    `SpeedBound`, the knots of its ``v_limit`` (piecewise linear: its minimum over any
+    stretch is at a knot or an end), the ends of its spans and the entries and exits of its
+    zones (`zone_intervals`, located to 1e-9 m on the inside). In the bound's own arc length
     (the path's minus `SpeedBound.offset`), sorted, within the path.
 
     Examples
