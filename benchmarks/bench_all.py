@@ -31,7 +31,9 @@ Prints, in order:
    With ``--baseline TREE`` also the speedplan in TREE (a worker process), alternating.
 4. copp-py's jerk-limited TOPP3 (``topp3_socp``) on the same grids, when it is installed.
 5. ``import speedplan`` (subprocess, median of ``--import-runs``) and the first ``plan()`` in
-   a fresh process with an empty numba cache (``NUMBA_CACHE_DIR`` in a temporary directory).
+   a fresh process: installed from a wheel built here (its kernels compiled by the build),
+   and with an empty numba cache (``NUMBA_CACHE_DIR`` in a temporary directory: the first
+   use of a wheel built elsewhere).
 6. ``solve_discrete`` at 10 k and 100 k nodes: tracemalloc peak per node and the time ratio,
    sizes interleaved, split into iterations and time per node and iteration
    (``bench_kernel_scaling.py``; ``--seeds`` for more random draws).
@@ -474,9 +476,9 @@ def section_copp(repeats: int) -> None:
 # --- 5. import and cold start --------------------------------------------------------------
 
 
-def _run(code: str, env: dict[str, str], *args: str) -> str:
+def _run(code: str, env: dict[str, str], *args: str, cwd: str = str(ROOT)) -> str:
     res = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
-                         env=env, cwd=str(ROOT), timeout=900)
+                         env=env, cwd=cwd, timeout=900)
     if res.returncode != 0:
         raise RuntimeError(res.stderr)
     return res.stdout.strip()
@@ -488,7 +490,7 @@ t0 = time.perf_counter()
 import speedplan as sp
 from speedplan.io import read_path
 t1 = time.perf_counter()
-path = read_path("paths/u_turn.json")
+path = read_path(sys.argv[2])
 lim = sp.Limits(v_max=2, a_max=1, a_lat_max=1, j_max=0.5)
 prof = sp.plan(path, lim)
 t2 = time.perf_counter()
@@ -512,10 +514,20 @@ def _busy(count: int) -> list[subprocess.Popen[bytes]]:
 def _cold_starts(env: dict[str, str], plans: int) -> None:
     print(f"  {'':<44} {'import':>7} {'1st plan':>9} {f'{plans} more':>9} {'backend':>9}"
           f" {'banded after':>13}")
+    sample = str(ROOT / "paths" / "u_turn.json")
+    with tempfile.TemporaryDirectory() as site:
+        sys.path.insert(0, str(FsPath(__file__).parent))
+        from bench_first_use import install_wheel
+
+        t_wheel = install_wheel(ROOT, FsPath(site))
+        clean = {k: v for k, v in env.items() if k != "NUMBA_CACHE_DIR"}
+        # run from elsewhere: from ROOT, `python -c` would import the source tree instead
+        installed = [_run(COLD, {**clean, "PYTHONPATH": site}, str(plans), sample,
+                          cwd=tempfile.gettempdir()).split() for _ in range(2)]
     with tempfile.TemporaryDirectory() as cache:
-        fresh = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache}, str(plans)).split()
+        fresh = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache}, str(plans), sample).split()
         _wait_for_cache_locks(cache)  # the background compilation the fresh process started
-        warm = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache}, str(plans)).split()
+        warm = _run(COLD, {**env, "NUMBA_CACHE_DIR": cache}, str(plans), sample).split()
     with tempfile.TemporaryDirectory() as cache:
         t0, r0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
         families = subprocess.run([sys.executable, "-m", "speedplan", "compile"],
@@ -524,12 +536,14 @@ def _cold_starts(env: dict[str, str], plans: int) -> None:
         t_compile = time.perf_counter() - t0
         r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
-    for label, out in (("empty cache (fresh environment)", fresh),
+    for label, out in ((f"installed from a wheel built here ({t_wheel:.1f} s)", installed[0]),
+                       ("the same installation, once more", installed[1]),
+                       ("empty cache (kernels not compiled yet)", fresh),
                        ("the same cache, filled (warm)", warm)):
         print(f"  {label:<44} {float(out[0]):>7.2f} {float(out[1]):>9.2f}"
               f" {float(out[2]):>9.2f} {out[3]:>9} {out[4] + ('' if out[4] == '-' else ' s'):>13}")
     ratio = (float(fresh[1]) + float(fresh[2])) / (float(warm[1]) + float(warm[2]))
-    print(f"  plans in the fresh environment / warm: {ratio:.2f}; `speedplan compile` into an "
+    print(f"  plans with an empty cache / warm: {ratio:.2f}; `speedplan compile` into an "
           f"empty cache: {t_compile:.1f} s ({cpu:.1f} s of CPU, user + sys, every process; "
           f"{'; '.join(families.strip().splitlines())})")
 

@@ -240,12 +240,13 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument("--n", type=_positive(int), default=1000, help="grid size")
     _add_verbose(b, argparse.SUPPRESS)
     c = sub.add_parser(
-        "compile", help="compile the solver's kernels into numba's cache (once per install)",
+        "compile", help="compile the solver's kernels into numba's cache",
         description="Compile every compiled kernel (relaxation, time law, refinement) into "
-        "numba's on-disk cache, in parallel processes, and wait for them. Run it once after "
-        "installing (in CI, a container build, a fresh virtual environment): the first plan "
-        "then runs the compiled kernels instead of their fallbacks. The cache is next to the "
-        "package, or under NUMBA_CACHE_DIR.",
+        "numba's on-disk cache, in parallel processes, and wait for them. `pip install .` "
+        "already compiles them for the machine it builds on; run this where those do not "
+        "apply (a wheel built on another kind of machine, another numba, NUMBA_CACHE_DIR): "
+        "the first plan then runs the compiled kernels instead of their fallbacks. The cache "
+        "is next to the package, or under NUMBA_CACHE_DIR.",
         formatter_class=_HelpFormatter)
     c.add_argument("--serial", action="store_true",
                    help="compile in this process, one family after the other")
