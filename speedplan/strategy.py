@@ -59,6 +59,7 @@ from .core.checks import FloatArray, as_scalar
 from .core.deadline import deadline
 from .core.errors import (
     InfeasibleError,
+    InvalidInputError,
     LimitWarning,
     PlanTimeout,
     SolverError,
@@ -509,11 +510,14 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
             grid = refined_grid(legs[i].s, leg_check.knots, leg_check.excess, leg.anchors,
                                 refine_factor(leg_check.verification))
             try:
+                # A refined grid finer than the relaxation resolves (a user grid at the
+                # finest step the jerk bounds allow) is refused like a failed solve.
                 refined = record.attempt("local_refinement", i,
                                          partial(_solve_on_grid, request, leg, grid),
+                                         catch=(SolverError, InvalidInputError),
                                          until=window.until(i))
-            except SolverError:  # keep the verified law; its excess is reported below
-                stuck.add(i)
+            except (SolverError, InvalidInputError):
+                stuck.add(i)  # keep the verified law; its excess is reported below
                 continue
             trial = replace(profile, legs=(*legs[:i], refined, *legs[i + 1:]))
             trial_check = trial.check_leg(i)
@@ -554,7 +558,7 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
     if not check.ok:
         if record.budget.expired():
             raise record.timeout()
-        _warn_exceeded(check, record)
+        _warn_exceeded(check, record, request.n is not None or request.ds is not None)
     # The bound's memo (every position evaluated while planning) stays with the plan, not
     # with the profile a caller keeps (a bound without one is kept as it is).
     bound = model.bound if model.bound.memo is None else replace(model.bound, memo=None)
@@ -562,16 +566,25 @@ def verified_profile(request: PlanRequest, model: Model, legs: list[LegResult],
                    speed_bound=bound, attempts=tuple(record.entries))
 
 
-def _warn_exceeded(check: Verification, record: Record) -> None:
+def _warn_exceeded(check: Verification, record: Record, given_grid: bool) -> None:
     worst = ", ".join(f"{k} {r:.3f}× at s={check.where.get(k, float('nan')):.4g} m"
                       for k, r in check.violations.items())
-    rounds = sum(e.name == "local_refinement" and e.outcome != "skipped"
-                 for e in record.entries)
+    tried = [e for e in record.entries
+             if e.name == "local_refinement" and e.outcome != "skipped"]
+    rounds = sum(e.outcome != "failed" for e in tried)
+    failed = (f" ({len(tried) - rounds}{' more' if rounds else ''} failed)"
+              if len(tried) > rounds else "")
+    if not any(e.reason.startswith(InvalidInputError.__name__) for e in tried):
+        advice = "or plan with a finer grid (n or ds)"
+    elif given_grid:  # its refinement would be finer than the relaxation resolves
+        advice = "or plan on the default grid (without n or ds)"
+    else:
+        advice = "a finer grid is beyond what the relaxation resolves for these jerk bounds"
     warnings.warn(
         f"the planned trajectory exceeds limits beyond tolerance ({worst} of the limit) "
-        f"after {rounds} local refinement{'s' * (rounds != 1)} of the grid; status "
-        "'limits_exceeded' — see profile.verification and profile.attempts, or plan with "
-        "a finer grid (n or ds)", LimitWarning, stacklevel=5,
+        f"after {rounds} local refinement{'s' * (rounds != 1)} of the grid{failed}; status "
+        f"'limits_exceeded' — see profile.verification and profile.attempts, {advice}",
+        LimitWarning, stacklevel=5,
     )
 
 

@@ -21,20 +21,27 @@ lasts ``dv/a + a/j`` (``2 sqrt(dv/j)`` when ``a`` is not reached) and covers its
 times that. The ends' phases come out exactly — jerk phases of microseconds on a kilometre
 move included, which no grid resolves.
 
+**The valley.** When even the lowest admissible peak's changes are longer than ``L``, the
+vehicle can only arrive by going slower first: it falls to a speed valley ``(vl, 0)`` and
+rises from it (a start at 0.1 m/s that must reach 2 m/s over a stretch shorter than the
+direct speed-up). Both changes are shorter in time the higher the valley, so the fastest has
+the highest valley whose changes fit, spanning ``L`` exactly (`_valley_motion`).
+
 **Where it is the optimum.** The time-optimal 1-D motion has at most seven constant-jerk
 phases (Berscheid & Kröger, *Jerk-limited real-time trajectory generation with arbitrary
-target states*, 2021); those that rise to one speed peak and fall from it are this family.
-The others — a motion that never has a peak (still accelerating on arrival past any peak),
-or one that must dip towards rest to arrive faster — have no member here: if even the lowest
-admissible peak does not fit in ``L``, `straight_motion` returns ``None`` and the leg is
-planned on a grid like any other — unless ``L`` is the length of the shortest change between
-a moving state and rest itself (a state read off a plan's braking): that change is then the
-only motion. ``tests/api/test_straight_moves.py`` holds every motion of this family against
-ruckig's optimum over decades of scale, boundary states included.
+target states*, 2021); those that rise to one speed peak and fall from it, or fall to one
+valley and rise from it, are this family. Between states at zero acceleration it holds every
+motion there is. The others — a motion that never has a peak nor a valley (still
+accelerating on arrival past any peak, say) — have no member here: `straight_motion` returns
+``None`` and the leg is planned on a grid like any other — unless ``L`` is the length of the
+shortest change between a moving state and rest itself (a state read off a plan's braking):
+that change is then the only motion. ``tests/api/test_straight_moves.py`` holds every motion
+of this family against ruckig's optimum over decades of scale, boundary states included.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -154,11 +161,11 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
     -------
     JerkPhases or None
         The motion (see the module notes for when it is the optimum), or ``None`` when no
-        motion that rises to one speed peak joins the states within ``length`` and
-        ``v_top`` (the states then need a grid, or no motion joins them) — unless the
-        stretch is as long as the shortest change from a moving state to rest (or from rest
-        to a moving state), to `BOUNDARY_ROUNDING`: that change is the only motion
-        (`_forced_change`).
+        motion through one speed peak or one speed valley joins the states within
+        ``length`` and ``v_top`` (the states then need a grid, or no motion joins them) —
+        unless the stretch is as long as the shortest change from a moving state to rest
+        (or from rest to a moving state), to `BOUNDARY_ROUNDING`: that change is the only
+        motion (`_forced_change`).
 
     Examples
     --------
@@ -184,28 +191,99 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
             return (_rise_distance(v0, a0, vp, j_max, a_max, a_decel)
                     + _rise_distance(vf, -af, vp, j_max, a_decel, a_max))
     if distance(low) > length:
-        return _forced_change(length, v0, a0, vf, af, a_max, a_decel, j_max)
-    # The peak to a few ulps of itself (an absolute tolerance in v_top left a peak 1e5 times
-    # below v_top 7e-6 short of the root, and a cruise at it in place of the jerk phases).
-    vp = v_top if distance(v_top) <= length else brentq(
-        lambda x: distance(x) - length, low, v_top, xtol=np.finfo(float).tiny,
-        rtol=4 * np.finfo(float).eps)
+        forced = _forced_change(length, v0, a0, vf, af, a_max, a_decel, j_max)
+        return forced if forced is not None else _valley_motion(length, v0, a0, vf, af, a_max,
+                                                                a_decel, j_max)
+    vp = v_top if distance(v_top) <= length else _root(distance, length, low, v_top)
+    return _joined(length, vp, low, v0, a0, vf, af, a_max, a_decel, j_max)
+
+
+def _root(distance: Callable[[float], float], length: float, lo: float, hi: float) -> float:
+    """The speed in ``[lo, hi]`` where ``distance`` equals ``length``, to a few ulps.
+
+    An absolute tolerance in the speed left a peak 1e5 times below ``v_top`` 7e-6 short of
+    the root, and a cruise at it in place of the jerk phases.
+    """
+    return float(brentq(lambda x: distance(x) - length, lo, hi, xtol=np.finfo(float).tiny,
+                        rtol=4 * np.finfo(float).eps))
+
+
+#: Speeds at which the valley's distance is evaluated between the turnaround speed and
+#: rest, to bracket its largest root (`_valley_motion`).
+VALLEY_SCAN = 64
+
+
+def _valley_motion(length: float, v0: float, a0: float, vf: float, af: float, a_max: float,
+                   a_decel: float, j_max: float) -> JerkPhases | None:
+    """The fastest motion over ``length`` that falls to one speed valley and rises from it.
+
+    Where even the lowest peak's changes are longer than the stretch, the vehicle can only
+    arrive by going slower first: a fall from ``(v0, a0)`` to a valley ``(vl, 0)`` and a
+    rise to ``(vf, af)``, each time-optimal. The higher the valley, the shorter both changes
+    in time and the longer in distance near it, so the fastest motion has the highest valley
+    whose changes fit, and they span ``length`` exactly: the largest root of
+    ``D(vl) = length`` below the lowest turnaround speed. ``D`` is not monotone (a change's
+    distance falls again as the valley nears rest, where the speed is low all along it), so
+    the root is bracketed by scanning down from the turnaround speed; at rest the motion
+    is a stop and a start again. ``None`` when not even those fit: a motion still
+    accelerating on arrival, or none at all.
+    """
+    high = min(turnaround_speed(v0, a0, j_max), turnaround_speed(vf, -af, j_max))
+    if not high > 0.0:
+        return None
+
+    def distance(vl: float) -> float:
+        return (_rise_distance(v0, a0, vl, j_max, a_max, a_decel)
+                + _rise_distance(vf, -af, vl, j_max, a_decel, a_max))
+
+    if not distance(high) > length:
+        return None
+    above = high
+    for vl in high * np.linspace(1.0, 0.0, VALLEY_SCAN + 1)[1:]:
+        if distance(vl) <= length:
+            valley = _root(distance, length, vl, above)
+            break
+        above = vl
+    else:  # a stop and a start again, if they span the stretch to a rounding
+        valley = 0.0
+    # No cruise at the valley: the changes span the stretch to a rounding, which a cruise at
+    # a valley next to rest would turn into seconds. They are stretched over it instead.
+    up = _rising(v0, a0, valley, j_max, a_max, a_decel)
+    down = _rising(vf, -af, valley, j_max, a_decel, a_max)
+    spanned = float(up[1][-1] + down[1][-1])
+    if not abs(length - spanned) <= BOUNDARY_ROUNDING * length:
+        return None
+    return _stretched(_assembled(spanned, up, down, 0.0), length / spanned)
+
+
+def _joined(length: float, vm: float, fits: float, v0: float, a0: float, vf: float,
+            af: float, a_max: float, a_decel: float, j_max: float) -> JerkPhases:
+    """The changes ``(v0, a0) -> (vm, 0) -> (vf, af)``, a cruise at ``vm`` over the rest.
+
+    ``fits``: a speed below ``vm`` whose changes fit in ``length``.
+    """
     for k in range(60):
-        t_up, d_up, v_up, a_up, j_up = _rising(v0, a0, vp, j_max, a_max, a_decel)
-        # The fall, time reversed, is a rise from (vf, -af): its positions counted from the
-        # end keep full precision next to a final stop.
-        t_dn, d_dn, v_dn, a_dn, j_dn = _rising(vf, -af, vp, j_max, a_decel, a_max)
-        gap = length - d_dn[-1] - d_up[-1]
-        if gap >= 0.0 or vp <= low:
+        up = _rising(v0, a0, vm, j_max, a_max, a_decel)
+        # The second change, time reversed, is a change from (vf, -af): its positions
+        # counted from the end keep full precision next to a final stop.
+        down = _rising(vf, -af, vm, j_max, a_decel, a_max)
+        gap = length - down[1][-1] - up[1][-1]
+        if gap >= 0.0 or vm <= fits:
             break
         # The changes overlap by a rounding (a change of a few ulps of speed computed from a
-        # difference of speeds): a hair lower peak leaves a cruise of a rounding instead, so
-        # that the positions of both changes meet without a jump.
-        vp = max(low, vp - (vp - low) * 2.0 ** (k - 50))
-    s_dn = length - d_dn[::-1]
-    cruise = max(gap, 0.0) / vp
+        # difference of speeds): a hair lower middle speed leaves a cruise of a rounding
+        # instead, so that the positions of both changes meet without a jump.
+        vm = max(fits, vm - (vm - fits) * 2.0 ** (k - 50))
+    return _assembled(length, up, down, max(gap, 0.0) / vm)
+
+
+def _assembled(length: float, up: tuple[FloatArray, ...], down: tuple[FloatArray, ...],
+               cruise: float) -> JerkPhases:
+    """The change ``up`` (`_rising`), a cruise of ``cruise`` seconds, then ``down`` reversed."""
+    t_up, d_up, v_up, a_up, j_up = up
+    t_dn, d_dn, v_dn, a_dn, j_dn = down
     starts = [t_up, t_up[-1] + cruise + (t_dn[-1] - t_dn[::-1])]
-    pos = [d_up, s_dn]
+    pos = [d_up, length - d_dn[::-1]]
     speed, acc, jerk = [v_up, v_dn[::-1]], [a_up, -a_dn[::-1]], [j_up, j_dn[::-1]]
     if cruise > 0:
         jerk.insert(1, np.zeros(1))
@@ -215,6 +293,16 @@ def straight_motion(length: float, v0: float, vf: float, v_top: float, a_max: fl
     return JerkPhases(t=np.concatenate(starts), s=np.concatenate(pos),
                       v=np.concatenate(speed), a=np.concatenate(acc),
                       jerk=np.concatenate(jerk))
+
+
+def _stretched(motion: JerkPhases, k: float) -> JerkPhases:
+    """``motion`` slowed down in time by ``k``: positions and times times ``k``.
+
+    The same speeds, accelerations over ``k`` and jerks over ``k²``; the phases stay
+    consistent (positions scaled alone would jump by ``(k - 1) s`` inside each phase).
+    """
+    return JerkPhases(t=motion.t * k, s=motion.s * k, v=motion.v, a=motion.a / k + 0.0,
+                      jerk=motion.jerk / (k * k))
 
 
 def _forced_change(length: float, v0: float, a0: float, vf: float, af: float, a_max: float,
@@ -227,10 +315,8 @@ def _forced_change(length: float, v0: float, a0: float, vf: float, af: float, a_
     acceleration still falling, or held at ``-a_decel``) lies there: no motion with a speed
     peak joins it to rest. ``None`` elsewhere.
 
-    The change is stretched in time by ``k = length / distance`` to cover ``length``
-    exactly: positions and times times ``k``, the same speeds, accelerations over ``k`` and
-    jerks over ``k²`` — a rounding, and the phases stay consistent (positions scaled alone
-    would jump by ``(k - 1) s`` inside each phase).
+    The change is stretched in time by ``k = length / distance`` (`_stretched`, a
+    rounding) to cover ``length`` exactly.
     """
     if vf == 0.0 and af == 0.0 and v0 > 0.0:
         t, d, v, a, jerk = _rising(v0, a0, 0.0, j_max, a_max, a_decel)
@@ -241,8 +327,7 @@ def _forced_change(length: float, v0: float, a0: float, vf: float, af: float, a_
         return None
     if jerk.size == 0 or not abs(d[-1] - length) <= BOUNDARY_ROUNDING * length:
         return None
-    k = length / d[-1]
-    return JerkPhases(t=t * k, s=d * k, v=v, a=a / k + 0.0, jerk=jerk / (k * k))
+    return _stretched(JerkPhases(t=t, s=d, v=v, a=a, jerk=jerk), length / d[-1])
 
 
 def constant_bound(bound: SpeedBound, lo: float, hi: float) -> float | None:

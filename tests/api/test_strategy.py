@@ -248,6 +248,28 @@ def test_a_solver_error_does_not_advise_the_grid_already_in_use():
         assert profile.verification is not None
 
 
+def test_a_given_grid_too_fine_to_refine_keeps_its_law_and_does_not_advise_a_finer_one():
+    # A start at 0.1 m/s that must dip before reaching 2 m/s, on a user grid at the finest
+    # step the relaxation resolves for j_max = 1: the law exceeds the jerk limit, and its
+    # local refinement would be finer still. That refusal ("use n <= 4001") escaped from
+    # plan(n=4000) as an InvalidInputError advising the grid already in use.
+    lim = sp.Limits(v_max=3.0, a_max=10.0, a_lat_max=1.0, j_max=1.0)
+    path = sp.Path.from_waypoints([[0, 0], [2.88, 0]], kind="polyline")
+    with pytest.warns(sp.LimitWarning) as caught:
+        profile = sp.plan(path, lim, v0=0.1, vf=2.0, n=4000)
+    assert profile.status == "limits_exceeded" and profile.limits_exceeded
+    (refinement,) = [a for a in profile.attempts if a.name == "local_refinement"]
+    assert refinement.outcome == "failed" and "too fine" in refinement.reason
+    (message,) = [str(w.message) for w in caught]
+    assert "(1 failed)" in message and "default grid (without n or ds)" in message
+    assert "finer grid" not in message
+    # The default grid plans it exactly (closed form).
+    best = sp.plan(path, lim, v0=0.1, vf=2.0)
+    assert best.status == "optimal"
+    assert best.duration == pytest.approx(ruckig_duration(2.88, lim, v0=0.1, vf=2.0),
+                                          rel=1e-12)
+
+
 def _one_edge_route(length: float) -> Route:
     edge = RouteEdge("AB", 1, "A", "B", sp.Path.from_segments([Line(length)]), v_max=1.0)
     return Route([RouteNode("A", 0, (0.0, 0.0)), RouteNode("B", 2, (length, 0.0))], [edge])
