@@ -17,8 +17,9 @@ only when the ones before it did not answer:
 * **solve** (per leg): ``"forced_motion"`` for a leg with no freedom left; ``"closed_form"``
   for a straight leg whose minimum-time motion is known exactly (`StraightLeg`); ``"given_grid"``
   for the caller's grid (``n`` or ``ds``: both relaxation backends, never another grid);
-  otherwise ``"default_grid"`` with the request's backend, then, for a leg that starts or
-  ends at a moving state and whose refinement found no feasible point,
+  otherwise ``"default_grid"`` with the request's backend (for a leg that starts or ends at a
+  moving state, its refinement without IPOPT), then, for such a leg whose refinement found
+  no feasible point,
   ``"state_rounding_on_grid"``: the same grid with ``j_max (1 + STATE_JERK_PINNED)`` in its
   rows (a state on the edge of what ``j_max`` reaches further on leaves the problem no
   interior; silent), then ``"coarser_grid_1/2"``,
@@ -338,12 +339,12 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
 
 
 # ---- solve ----------------------------------------------------------------------------------
-def solve_leg(leg: ModelLeg, *, fallback: bool = True) -> LegResult:
+def solve_leg(leg: ModelLeg, *, fallback: bool = True, ipopt: bool = True) -> LegResult:
     """Solve one leg and build its law; an infeasibility is restated in metres.
 
-    ``fallback``: whether a failed relaxation backend is retried with the other one
-    (`solve_problem`). A `ForcedLeg`, `TurnLeg` or `StraightLeg` carries its motion: only its
-    law is built.
+    ``fallback``: whether a failed relaxation backend is retried with the other one;
+    ``ipopt``: whether the refinement may fall back to IPOPT (`solve_problem`). A `ForcedLeg`,
+    `TurnLeg` or `StraightLeg` carries its motion: only its law is built.
     """
     if isinstance(leg, ForcedLeg):
         return _known_motion(leg.start, law_for(leg.s, leg.w, leg.time_law), "forced")
@@ -353,7 +354,7 @@ def solve_leg(leg: ModelLeg, *, fallback: bool = True) -> LegResult:
         return _known_motion(leg.start, MotionLaw(leg.motion), "closed_form")
     try:
         solution = solve_problem(leg.problem, refine=leg.refine, backend=leg.backend,
-                                 fallback=fallback)
+                                 fallback=fallback, ipopt_fallback=ipopt)
     except InfeasibleError as exc:
         raise explain_infeasible(exc, leg) from exc
     law = law_for(leg.problem.s, solution.w, leg.time_law)
@@ -405,13 +406,19 @@ def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
         return record.attempt("given_grid" if request.n is not None or request.ds is not None
                               else "default_grid", i, lambda: solve_leg(leg)), False
     grids: list[Leg] = [leg]  # each built inside its attempt: most default grids solve at once
+    # A moving state on the edge of its reach leaves the default grid's refinement little or
+    # no interior: the banded starts fail, and IPOPT then ran its 5 s to fail as well (twice
+    # on a road's replan, 12.5 s, where the grid with rounded state rows or the coarser one
+    # answers in 0.1 s). There the grids below come first; IPOPT runs in `other_backend`.
+    pinned = _moving_state_at_j_max(request, leg)
     try:
-        return record.attempt("default_grid", i, partial(solve_leg, leg, fallback=False)), False
+        return record.attempt("default_grid", i, partial(solve_leg, leg, fallback=False,
+                                                         ipopt=not pinned)), False
     except SolverError as exc:
         failures = [exc]
     # Only where the relaxation answered and the refinement found no feasible point: a stalled
     # backend would stall again on the same grid, where the coarser grids answer.
-    if failures[0].backend == "ipopt" and _moving_state_at_j_max(request, leg):
+    if failures[0].backend == "ipopt" and pinned:
         with contextlib.suppress(SolverError, InfeasibleError):
             return record.attempt("state_rounding_on_grid", i,
                                   partial(_solve_state_rounded, request, leg),
@@ -457,7 +464,7 @@ def _solve_state_rounded(request: PlanRequest, leg: Leg) -> LegResult:
     looser = replace(request, state_jerk=request.limits.j_max * (1.0 + STATE_JERK_PINNED))
     rounded = leg_on_grid(looser, leg.bound, leg.problem.s, leg.start, leg.v0, leg.a0, leg.vf,
                           leg.af)
-    return solve_leg(rounded, fallback=False)
+    return solve_leg(rounded, fallback=False, ipopt=False)
 
 
 def _other_backend(failed: str) -> RelaxationBackend:

@@ -160,12 +160,14 @@ def _relax_with_fallback(
 
 def solve_problem(
     problem: DiscreteProblem, *, refine: Refine = "auto", backend: Backend = "clarabel",
-    fallback: bool = True,
+    fallback: bool = True, ipopt_fallback: bool = True,
 ) -> DiscreteSolution:
     """Solve a validated `DiscreteProblem` (any grid) and certify the result.
 
     If the relaxation backend fails, the other one is tried, unless ``fallback`` is False
     ([`speedplan.plan`][speedplan.plan] first tries a coarser default grid with the same backend).
+    ``ipopt_fallback`` False keeps the refinement to the banded method's starts (no IPOPT
+    run of up to 5 s when none is accepted).
 
     Raises
     ------
@@ -201,7 +203,7 @@ def solve_problem(
     loose = relaxed.exact and problem.travel_time(w) > relaxed.lower * (1.0 + POLISH_GAP)
     refined = refine == "always" or (refine == "auto" and (not relaxed.exact or loose))
     if refined:
-        w, status, refinement = _refined(problem, relaxed, w, status)
+        w, status, refinement = _refined(problem, relaxed, w, status, ipopt_fallback)
     elif not relaxed.exact:
         warnings.warn(
             f"refine='never' and the relaxation is not exact: w violates jerk rows by up to "
@@ -334,8 +336,8 @@ def _relaxed(problem: DiscreteProblem, backend: str, fallback: bool) -> _Relaxed
     return _Relaxed(unit, relax.w, w_scale, w_relaxed, lower, exact, info, time_scale)
 
 
-def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status: Status
-             ) -> tuple[FloatArray, Status, RefinementInfo]:
+def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status: Status,
+             ipopt: bool = True) -> tuple[FloatArray, Status, RefinementInfo]:
     """The nonconvex refinement from the relaxation's point: ``w`` and status it leaves.
 
     An exact relaxation keeps its own ``w`` unless the refined point is feasible and faster
@@ -351,7 +353,8 @@ def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status:
 
     # A polish of an exact relaxation runs every start: it is there to reach POLISH_GAP.
     lower = None if relaxed.exact else relaxed.lower / relaxed.time_scale
-    ref = refine_nlp(relaxed.unit, relaxed.w_unit, accept=feasible, lower_bound=lower)
+    ref = refine_nlp(relaxed.unit, relaxed.w_unit, accept=feasible, lower_bound=lower,
+                     ipopt=ipopt)
     w_ref = np.clip(ref.w * relaxed.w_scale, 0.0, problem.w_max)
     ref_ok = ref.success and feasible(ref.w)
     refinement = RefinementInfo(

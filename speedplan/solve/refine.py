@@ -41,6 +41,7 @@ def refine(
     problem: DiscreteProblem, w0: FloatArray,
     accept: Callable[[FloatArray], bool] | None = None,
     lower_bound: float | None = None,
+    ipopt: bool = True,
 ) -> RefineResult:
     """Refine the relaxed ``w0`` into a feasible point of the original problem.
 
@@ -58,6 +59,8 @@ def refine(
     lower_bound : float, optional
         A certified lower bound on ``problem``'s travel time (the relaxation's): the starts
         end at the first accepted candidate within `ENOUGH_GAP` of it.
+    ipopt : bool
+        Whether IPOPT runs when no banded start is accepted (for up to 5 s).
 
     Returns
     -------
@@ -109,13 +112,13 @@ def refine(
             if any(abs(objective - f) <= AGREE * f for f in found):
                 break  # two paths ended at the same point: the third would too (corpus)
             found.append(objective)
-    if best is None and not passed():
-        ipopt = refine_ipopt(problem, w0)
-        iterations += ipopt.iterations
-        status = f"ipopt: {ipopt.status}"
-        if ipopt.success and accept(ipopt.w):
-            best = (problem.travel_time(ipopt.w), ipopt.w, status)
-        last = (ipopt.w, status)
+    if best is None and ipopt and not passed():
+        fallback = refine_ipopt(problem, w0)
+        iterations += fallback.iterations
+        status = f"ipopt: {fallback.status}"
+        if fallback.success and accept(fallback.w):
+            best = (problem.travel_time(fallback.w), fallback.w, status)
+        last = (fallback.w, status)
     if best is None:
         return RefineResult(w=last[0], status=last[1], success=False, iterations=iterations,
                             solve_time=time.perf_counter() - t0)

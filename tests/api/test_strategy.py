@@ -341,31 +341,56 @@ def test_states_read_off_a_plan_replan_without_a_warning():
     assert rounded > 0  # the case is exercised
 
 
-def test_a_state_on_the_edge_of_its_reach_replans_on_its_default_grid():
-    # On the road S-curve with comfort limits, 0.1 of the way through, the plan brakes its
-    # acceleration at -j_max: the slowest motion from there is the only one that meets the
-    # lateral-jerk caps of the clothoid joins 50 m on, and the replan's problem has no
-    # interior (its refinement: "Infeasible_Problem_Detected"). Before, the strategy's
-    # coarser grids answered after 3.6 s, limits_exceeded (jerk 1.08x).
+def _road_comfort():
     from speedplan.io import read_path
 
     path = read_path(os.path.join(os.path.dirname(__file__), "..", "..", "paths",
                                   "road_s_curve.csv"))
     lim = sp.Limits(v_max=15.0, a_max=2.0, a_lat_max=3.0, j_max=1.0, j_lat_max=0.3,
                     yaw_rate_max=0.4)
-    first = sp.plan(path, lim)
-    t = 0.1 * first.duration
+    return path, lim, sp.plan(path, lim)
+
+
+def _replan(path, lim, first, fraction):
+    t = fraction * first.duration
     state = first.at(t)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         again = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
                         a0=float(state.a[0]))
-    outcomes = {a.name: a.outcome for a in again.attempts}
-    assert outcomes.get("default_grid") == "failed"  # the case is exercised
-    assert outcomes.get("state_rounding_on_grid") == "answered"
     assert again.status in ("optimal", "refined") and again.verification.ok
     assert within_promise(measure(again, samples=3_000))
     assert t + again.duration == pytest.approx(first.duration, rel=1e-4)
+    return again
+
+
+def test_a_state_on_the_edge_of_its_reach_replans_on_its_default_grid():
+    # On the road S-curve with comfort limits, 0.1225 of the way through, the plan brakes at
+    # -j_max: the slowest motion from there is nearly the only one that meets the
+    # lateral-jerk caps further on, and the replan's refinement finds no feasible point on
+    # the default grid. The same grid with rounded state rows answers; IPOPT is not run on
+    # the default grid first (it spent its 5 s there and failed: 7.1 s in all).
+    path, lim, first = _road_comfort()
+    again = _replan(path, lim, first, 0.1225)
+    attempts = {a.name: a for a in again.attempts}
+    assert attempts["default_grid"].outcome == "failed"  # the case is exercised
+    assert "ipopt" not in attempts["default_grid"].reason.split("feasible point")[-1]
+    assert attempts["state_rounding_on_grid"].outcome == "answered"
+
+
+@pytest.mark.parametrize("fraction", [0.15, 0.2, 0.5, 0.6])
+def test_replans_along_a_road_with_close_joins_keep_steps_the_relaxation_resolves(fraction):
+    # The road's G2 corners leave joins of clothoids 0.09-2.7 mm apart. The room for 25
+    # nodes between every two joins made steps of 2.6 µm on the replans' default grids: the
+    # banded relaxation stopped at its first iteration (NumericalError), and the replans
+    # were answered on coarser grids (up to 5.8e-4 off the plan's remaining time), or after
+    # 113 s by a SolverError. At 0.6 the refinement fails on the default grid and the
+    # coarser grid answers, without an IPOPT run of 5 s before it.
+    path, lim, first = _road_comfort()
+    again = _replan(path, lim, first, fraction)
+    assert float(np.min(np.diff(again.legs[0].s))) > 1e-4
+    for attempt in again.attempts:
+        assert "ipopt" not in attempt.reason
 
 
 def test_states_read_off_a_plans_final_stop_replan_to_rest():
