@@ -33,10 +33,12 @@ the family compiles the entry point, loading the rest (`part_count`, `_compile_w
 When a family is not in the cache, `Kernels.ready` starts one background Python process
 that compiles it (and the families after it) while the fallback answers. A lock file per
 family (`Kernels.lock_path`) keeps the workers of [`plan_many`][speedplan.plan_many], which
-all start cold, from compiling the same family at once. ``speedplan compile``
-(`compile_families`) compiles every family in parallel processes and waits: the step for CI
-jobs, containers and fresh virtual environments, after which the first ``plan()`` already
-runs the compiled kernels.
+all start cold, from compiling the same family at once. ``pip install`` runs
+`compile_families` while it builds the wheel (the build hook ``hatch_build.py``) and
+installs the cache with the package, so that the first ``plan()`` after installing loads the
+kernels. ``speedplan compile`` (`compile_families`, every family in parallel processes, then
+waits) is the step where those do not apply: a wheel built on another kind of machine,
+another numba, a cache under ``NUMBA_CACHE_DIR``.
 
 Setting the environment variable ``SPEEDPLAN_BACKGROUND_COMPILE=0`` makes every fallback
 compile in the calling process instead (the results are then independent of timing).
