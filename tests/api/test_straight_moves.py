@@ -191,10 +191,24 @@ def test_moves_shorter_than_the_direct_change_dip_and_take_ruckigs_optimum(
         return
     answer = ruckig_move(length, lim, v0=v0, vf=vf)
     try:
-        prof = sp.plan(_line(length), lim, v0=v0, vf=vf)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            prof = sp.plan(_line(length), lim, v0=v0, vf=vf)
     except sp.InfeasibleError:
         assert answer.duration is None
         return
+    answered = {a.name for a in prof.attempts if a.outcome == "answered"}
+    for name, more, warned in (("jerk_slack", 2e-2, True), ("state_rounding", 1e-4, False)):
+        if any(name in a for a in answered):
+            # Just shorter than a stop and a start again: reachable with a hair more jerk
+            # (up to 1e-4 silently, 2 % with a warning: docs/failure-modes.md), as ruckig
+            # confirms.
+            assert any(issubclass(w.category, sp.SpeedplanWarning) for w in caught) == warned
+            looser = sp.Limits(v_max=lim.v_max, a_max=lim.a_max, a_decel=lim.a_decel,
+                               a_lat_max=1.0, j_max=(1.0 + more) * lim.j_max)
+            assert ruckig_move(length, looser, v0=v0, vf=vf).duration is not None
+            return
+    assert not caught
     assert answer.duration is not None
     assert _answered(prof) == ["model", "closed_form"] and prof.status == "optimal"
     assert prof.duration == pytest.approx(answer.duration, rel=1e-9, abs=1e-12)
