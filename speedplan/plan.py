@@ -128,7 +128,9 @@ def plan(
         No jerk-limited motion meets the boundary states (the message says which state, which
         limit and where, ``s`` in metres). A moving state that ``j_max (1 +
         STATE_JERK_ROUNDING)`` (1e-4) reaches, such as a state read off a plan, is planned
-        with that jerk, silently; one that ``j_max (1 + STATE_JERK_SLACK)`` (2 %) reaches,
+        with that jerk, silently, as is one read off the last jerk phase of a plan's stop
+        that ``j_max (1 + STATE_JERK_LAW_ROUNDING)`` (3e-3) reaches (in its stretch up to
+        the next stop only); one that ``j_max (1 + STATE_JERK_SLACK)`` (2 %) reaches,
         with up to that jerk while its acceleration is brought to 0 (``j_max`` after) and a
         [`SpeedplanWarning`][speedplan.SpeedplanWarning] (`speedplan.strategy.model_request`).
     SolverError

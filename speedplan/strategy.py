@@ -7,7 +7,10 @@ only when the ones before it did not answer:
   capped by the max-jerk motion); ``"exact_reach"``, the exact reach envelope in distance,
   when the first refuses moving states that a motion whose speed first dips reaches;
   ``"state_rounding"`` and ``"exact_reach_state_rounding"``, both again with ``j_max (1 +
-  STATE_JERK_ROUNDING)`` (a state read off a plan; silent); then
+  STATE_JERK_ROUNDING)`` (a state read off a plan; silent); ``"law_rounding"`` and
+  ``"exact_reach_law_rounding"`` with ``j_max (1 + STATE_JERK_LAW_ROUNDING)`` (a state read
+  off a plan's approach to a stop, whose law rides the max-jerk stop within its own rounding;
+  silent, in the state's stretch only); then
   ``"jerk_slack"`` and ``"exact_reach_jerk_slack"``, for moving states just outside what
   ``j_max`` reaches: up to ``j_max (1 + STATE_JERK_SLACK)`` while such a state's
   acceleration is brought to 0 (a `TurnLeg`), ``j_max`` elsewhere; then
@@ -69,6 +72,7 @@ from .core.errors import (
 from .core.options import RelaxationBackend
 from .model import ForcedLeg, Leg, Model, ModelLeg, PlanRequest, StraightLeg, TurnLeg, build_model
 from .model.boundary import (
+    STATE_JERK_LAW_ROUNDING,
     STATE_JERK_PINNED,
     STATE_JERK_ROUNDING,
     STATE_JERK_SLACK,
@@ -113,8 +117,9 @@ COARSER_GRIDS = (1 / 2, 1 / 4, 1 / 8)
 
 #: Every attempt's name, in the order the strategy tries them (see the module docstring).
 ATTEMPTS: tuple[str, ...] = (
-    "model", "exact_reach", "state_rounding", "exact_reach_state_rounding", "jerk_slack",
-    "exact_reach_jerk_slack", "jerk_slack_whole_move", "exact_reach_jerk_slack_whole_move",
+    "model", "exact_reach", "state_rounding", "exact_reach_state_rounding", "law_rounding",
+    "exact_reach_law_rounding", "jerk_slack", "exact_reach_jerk_slack", "jerk_slack_whole_move",
+    "exact_reach_jerk_slack_whole_move",
     "forced_motion", "closed_form", "given_grid", "default_grid", "state_rounding_on_grid",
     *(f"coarser_grid_1/{round(1 / f)}" for f in COARSER_GRIDS),
     "other_backend", "local_refinement", "default_grid_other_backend",
@@ -286,13 +291,17 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
 
     Marginal states: a moving boundary state that ``j_max (1 + STATE_JERK_ROUNDING)``
     reaches (a state read off a plan, on the boundary of the reachable set up to the law's
-    rounding) is planned with that jerk, silently; one just outside what ``j_max`` reaches
-    is planned with up to ``j_max (1 + STATE_JERK_SLACK)``, with a warning (a state measured
-    on the vehicle: refusing it would strand the vehicle). The looser jerk is used only
-    where the state needs it: its acceleration brought to 0 at constant jerk (`TurnLeg`,
+    rounding) is planned with that jerk, silently, and so is one that ``j_max (1 +
+    STATE_JERK_LAW_ROUNDING)`` reaches (read off the final jerk phase of a plan's stop); the
+    looser jerk holds in the legs up to the state's first rest, ``j_max`` after it
+    (`PlanRequest.leg_jerk`). One just outside what ``j_max`` reaches is planned with up to
+    ``j_max (1 + STATE_JERK_SLACK)``, with a warning (a state measured on the vehicle:
+    refusing it would strand the vehicle). The looser jerk is used only where the state
+    needs it: its acceleration brought to 0 at constant jerk (`TurnLeg`,
     `PlanRequest.turn_jerk`), the rest of the move planned from there with ``j_max``.
     Where that turn does not fit (longer than the stretch, or above the speed bound) the
-    jerk rows of the whole move take the looser jerk (`PlanRequest.state_jerk`): held only
+    jerk rows of the legs up to the state's first rest take the looser jerk
+    (`PlanRequest.state_jerk`): held only
     near the state in the rows, the varying jerk bound made the relaxation inexact and a
     27.8 km move took minutes in the refinement instead of 1 s. The plan is verified
     against the requested limits.
@@ -311,9 +320,12 @@ def model_request(request: PlanRequest, record: Record) -> tuple[PlanRequest, Mo
                                      catch=(InfeasibleError,))
     j_max = request.limits.j_max
     rounding, slack = j_max * (1.0 + STATE_JERK_ROUNDING), state_jerk(j_max)
+    law_rounding = j_max * (1.0 + STATE_JERK_LAW_ROUNDING)
     for name, looser in (
             ("state_rounding", replace(request, state_jerk=rounding)),
             ("exact_reach_state_rounding", replace(exact, state_jerk=rounding)),
+            ("law_rounding", replace(request, state_jerk=law_rounding)),
+            ("exact_reach_law_rounding", replace(exact, state_jerk=law_rounding)),
             ("jerk_slack", replace(request, turn_jerk=slack)),
             ("exact_reach_jerk_slack", replace(exact, turn_jerk=slack)),
             ("jerk_slack_whole_move", replace(request, state_jerk=slack)),

@@ -34,6 +34,7 @@ from ..core.checks import FloatArray
 from ..core.errors import InfeasibleError
 
 __all__ = [
+    "STATE_JERK_LAW_ROUNDING",
     "STATE_JERK_PINNED",
     "STATE_JERK_ROUNDING",
     "STATE_JERK_SLACK",
@@ -61,6 +62,10 @@ STATE_JERK_SLACK = 0.02
 #: ``j_max`` reaches (the time-optimal motion rides its limits) and the law's rounding puts
 #: it a hair outside (measured: the U-turn's state at t = 3 s needs 2.6e-5 more jerk).
 STATE_JERK_ROUNDING = 1e-4
+#: ... and one that ``j_max (1 + STATE_JERK_LAW_ROUNDING)`` reaches, silently too, in the stretch
+#: that holds it: a state read off the final jerk phase of a plan's stop, whose law rides
+#: ``j_max`` there within its own rounding (measured: up to 2.3e-3 more jerk needed).
+STATE_JERK_LAW_ROUNDING = 3e-3
 #: A moving state on the edge of what ``j_max`` reaches downstream (its slowest motion, at
 #: ``-j_max``, is the only one that meets a cap further on: a state read off a road's plan
 #: braking into the lateral-jerk caps of the next clothoid joins) leaves its discrete problem

@@ -136,11 +136,11 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
     if request.jerk_limited:
         _check_stretch_states(request, lo, hi, start, end, rest_before, rest_after)
     legs: list[ModelLeg] = []
-    j_state = request.moving_state_jerk
+    j_state = request.leg_jerk(v0, a0, vf, af)
     # A state read off a plan's final stop (it needs the rounding jerk) lies on the stop's
     # curve to the law's rounding, a few 1e-5: it touches zero within a few times that, and
     # its own stop, like a³/j², ends a few times that before or past the stretch's end.
-    rounded = request.state_jerk is not None and j_state <= lim.j_max * (1.0 + STATE_JERK_ROUNDING)
+    rounded = lim.j_max < j_state <= lim.j_max * (1.0 + STATE_JERK_ROUNDING)
     touch = max(TOUCH_ZERO, 4.0 * STATE_JERK_ROUNDING) if rounded else TOUCH_ZERO
     past = 5.0 * STATE_JERK_ROUNDING if rounded else STATE_ROUNDING
     touching = {"touch": touch, "least_duration": length / lim.v_max}
@@ -167,7 +167,7 @@ def _stretch_legs(request: PlanRequest, bound: SpeedBound, lo: float, hi: float,
         if forced is not None and abs(forced.length - length) <= past * length:
             # A state on a stop's curve a rounding before or past the stretch's end: its stop
             # spans the stretch.
-            forced = replace(forced, length=length, s=forced.s * (length / forced.length))
+            forced = _spanning(forced, length)
             head, tail = (forced, None) if forced.v0 > 0 else (None, forced)
     # A forced stop whose acceleration and duration are roundings (a state a few ulps from
     # rest) is no motion: the state is rest.
@@ -199,7 +199,7 @@ def _check_stretch_states(request: PlanRequest, lo: float, hi: float,
     lim = request.limits
     try:
         check_reachable_states(*start, *end, hi - lo, lim.v_max, lim.a_max, lim.a_decel,
-                               request.moving_state_jerk)
+                               request.leg_jerk(*start, *end))
     except InfeasibleError as exc:
         if rest_before is None and rest_after is None:
             raise
@@ -307,7 +307,7 @@ def straight_leg(request: PlanRequest, bound: SpeedBound, lo: float, hi: float, 
     # The jerk a marginal boundary state may use (a state read off a plan lies on the
     # boundary of what j_max reaches, to rounding), as on a grid: over the whole leg.
     motion = straight_motion(hi - lo, v0, vf, float(np.sqrt(top)), lim.a_max, lim.a_decel,
-                             request.moving_state_jerk, a0=a0, af=af)
+                             request.leg_jerk(v0, a0, vf, af), a0=a0, af=af)
     if motion is None:
         return None
     return StraightLeg(start=lo, length=hi - lo, v0=v0, a0=a0, vf=vf, af=af, motion=motion)
@@ -382,8 +382,9 @@ def leg_on_grid(request: PlanRequest, bound: SpeedBound, s: FloatArray, lo: floa
                      s, lo, v0, a0, vf, af)
         w_max[1:-1] = np.maximum(w_max[1:-1], floor[1:-1])
     jerk = np.full(m - 2, lim.J)
-    if request.state_jerk is not None:  # the slack of marginal states, over the whole leg
-        jerk[:] = 2.0 * request.state_jerk
+    j_leg = request.leg_jerk(v0, a0, vf, af)
+    if j_leg != lim.j_max:  # the slack of a marginal state, over the whole leg
+        jerk[:] = 2.0 * j_leg
     if request.smooth_standstill:
         calibrate_standstill_rows(jerk, s, v0, a0, vf, af, lim.j_max)
     problem = DiscreteProblem(
@@ -443,7 +444,7 @@ def _forced_stop(v: float, a: float, j_max: float, *, end: bool, touch: float,
                  least_duration: float) -> ForcedLeg | None:
     """The forced motion to rest when a decelerating start (accelerating end) touches zero.
 
-    ``j_max``: the jerk the state may use (``PlanRequest.moving_state_jerk``). It touches
+    ``j_max``: the jerk the state may use (`PlanRequest.leg_jerk`). It touches
     zero when the speed falls to within ``touch`` of its own (`TOUCH_ZERO`), or so
     close to zero that restarting from rest would cost less than `TOUCH_TIME` of
     ``least_duration`` (the stretch's length over ``v_max``): a dip the grid cannot resolve
@@ -473,6 +474,24 @@ def _forced_stop(v: float, a: float, j_max: float, *, end: bool, touch: float,
     law = TimeLawSpec(j_max=j_max, accel_start=a, accel_end=None)
     return ForcedLeg(start=0.0, length=length, v0=v, a0=a, vf=0.0, af=0.0, s=s, w=w,
                      time_law=law)
+
+
+def _spanning(forced: ForcedLeg, length: float) -> ForcedLeg:
+    """``forced`` (a stop at its own length) bent to span ``length``, its state kept exactly.
+
+    The stop's ``w = v² (1 - x)^{4/3}`` (``x = s / length``; time reversed at an end) takes a
+    factor ``1 + β x`` with ``β = 4/3 (1 - length / forced.length)``: the state's speed and
+    acceleration (the slope at ``x = 0``) stay exact and the jerk changes by about ``β``.
+    Stretching ``s`` alone gave the law an acceleration off by ``β``, bent back to the
+    state's within its first micrometres at 1.05 ``j_max``.
+    """
+    frac = forced.s / forced.length
+    beta = (4.0 / 3.0) * (1.0 - length / forced.length)
+    if forced.v0 > 0:  # from the state to rest
+        w = forced.v0**2 * (1.0 - frac) ** (4.0 / 3.0) * (1.0 + beta * frac)
+    else:  # from rest to the state at the end
+        w = forced.vf**2 * frac ** (4.0 / 3.0) * (1.0 + beta * (1.0 - frac))
+    return replace(forced, length=length, s=frac * length, w=w)
 
 
 def _stops_in_closed_form(v: float, a: float, j_max: float, *, end: bool, touch: float,

@@ -169,10 +169,15 @@ class PlanRequest:
         """Whether the limits bound the jerk."""
         return math.isfinite(self.limits.j_max)  # read many times a plan: no numpy call
 
-    @property
-    def moving_state_jerk(self) -> float:
-        """The jerk a moving boundary state may use [m/s³] (``state_jerk``)."""
-        return self.limits.j_max if self.state_jerk is None else self.state_jerk
+    def leg_jerk(self, v0: float, a0: float, vf: float, af: float) -> float:
+        """The jerk [m/s³] of a leg (or stretch) between these states.
+
+        ``state_jerk`` where one of them moves (a marginal state's looser jerk), else
+        ``limits.j_max``: the looser jerk ends at the state's first rest.
+        """
+        if self.state_jerk is None or (v0 == 0.0 and a0 == 0.0 and vf == 0.0 and af == 0.0):
+            return self.limits.j_max
+        return self.state_jerk
 
     @property
     def smooth_standstill(self) -> bool:

@@ -173,7 +173,7 @@ class Envelopes:
     af: float
     length: float
     in_distance: bool = False
-    state_j: float | None = None  # the jerk of a moving state's envelopes (default j_max)
+    state_j: float | None = None  # the leg's jerk (`PlanRequest.leg_jerk`; default j_max)
 
     @classmethod
     def of(cls, request: PlanRequest, v0: float, a0: float, vf: float, af: float,
@@ -181,7 +181,7 @@ class Envelopes:
         """The envelopes of one leg of ``request`` between the given states."""
         return cls(request.limits, request.smooth_standstill, request.jerk_limited, v0, a0,
                    vf, af, length, in_distance=request.reach == "distance",
-                   state_j=request.moving_state_jerk)
+                   state_j=request.leg_jerk(v0, a0, vf, af))
 
     def cap(self, s: FloatArray, w: FloatArray) -> FloatArray:
         """``w`` capped by the largest ``w`` reachable from (v0, a0) and reaching (vf, af).
@@ -196,16 +196,17 @@ class Envelopes:
         if not self.jerk_limited:
             return w
         if self.smooth or self.v0 > 0:
-            w = np.minimum(w, self._fastest(s, self.v0, self.a0, lim.a_max, lim.a_decel,
-                                            moving=self.v0 > 0))
+            w = np.minimum(w, self._fastest(s, self.v0, self.a0, lim.a_max, lim.a_decel))
         if self.smooth or self.vf > 0:
             w = np.minimum(w, self._fastest(self.length - s, self.vf, -self.af, lim.a_decel,
-                                            lim.a_max, moving=self.vf > 0))
+                                            lim.a_max))
         return w
 
     def _fastest(self, d: FloatArray, v: float, a: float, a_limit: float,
-                 a_brake: float, *, moving: bool) -> FloatArray:
-        j = self.state_j if moving and self.state_j is not None else self.limits.j_max
+                 a_brake: float) -> FloatArray:
+        # The leg's jerk at a rest too: a marginal state's stop into it takes its looser
+        # jerk (1.2 cm before a stop, the state's slowest motion stayed over a cap of j_max).
+        j = self.state_j if self.state_j is not None else self.limits.j_max
         if self.in_distance:
             return fastest_w(d, v, a, j, a_limit, a_brake)
         return jerk_motion_w(d, v, a, j, a_limit)

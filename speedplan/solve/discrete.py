@@ -79,6 +79,9 @@ CUT_MAX_NODES = 10_000
 #: refinement then polishes its point, so that both backends agree to this (the banded
 #: kernel accepts no stop above it, `speedplan.solve._banded_ipm.ALMOST_GAP`).
 POLISH_GAP = 1e-6
+#: A refined point slower than the relaxed one by more than this (relative), where the
+#: relaxed point meets every row within the acceptance tolerance, went astray (`_refined`).
+ASTRAY_GAP = 1e-3
 #: Until the banded kernel is compiled (first use after installation, 20-30 s; see
 #: `kernel_ready`), ``"auto"`` answers with Clarabel below this
 #: many nodes while a background process compiles it; from this size on Clarabel would take
@@ -364,8 +367,22 @@ def _refined(problem: DiscreteProblem, relaxed: _Relaxed, w: FloatArray, status:
     if relaxed.exact:
         faster = ref_ok and problem.travel_time(w_ref) < problem.travel_time(w)
         return (w_ref if faster else w), status, refinement
-    if ref_ok:
+    # The relaxed point may meet every row within the tolerance the refined points are
+    # accepted with, yet fail exactness only by lying under its own bound (rows a hair over
+    # next to a standstill, where the time grows as w^-1/2): there the refinement can stall
+    # and its fallback start end in a far optimum (states read off a stop's approach: 8-50 %
+    # slower, and a law with 7x the jerk). Such a refined point does not replace it.
+    held = (feasible(relaxed.w_unit)
+            and problem.relative_row_excess(relaxed.w) <= ROW_TOL_REL)
+    if ref_ok and not (held and problem.travel_time(w_ref)
+                       > problem.travel_time(relaxed.w) * (1.0 + ASTRAY_GAP)):
         return w_ref, "refined", refinement
+    if held:
+        kept = RefinementInfo(
+            status=f"{ref.status}; the relaxed point kept (within the rows' tolerance)",
+            accepted=False, iterations=ref.iterations, time=ref.solve_time,
+            objective=refinement.objective)
+        return relaxed.w, "refined", kept
     scaled = _scale_into_jerk_bounds(problem, relaxed.w)
     if scaled is None:
         raise SolverError(
