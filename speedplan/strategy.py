@@ -21,8 +21,8 @@ only when the ones before it did not answer:
   for a straight leg whose minimum-time motion is known exactly (`StraightLeg`); ``"given_grid"``
   for the caller's grid (``n`` or ``ds``: both relaxation backends, never another grid);
   otherwise ``"default_grid"`` with the request's backend (for a leg that starts or ends at a
-  moving state, its refinement without IPOPT), then, for such a leg whose refinement found
-  no feasible point,
+  moving state, this and the attempts below refine without IPOPT unless the leg has
+  friction-ellipse rows), then, for such a leg whose refinement found no feasible point,
   ``"state_rounding_on_grid"``: the same grid with ``j_max (1 + STATE_JERK_PINNED)`` in its
   rows (a state on the edge of what ``j_max`` reaches further on leaves the problem no
   interior; silent), then ``"coarser_grid_1/2"``,
@@ -418,14 +418,18 @@ def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
         return record.attempt("given_grid" if request.n is not None or request.ds is not None
                               else "default_grid", i, lambda: solve_leg(leg)), False
     grids: list[Leg] = [leg]  # each built inside its attempt: most default grids solve at once
-    # A moving state on the edge of its reach leaves the default grid's refinement little or
-    # no interior: the banded starts fail, and IPOPT then ran its 5 s to fail as well (twice
-    # on a road's replan, 12.5 s, where the grid with rounded state rows or the coarser one
-    # answers in 0.1 s). There the grids below come first; IPOPT runs in `other_backend`.
+    # A moving state on the edge of its reach leaves the refinement little or no interior:
+    # the banded starts fail, and IPOPT then ran its 5 s to fail as well (twice on a road's
+    # replan, 12.5 s, where the grid with rounded state rows or the coarser one answers in
+    # 0.1 s; a replan 1.5 a_max / j_max before a stop spent 10 s in IPOPT on the coarser grid
+    # and with the other backend, to fail). Such a leg's attempts run no IPOPT, but where
+    # only IPOPT refines (friction-ellipse rows): over the 2 000 plans of bench_latency and
+    # 4 037 replans next to stops, IPOPT answered none of them.
     pinned = _moving_state_at_j_max(request, leg)
+    ipopt = not pinned or leg.problem.has_grip
     try:
         return record.attempt("default_grid", i, partial(solve_leg, leg, fallback=False,
-                                                         ipopt=not pinned)), False
+                                                         ipopt=ipopt)), False
     except SolverError as exc:
         failures = [exc]
     # Only where the relaxation answered and the refinement found no feasible point: a stalled
@@ -438,7 +442,7 @@ def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
     for factor in COARSER_GRIDS:
         try:
             result = record.attempt(f"coarser_grid_1/{round(1 / factor)}", i,
-                                    partial(_solve_coarser, request, grids, factor))
+                                    partial(_solve_coarser, request, grids, factor, ipopt))
         except SolverError as exc:
             failures.append(exc)
             continue
@@ -448,8 +452,8 @@ def _first_answer(request: PlanRequest, leg: ModelLeg, i: int,
     # Each grid with the backend that did not fail on it (the failed one is not run again).
     for grid, failed in zip(grids, failures, strict=True):
         run = (partial(solve_leg, replace(grid, backend=_other_backend(failed.backend)),
-                       fallback=False) if failed.backend in ("banded", "clarabel")
-               else partial(solve_leg, grid))  # a law that did not arrive: both backends
+                       fallback=False, ipopt=ipopt) if failed.backend in ("banded", "clarabel")
+               else partial(solve_leg, grid, ipopt=ipopt))  # both backends
         try:
             return record.attempt("other_backend", i, run), False
         except SolverError as exc:
@@ -488,17 +492,18 @@ class _NotCoarser(Exception):
     """The default grid cannot get coarser (`coarser_leg`)."""
 
 
-def _solve_coarser(request: PlanRequest, grids: list[Leg], factor: float) -> LegResult:
+def _solve_coarser(request: PlanRequest, grids: list[Leg], factor: float,
+                   ipopt: bool = True) -> LegResult:
     """The first leg of ``grids`` on a grid with ``factor`` times its nodes, solved.
 
     The grid is appended to ``grids``; `_NotCoarser` when it would not be coarser
-    than the last one there.
+    than the last one there. ``ipopt``: whether the refinement may fall back to IPOPT.
     """
     coarser = coarser_leg(request, grids[0], factor)
     if coarser is None or coarser.problem.n >= grids[-1].problem.n:
         raise _NotCoarser
     grids.append(coarser)
-    return solve_leg(coarser, fallback=False)
+    return solve_leg(coarser, fallback=False, ipopt=ipopt)
 
 
 # ---- verify ---------------------------------------------------------------------------------

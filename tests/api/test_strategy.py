@@ -532,6 +532,41 @@ def test_a_replan_whose_refinement_stops_short_next_to_its_bound_answers():
         assert not any("ipopt" in a.reason for a in again.attempts), t
 
 
+def test_a_leg_from_a_moving_state_runs_no_ipopt_on_any_grid(monkeypatch):
+    # 1.5 a_max / j_max before a stop on a G2 comfort path, the replan's first leg finds no
+    # feasible refined point on any grid. IPOPT ran on the coarser grid and with the other
+    # backend (5.3 s, 2.2 s, 2.2 s) to fail the same way: 10 s before the SolverError.
+    path = sp.Path.from_waypoints(
+        [[-5.3696874721825845, -1.0806899260810363], [-9.340651477486684, -0.13153752593207813],
+         [-12.739796376730684, 5.292436205848862], [-10.280385387960187, 2.2909414151822842],
+         [-5.054883305693384, 6.066555696008243], [-9.23154158065904, 7.9032614054220405],
+         [-5.111136856360281, 2.409186918189329]], max_deviation=0.23292422603967894)
+    lim = sp.Limits(v_max=1.0912771302521995, a_max=0.9875847487242622,
+                    a_lat_max=0.3882437637948343, j_max=1.497447258996227,
+                    j_lat_max=0.19825777774963074)
+    first = sp.plan(path, lim)
+    stop = _rest_times(first)[1]
+    state = first.at(stop - 1.5 * lim.a_max / lim.j_max)
+    refine = importlib.import_module("speedplan.solve.refine")
+    ran: list[int] = []
+
+    def no_ipopt(problem, w0):
+        ran.append(problem.n)
+        raise AssertionError("IPOPT ran")
+
+    monkeypatch.setattr(refine, "refine_ipopt", no_ipopt)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            again = sp.plan(path.sub(float(state.s[0])), lim, v0=float(state.v[0]),
+                            a0=float(state.a[0]))
+        except sp.SolverError:  # a named error, without a minute of work first
+            again = None
+    assert ran == []
+    if again is not None:
+        assert again.verification.ok and within_promise(measure(again, samples=3_000))
+
+
 def test_a_state_in_the_last_jerk_phase_of_a_stop_keeps_its_acceleration_and_the_jerk():
     # 0.1 a_max / j_max before the end of a G2 path (1.6 mm left), the state needs 8.6e-5
     # more jerk than j_max: its stop, 0.05 % longer than the path left, spans it. Stretched
